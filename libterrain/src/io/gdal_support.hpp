@@ -1,0 +1,30 @@
+#pragma once
+// Private helpers for the GDAL-facing code of libterrain (not installed).
+
+#include <cpl_error.h>
+
+#include <string>
+
+namespace terrain::io {
+
+// GDALAllRegister once per process.
+void ensure_gdal_registered();
+
+// While alive, GDAL errors and warnings raised on this thread are kept here instead of being
+// printed (the library never prints). suffix() gives ": <last error>" for a message.
+class GdalErrorCapture {
+public:
+    GdalErrorCapture();
+    ~GdalErrorCapture();
+    GdalErrorCapture(const GdalErrorCapture&) = delete;
+    GdalErrorCapture& operator=(const GdalErrorCapture&) = delete;
+
+    const std::string& last_error() const { return last_error_; }
+    std::string suffix() const { return last_error_.empty() ? "" : " (" + last_error_ + ")"; }
+
+private:
+    static void CPL_STDCALL handler(CPLErr level, CPLErrorNum number, const char* message);
+    std::string last_error_;
+};
+
+}  // namespace terrain::io

@@ -1,0 +1,144 @@
+#include "terrain/io/read_dem.hpp"
+
+#include <cpl_conv.h>
+#include <cpl_error.h>
+#include <gdal_priv.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <memory>
+
+#include "terrain/core/error.hpp"
+#include "gdal_support.hpp"
+
+namespace terrain::io {
+
+ElevationKind detect_elevation_kind(const Body& body, double min_value, double max_value) {
+    // A radius DEM holds values close to the body's radius; heights above a reference never
+    // reach half of it (Vesta's relief, the largest relative to its size, is about +-10%).
+    if (body.has_crs && body.semi_major_axis > 0 && min_value > 0.5 * body.semi_major_axis &&
+        max_value < 1.5 * body.semi_major_axis)
+        return ElevationKind::radius;
+    return ElevationKind::height;
+}
+
+Dem read_dem(const std::string& path, const ReadDemOptions& options, const ProgressFn& progress) {
+    ensure_gdal_registered();
+    const GdalErrorCapture errors;
+    if (!std::filesystem::exists(path) && path.rfind("/vsi", 0) != 0)
+        throw Error("read", "'" + path + "' does not exist; check the path");
+    std::unique_ptr<GDALDataset> dataset(
+        GDALDataset::Open(path.c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY));
+    if (!dataset)
+        throw Error("read", "'" + path + "' is not a raster GDAL can open" +
+                                errors.suffix() + "; give a DEM such as a GeoTIFF or a PDS label");
+    const int band_count = dataset->GetRasterCount();
+    if (band_count == 0) throw Error("read", "'" + path + "' has no raster band");
+    if (options.band < 1 || options.band > band_count)
+        throw Error("read", "band " + std::to_string(options.band) + " does not exist in '" +
+                                path + "', which has " + std::to_string(band_count) +
+                                " band(s); choose --band 1.." + std::to_string(band_count));
+    Dem dem;
+    dem.source = path;
+    dem.band = options.band;
+    dem.width = dataset->GetRasterXSize();
+    dem.height = dataset->GetRasterYSize();
+    if (dem.width < 2 || dem.height < 2)
+        throw Error("read", "'" + path + "' is " + std::to_string(dem.width) + "x" +
+                                std::to_string(dem.height) +
+                                " pixels; a surface needs at least 2x2 pixels");
+
+    dem.has_transform = dataset->GetGeoTransform(dem.transform.data()) == CE_None;
+    if (!dem.has_transform) {
+        const double size = options.pixel_size.value_or(1.0);
+        dem.transform = {0, size, 0, 0, 0, -size};
+    } else if (options.pixel_size) {
+        throw Error("read", "'" + path +
+                                "' is georeferenced; --pixel-size is only for rasters without a "
+                                "geotransform");
+    }
+    if (const OGRSpatialReference* srs = dataset->GetSpatialRef()) {
+        char* wkt = nullptr;
+        const char* wkt_options[] = {"FORMAT=WKT2_2019", nullptr};
+        if (srs->exportToWkt(&wkt, wkt_options) == OGRERR_NONE && wkt) dem.crs_wkt = wkt;
+        CPLFree(wkt);
+    }
+    dem.body = body_from_crs(dem.crs_wkt);
+
+    GDALRasterBand* band = dataset->GetRasterBand(options.band);
+    int has_scale = 0, has_offset = 0;
+    const double scale = band->GetScale(&has_scale);
+    const double offset = band->GetOffset(&has_offset);
+    const double a = has_scale ? scale : 1.0;
+    const double b = has_offset ? offset : 0.0;
+    GDALRasterBand* mask = band->GetMaskBand();
+    const bool all_valid = band->GetMaskFlags() == GMF_ALL_VALID;
+
+    const std::size_t width = static_cast<std::size_t>(dem.width);
+    dem.values.assign(width * static_cast<std::size_t>(dem.height),
+                      std::numeric_limits<double>::quiet_NaN());
+    std::vector<unsigned char> mask_row(all_valid ? 0 : width);
+    std::size_t valid = 0, not_finite = 0;
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    int first_bad_col = -1, first_bad_row = -1;
+    for (int row = 0; row < dem.height; ++row) {
+        double* out = dem.values.data() + static_cast<std::size_t>(row) * width;
+        if (band->RasterIO(GF_Read, 0, row, dem.width, 1, out, dem.width, 1, GDT_Float64, 0, 0) !=
+            CE_None)
+            throw Error("read", "cannot read row " + std::to_string(row) + " of '" + path + "'" +
+                                    errors.suffix());
+        if (!all_valid && mask->RasterIO(GF_Read, 0, row, dem.width, 1, mask_row.data(),
+                                         dem.width, 1, GDT_Byte, 0, 0) != CE_None)
+            throw Error("read", "cannot read the NoData mask of '" + path + "'" + errors.suffix());
+        for (std::size_t col = 0; col < width; ++col) {
+            double& v = out[col];
+            if (!all_valid && mask_row[col] == 0) {
+                v = std::numeric_limits<double>::quiet_NaN();
+                continue;
+            }
+            if (!std::isfinite(v)) {
+                if (not_finite++ == 0) {
+                    first_bad_col = static_cast<int>(col);
+                    first_bad_row = row;
+                }
+                v = std::numeric_limits<double>::quiet_NaN();
+                continue;
+            }
+            v = v * a + b;
+            lo = std::min(lo, v);
+            hi = std::max(hi, v);
+            ++valid;
+        }
+        if ((row & 63) == 0) report_progress(progress, double(row) / dem.height, "read");
+    }
+    if (not_finite > 0 && !options.nan_as_nodata)
+        throw Error("read", "'" + path + "' has " + std::to_string(not_finite) +
+                                " NaN or infinite value(s) not declared NoData (first at col " +
+                                std::to_string(first_bad_col) + ", row " +
+                                std::to_string(first_bad_row) +
+                                "); declare NoData (gdal_edit.py -a_nodata nan) or pass "
+                                "--nan-nodata to treat them as holes");
+    if (valid == 0)
+        throw Error("read", "'" + path + "' band " + std::to_string(options.band) +
+                                " has no valid pixel (all NoData); check the band and NoData value");
+    if (valid < 3)
+        throw Error("read", "'" + path + "' has only " + std::to_string(valid) +
+                                " valid pixel(s); a surface needs at least three");
+
+    if (options.elevation) {
+        dem.elevation = *options.elevation;
+        dem.elevation_detected = false;
+        if (dem.elevation == ElevationKind::radius && !dem.body.has_crs)
+            throw Error("read", "'" + path +
+                                    "' has no CRS, so its values cannot be radii of a body; use "
+                                    "--elevation height");
+    } else {
+        dem.elevation = detect_elevation_kind(dem.body, lo, hi);
+    }
+    report_progress(progress, 1.0, "read");
+    return dem;
+}
+
+}  // namespace terrain::io

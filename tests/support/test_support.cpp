@@ -1,0 +1,91 @@
+#include "support/test_support.hpp"
+
+#include <gdal_priv.h>
+#include <ogr_spatialref.h>
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <fstream>
+#include <memory>
+#include <sstream>
+#include <stdexcept>
+
+namespace terrain::test {
+
+std::string sample(const std::string& name) {
+    return std::string(TERRAIN_SOURCE_DIR) + "/examples/data/" + name;
+}
+
+std::optional<std::string> shared_data(const std::string& relative) {
+    const std::string path = std::string(TERRAIN_SHARED_DATA_DIR) + "/" + relative;
+    if (!std::filesystem::exists(path)) return std::nullopt;
+    return path;
+}
+
+std::filesystem::path scratch_dir(const std::string& name) {
+    const auto dir = std::filesystem::current_path() / "scratch" / name;
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+    return dir;
+}
+
+std::string write_raster(const std::filesystem::path& path, const RasterSpec& spec) {
+    GDALAllRegister();
+    GDALDriver* driver = GetGDALDriverManager()->GetDriverByName("GTiff");
+    const GDALDataType type = GDALGetDataTypeByName(spec.type.c_str());
+    std::unique_ptr<GDALDataset> ds(
+        driver->Create(path.c_str(), spec.width, spec.height, 1, type, nullptr));
+    if (!ds) throw std::runtime_error("cannot create " + path.string());
+    if (!spec.geotransform.empty()) {
+        std::vector<double> gt = spec.geotransform;
+        ds->SetGeoTransform(gt.data());
+    }
+    if (!spec.crs.empty()) {
+        OGRSpatialReference srs;
+        srs.SetFromUserInput(spec.crs.c_str());
+        ds->SetSpatialRef(&srs);
+    }
+    GDALRasterBand* band = ds->GetRasterBand(1);
+    if (spec.nodata) band->SetNoDataValue(*spec.nodata);
+    if (spec.scale != 1) band->SetScale(spec.scale);
+    if (spec.offset != 0) band->SetOffset(spec.offset);
+    std::vector<double> values = spec.values;
+    values.resize(static_cast<std::size_t>(spec.width) * spec.height, 0.0);
+    if (band->RasterIO(GF_Write, 0, 0, spec.width, spec.height, values.data(), spec.width,
+                       spec.height, GDT_Float64, 0, 0) != CE_None)
+        throw std::runtime_error("cannot write " + path.string());
+    return path.string();
+}
+
+namespace {
+std::string quote(const std::string& s) {
+    std::string q = "'";
+    for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    return q + "'";
+}
+std::string slurp(const std::filesystem::path& p) {
+    std::ifstream in(p);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+}  // namespace
+
+CliResult run_cli(const std::vector<std::string>& args) {
+    static int counter = 0;
+    const auto dir = std::filesystem::current_path() / "scratch" / "cli";
+    std::filesystem::create_directories(dir);
+    const auto out = dir / ("out" + std::to_string(counter) + ".txt");
+    const auto err = dir / ("err" + std::to_string(counter++) + ".txt");
+    std::string command = quote(TERRAIN_CLI);
+    for (const auto& a : args) command += " " + quote(a);
+    command += " </dev/null >" + quote(out) + " 2>" + quote(err);
+    const int raw = std::system(command.c_str());
+    CliResult r;
+    r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : 128 + WTERMSIG(raw);
+    r.out = slurp(out);
+    r.err = slurp(err);
+    return r;
+}
+
+}  // namespace terrain::test

@@ -1,0 +1,40 @@
+#pragma once
+// Helpers for the tests: sample data paths, a scratch directory, small rasters made with GDAL,
+// and running the `terrain` CLI.
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace terrain::test {
+
+// examples/data/<name>
+std::string sample(const std::string& name);
+// ../shared/data/<relative>, or nullopt when the shared data is not beside the project.
+std::optional<std::string> shared_data(const std::string& relative);
+
+// A fresh, empty directory under the build tree for one test (removed at the start of the
+// next run, kept for inspection after a failure).
+std::filesystem::path scratch_dir(const std::string& name);
+
+struct RasterSpec {
+    int width = 4, height = 4;
+    std::string type = "Float32";  // a GDAL data type name
+    std::vector<double> values;    // row-major, width*height
+    std::optional<double> nodata;
+    std::string crs;               // empty: none; else anything SetFromUserInput takes
+    std::vector<double> geotransform;  // empty: none
+    double scale = 1, offset = 0;
+};
+// Writes a GeoTIFF with GDAL; returns its path.
+std::string write_raster(const std::filesystem::path& path, const RasterSpec& spec);
+
+struct CliResult {
+    int status = -1;
+    std::string out, err;
+};
+// Runs the built `terrain` binary with arguments (shell-quoted), capturing stdout and stderr.
+CliResult run_cli(const std::vector<std::string>& args);
+
+}  // namespace terrain::test

@@ -1,0 +1,100 @@
+#include "cli.hpp"
+
+#include <iostream>
+#include <cmath>
+#include <memory>
+
+#include "terrain/core/error.hpp"
+
+namespace terrain::cli {
+
+bool parse(int argc, char** argv, const std::string& usage, const po::options_description& options,
+           const po::positional_options_description& positional, po::variables_map& vm) {
+    po::options_description all;
+    all.add(options);
+    all.add_options()("help,h", "show this help");
+    try {
+        po::store(po::command_line_parser(argc, argv).options(all).positional(positional).run(),
+                  vm);
+        if (vm.count("help")) {
+            std::cout << "Usage: " << usage << "\n\n" << all << "\n";
+            return false;
+        }
+        po::notify(vm);
+    } catch (const po::error& e) {
+        throw UsageError(std::string(e.what()) + " (see --help)");
+    }
+    return true;
+}
+
+ProgressFn terminal_progress(bool quiet) {
+    if (quiet) return {};
+    // Prints each tenth once, like GDALTermProgress; shared state lives in the closure.
+    auto last = std::make_shared<int>(-1);
+    return [last](double fraction, std::string_view) {
+        const int tenth = static_cast<int>(fraction * 10.0 + 1e-9);
+        while (*last < tenth) {
+            ++*last;
+            if (*last == 10)
+                std::cerr << "100 - done." << std::endl;
+            else
+                std::cerr << *last * 10 << "..." << std::flush;
+        }
+        return true;
+    };
+}
+
+int guarded(const std::string& command, const std::function<int()>& body) {
+    try {
+        return body();
+    } catch (const UsageError& e) {
+        std::cerr << "terrain " << command << ": " << e.what() << "\n";
+        return kUsageError;
+    } catch (const terrain::Error& e) {
+        std::cerr << "terrain " << command << ": " << e.what() << "\n";
+        return kUserError;
+    } catch (const std::bad_alloc&) {
+        std::cerr << "terrain " << command << ": out of memory; try a smaller input\n";
+        return kUserError;
+    } catch (const std::exception& e) {
+        std::cerr << "terrain " << command << ": " << e.what() << "\n";
+        return kUserError;
+    }
+}
+
+}  // namespace terrain::cli
+
+#include "dem_options.hpp"
+
+namespace terrain::cli {
+
+void add_dem_options(po::options_description& options, DemOptionValues& values) {
+    options.add_options()
+        ("band,b", po::value(&values.band)->default_value(1), "raster band to read (1-based)")
+        ("elevation", po::value(&values.elevation)->default_value("auto"),
+         "radius|height|auto: whether values are radii from the body's centre or heights "
+         "above its reference (auto: radius when they sit near the body's radius)")
+        ("nan-nodata", po::bool_switch(&values.nan_nodata),
+         "treat NaN/Inf pixels as NoData holes instead of refusing the raster")
+        ("pixel-size", po::value(&values.pixel_size),
+         "metres per pixel, for a raster with no geotransform (default 1)");
+}
+
+io::ReadDemOptions to_read_options(const DemOptionValues& values) {
+    io::ReadDemOptions options;
+    options.band = values.band;
+    if (values.elevation == "radius")
+        options.elevation = ElevationKind::radius;
+    else if (values.elevation == "height")
+        options.elevation = ElevationKind::height;
+    else if (values.elevation != "auto")
+        throw UsageError("--elevation must be radius, height or auto, not '" + values.elevation +
+                         "'");
+    options.nan_as_nodata = values.nan_nodata;
+    if (values.pixel_size < 0 || !std::isfinite(values.pixel_size))
+        throw UsageError("--pixel-size must be a positive number of metres");
+    if (values.pixel_size > 0) options.pixel_size = values.pixel_size;
+    return options;
+}
+
+}  // namespace terrain::cli

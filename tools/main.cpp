@@ -1,0 +1,59 @@
+// terrain: planetary terrain segmentation. Dispatches to one subcommand per file.
+#include <cstring>
+#include <iostream>
+#include <string>
+
+#include "cli.hpp"
+#include "terrain/core/version.hpp"
+
+namespace terrain::cli {
+int run_info(int argc, char** argv);
+int run_synth(int argc, char** argv);
+}  // namespace terrain::cli
+
+namespace {
+
+struct Command {
+    const char* name;
+    const char* summary;
+    int (*run)(int, char**);
+};
+
+constexpr Command kCommands[] = {
+    {"info", "describe a DEM: size, pixel size, CRS, body, elevation kind and range",
+     terrain::cli::run_info},
+    {"synth", "generate a synthetic cratered DEM tile (the Vesta sample)",
+     terrain::cli::run_synth},
+};
+
+void print_usage(std::ostream& out) {
+    out << "Usage: terrain <command> [options]   (terrain <command> --help for details)\n\n"
+           "Commands:\n";
+    for (const auto& c : kCommands) out << "  " << c.name << std::string(10 - std::strlen(c.name), ' ') << c.summary << "\n";
+    out << "\nOptions:\n  --version   print the versions of terrain and its libraries\n"
+           "  --help      show this help\n";
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    if (argc < 2) {
+        print_usage(std::cerr);
+        return terrain::cli::kUsageError;
+    }
+    const std::string first = argv[1];
+    if (first == "--help" || first == "-h" || first == "help") {
+        print_usage(std::cout);
+        return 0;
+    }
+    if (first == "--version") {
+        std::cout << "terrain " << terrain::version() << "\n";
+        for (const auto& [name, version] : terrain::dependency_versions())
+            std::cout << "  " << name << " " << version << "\n";
+        return 0;
+    }
+    for (const auto& c : kCommands)
+        if (first == c.name) return c.run(argc - 1, argv + 1);
+    std::cerr << "terrain: unknown command '" << first << "' (see terrain --help)\n";
+    return terrain::cli::kUsageError;
+}
