@@ -1,0 +1,73 @@
+#!/usr/bin/env bash
+# terrain's set-up, in one command each (see README.md):
+#   ./setup.sh          install missing Debian packages, build, run the main job on the sample
+#   ./setup.sh test     install missing Debian packages, build, run the whole test suite
+# Both are idempotent: installed packages are skipped and the build directory is reused.
+# Environment: BUILD_DIR (default build), OUT_DIR (default out), JOBS (default nproc).
+set -euo pipefail
+
+here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
+cd "$here"
+mode="${1:-run}"
+build_dir="${BUILD_DIR:-build}"
+out_dir="${OUT_DIR:-out}"
+jobs="${JOBS:-$(nproc)}"
+
+# Every Debian 12 package the project builds, tests and runs with. Keep in step with
+# cmake/TerrainDependencies.cmake, which names the package for each missing dependency.
+packages=(
+  build-essential cmake ninja-build pkg-config ccache
+  libgdal-dev gdal-bin libproj-dev
+  libgeographiclib-dev
+  libcgal-dev libgmp-dev libmpfr-dev
+  libopenimageio-dev
+  libboost-program-options-dev
+  libeigen3-dev libtbb-dev
+  catch2
+)
+
+install_packages() {
+  local missing=()
+  for p in "${packages[@]}"; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+  done
+  [ ${#missing[@]} -eq 0 ] && return 0
+  echo "setup: installing ${missing[*]}"
+  local sudo=""
+  if [ "$(id -u)" -ne 0 ]; then
+    command -v sudo >/dev/null || { echo "setup: run as root or install: ${missing[*]}" >&2; exit 1; }
+    sudo=sudo
+  fi
+  $sudo apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
+}
+
+build() {
+  local launcher=()
+  command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+  if [ ! -f "$build_dir/CMakeCache.txt" ]; then
+    cmake -S . -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE=Release "${launcher[@]}"
+  fi
+  cmake --build "$build_dir" -j "$jobs"
+}
+
+case "$mode" in
+  run)
+    install_packages
+    build
+    sample=examples/data/vesta_hamo_tile.lbl
+    mkdir -p "$out_dir"
+    "$build_dir/tools/terrain" info "$sample"
+    "$build_dir/tools/terrain" info "$sample" --json > "$out_dir/vesta_hamo_tile.info.json"
+    echo "setup: outputs in $out_dir/: vesta_hamo_tile.info.json"
+    ;;
+  test)
+    install_packages
+    build
+    ctest --test-dir "$build_dir" --output-on-failure -j "$jobs"
+    ;;
+  *)
+    echo "usage: ./setup.sh [run|test]" >&2
+    exit 2
+    ;;
+esac
