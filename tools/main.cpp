@@ -9,6 +9,7 @@
 namespace terrain::cli {
 int run_info(int argc, char** argv);
 int run_synth(int argc, char** argv);
+int run_mesh(int argc, char** argv);
 }  // namespace terrain::cli
 
 namespace {
@@ -22,6 +23,8 @@ struct Command {
 constexpr Command kCommands[] = {
     {"info", "describe a DEM: size, pixel size, CRS, body, elevation kind and range",
      terrain::cli::run_info},
+    {"mesh", "triangulate a DEM on its body (or check a mesh file) into a binary PLY",
+     terrain::cli::run_mesh},
     {"synth", "generate a synthetic cratered DEM tile (the Vesta sample)",
      terrain::cli::run_synth},
 };

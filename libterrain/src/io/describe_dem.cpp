@@ -24,7 +24,7 @@ struct Transformer {
 Transformer make_lonlat_transformer(const std::string& wkt) {
     Transformer t;
     t.source = std::make_unique<OGRSpatialReference>();
-    if (t.source->importFromWkt(wkt.c_str()) != OGRERR_NONE) return {};
+    if (t.source->SetFromUserInput(wkt.c_str()) != OGRERR_NONE) return {};
     t.source->SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
     t.geographic.reset(t.source->CloneGeogCS());
     if (!t.geographic) return {};

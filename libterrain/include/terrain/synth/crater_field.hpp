@@ -8,6 +8,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "terrain/core/dem.hpp"
@@ -17,10 +18,10 @@ namespace terrain::synth {
 
 // Vesta's reference sphere and the HAMO DTM grid (Preusker et al., Dawn HAMO DTM, PDS
 // data set DAWN-A-FC2-5-VESTADTMSPG-V1.0).
-inline constexpr double kVestaRadius = 255000.0;       // metres
-inline constexpr double kHamoPixelsPerDegree = 64.0;   // about 69.54 m per pixel
-inline constexpr double kHamoScalingFactor = 2.0;      // metres per DN
-inline constexpr double kHamoOffset = 255000.0;        // radius at DN 0, metres
+inline constexpr double kVestaRadius = 255000.0;      // metres
+inline constexpr double kHamoPixelsPerDegree = 64.0;  // about 69.54 m per pixel
+inline constexpr double kHamoScalingFactor = 2.0;     // metres per DN
+inline constexpr double kHamoOffset = 255000.0;       // radius at DN 0, metres
 
 // One simple crater. Centres are in pixels of the tile: (0,0) is the top-left corner of the
 // top-left pixel, (col+0.5,row+0.5) the centre of pixel (col,row); they may lie outside the
@@ -33,8 +34,8 @@ struct Crater {
 };
 
 struct VestaTileOptions {
-    int width = 512;   // pixels
-    int height = 512;  // pixels
+    int width = 512;                // pixels
+    int height = 512;               // pixels
     std::uint64_t seed = 20110716;  // Dawn entered orbit around Vesta on 16 July 2011
 
     // Tile centre, degrees (planetocentric latitude, east longitude). Default: the southern
@@ -47,9 +48,10 @@ struct VestaTileOptions {
     std::optional<double> standard_parallel;
 
     // Crater population: cumulative N(>=D) = crater_density * (D / 1 km)^-size_exponent per
-    // km^2, for diameters in [min_diameter, max_diameter]. 0.02 km^-2 at 1 km is a moderately
-    // cratered Vesta surface (Marchi et al. 2012 count 0.004-0.04).
-    double crater_density = 0.02;
+    // km^2, for diameters in [min_diameter, max_diameter]. 0.05 km^-2 at 1 km is a heavily
+    // cratered surface, about a third of the empirical saturation of small craters (Hartmann
+    // 1984: N(>=D) = 0.15 D^-2 km^-2).
+    double crater_density = 0.05;
     double size_exponent = 2.0;
     double min_diameter = 300.0;    // metres (about 4 pixels)
     double max_diameter = 15000.0;  // metres

@@ -1,0 +1,34 @@
+#pragma once
+// Triangulates a DEM into a georeferenced 2-manifold mesh on its body (METHOD.md section 1):
+// one vertex per valid pixel centre, each 2x2 block of valid pixels split along its shorter
+// 3-D diagonal (ties: the top-left to bottom-right one), three valid pixels give one
+// triangle. A grid global in longitude closes its seam and collapses each pole row to one
+// vertex (body frame). Pinched vertices (fans meeting only at them) are split, one vertex
+// per fan; valid pixels in no triangle are left out. See docs/mesh.md.
+
+#include <optional>
+
+#include "terrain/core/dem.hpp"
+#include "terrain/core/progress.hpp"
+#include "terrain/mesh/triangle_mesh.hpp"
+
+namespace terrain::mesh {
+
+struct DemToMeshOptions {
+    std::optional<MeshFrame> frame;  // body or map; unset: default_frame(dem)
+    bool close_global = true;        // close the seam and the poles of a global grid
+};
+
+// body for planetary and geographic CRSs, map for projected Earth CRSs and local grids.
+MeshFrame default_frame(const Dem& dem);
+
+// Throws terrain::Error (stage "mesh") when the DEM gives no triangle or the frame does not
+// apply (body frame without a CRS).
+TriangleMesh dem_to_mesh(const Dem& dem, const DemToMeshOptions& options = {},
+                         const ProgressFn& progress = {});
+
+// For each pixel (row-major), the vertex made from it, or -1 (NoData, isolated). The pixels
+// of a collapsed pole row all map to the pole vertex; a split pinch maps to its first copy.
+std::vector<std::int32_t> pixel_to_vertex(const TriangleMesh& mesh, const Dem& dem);
+
+}  // namespace terrain::mesh

@@ -1,0 +1,88 @@
+#pragma once
+// The triangle mesh every later stage works on: compact arrays (float positions re-centred
+// on an origin, int32 triangles, CSR vertex adjacency, float vertex areas), about 72 bytes
+// per vertex for a DEM mesh. Vertices made from a DEM keep their pixel.
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "terrain/core/body.hpp"
+
+namespace terrain {
+
+enum class MeshFrame { body, map, file };
+
+const char* to_string(MeshFrame frame);
+
+struct TriangleMesh {
+    // Position of vertex v in metres = origin + positions[v]; floats keep ~0.1 m on a
+    // whole planet and sub-millimetre on a tile.
+    std::array<double, 3> origin{0, 0, 0};
+    std::vector<std::array<float, 3>> positions;
+    // Counter-clockwise seen from outside the body (or from above, for a map frame).
+    std::vector<std::array<std::int32_t, 3>> triangles;
+    // One third of the incident triangles' areas, m^2 (their sum is the surface area).
+    std::vector<float> vertex_areas;
+    // CSR adjacency: the mesh neighbours of v are neighbors[neighbor_offsets[v] ..
+    // neighbor_offsets[v+1]), sorted by index.
+    std::vector<std::int32_t> neighbor_offsets;
+    std::vector<std::int32_t> neighbors;
+
+    // DEM meshes: the pixel (row*grid_width + col) each vertex was made from; empty for
+    // meshes read from files. A pole vertex keeps the first pixel of its row.
+    std::vector<std::int32_t> vertex_pixel;
+    int grid_width = 0, grid_height = 0;
+
+    MeshFrame frame = MeshFrame::file;
+    Body body;                 // the body for DEM meshes in the body frame
+    std::string crs_wkt;       // the DEM's CRS (map frame: the CRS of x, y)
+
+    // What the triangulation met (DEM meshes).
+    std::size_t pinched_vertices = 0;   // vertices split because fans met only at them
+    std::size_t isolated_vertices = 0;  // valid pixels (or file vertices) in no triangle, left out
+    bool seam_closed = false;           // a global grid: last column joined to the first
+    // Collapsed pole rows (north, south) and their vertices; -1 when not collapsed.
+    std::array<int, 2> pole_rows{-1, -1};
+    std::array<std::int32_t, 2> pole_vertices{-1, -1};
+
+    std::size_t vertex_count() const { return positions.size(); }
+    std::size_t triangle_count() const { return triangles.size(); }
+    std::array<double, 3> position(std::size_t v) const {
+        const auto& p = positions[v];
+        return {origin[0] + p[0], origin[1] + p[1], origin[2] + p[2]};
+    }
+    std::size_t degree(std::size_t v) const {
+        return static_cast<std::size_t>(neighbor_offsets[v + 1] - neighbor_offsets[v]);
+    }
+    // Bytes held by the arrays above (capacity, not size).
+    std::size_t memory_bytes() const;
+};
+
+// Counts of a mesh's topology.
+struct MeshTopology {
+    std::size_t vertices = 0, edges = 0, faces = 0;
+    std::size_t boundary_edges = 0;      // edges in one triangle
+    std::size_t boundary_loops = 0;      // connected cycles of boundary edges
+    std::size_t components = 0;          // connected components (by triangles)
+    std::int64_t euler_characteristic = 0;  // V - E + F
+};
+
+// Fills vertex_areas and the CSR adjacency from positions and triangles.
+void finish_mesh(TriangleMesh& mesh);
+
+MeshTopology mesh_topology(const TriangleMesh& mesh);
+
+// Splits every vertex whose triangles form several fans (meeting only at the vertex): the
+// largest fan (ties: the one with the lowest triangle) keeps it, each other fan gets a copy
+// appended at the end (vertex_pixel copied too). Returns the number of vertices split and
+// stores the first one in *first_pinched when given. Call before finish_mesh.
+std::size_t split_pinched_vertices(TriangleMesh& mesh, std::int32_t* first_pinched = nullptr);
+
+// Removes vertices that are in no triangle, keeping the order of the others (and their
+// vertex_pixel). Returns the number removed.
+std::size_t remove_unreferenced_vertices(TriangleMesh& mesh);
+
+}  // namespace terrain

@@ -1,0 +1,300 @@
+#include "terrain/mesh/dem_to_mesh.hpp"
+
+#include <GeographicLib/Geocentric.hpp>
+#include <GeographicLib/LocalCartesian.hpp>
+#include <ogr_spatialref.h>
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <numbers>
+
+#include "terrain/core/error.hpp"
+#include "terrain/io/describe_dem.hpp"
+
+namespace terrain::mesh {
+namespace {
+
+constexpr double kDegree = std::numbers::pi / 180.0;
+using Triangle = std::array<std::int32_t, 3>;
+
+struct LonLatTransform {
+    std::unique_ptr<OGRSpatialReference> source, geographic;
+    std::unique_ptr<OGRCoordinateTransformation> ct;
+};
+
+LonLatTransform make_lonlat(const std::string& wkt) {
+    LonLatTransform t;
+    t.source = std::make_unique<OGRSpatialReference>();
+    if (t.source->SetFromUserInput(wkt.c_str()) != OGRERR_NONE)
+        throw Error("mesh", "cannot read the DEM's CRS");
+    t.source->SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+    t.geographic.reset(t.source->CloneGeogCS());
+    if (!t.geographic) throw Error("mesh", "the DEM's CRS has no geographic base");
+    t.geographic->SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+    t.ct.reset(OGRCreateCoordinateTransformation(t.source.get(), t.geographic.get()));
+    if (!t.ct) throw Error("mesh", "cannot transform the DEM's CRS to longitude/latitude");
+    return t;
+}
+
+bool crs_is(const std::string& wkt, bool geographic) {
+    OGRSpatialReference srs;
+    if (srs.SetFromUserInput(wkt.c_str()) != OGRERR_NONE) return false;
+    return geographic ? srs.IsGeographic() : srs.IsProjected();
+}
+
+double crs_linear_unit(const std::string& wkt) {
+    OGRSpatialReference srs;
+    if (srs.SetFromUserInput(wkt.c_str()) != OGRERR_NONE) return 1.0;
+    return srs.IsProjected() ? srs.GetLinearUnits() : 1.0;
+}
+
+}  // namespace
+
+MeshFrame default_frame(const Dem& dem) {
+    if (dem.crs_wkt.empty()) return MeshFrame::map;
+    if (dem.body.name == "Earth" && crs_is(dem.crs_wkt, false)) return MeshFrame::map;
+    return MeshFrame::body;
+}
+
+TriangleMesh dem_to_mesh(const Dem& dem, const DemToMeshOptions& options,
+                         const ProgressFn& progress) {
+    const MeshFrame frame = options.frame.value_or(default_frame(dem));
+    if (frame == MeshFrame::file) throw Error("mesh", "a DEM mesh is in the body or map frame");
+    if (frame == MeshFrame::body && dem.crs_wkt.empty())
+        throw Error("mesh", "'" + dem.source +
+                                "' has no CRS, so it has no body to place it on; use --frame map");
+    const int W = dem.width, H = dem.height;
+    const bool geographic_crs = !dem.crs_wkt.empty() && crs_is(dem.crs_wkt, true);
+    const bool need_lonlat = frame == MeshFrame::body || geographic_crs;
+
+    // A global grid closes in the body frame: seam, and pole rows whose outer edge is a pole.
+    bool wrap = false;
+    std::array<bool, 2> pole{false, false};
+    if (frame == MeshFrame::body && options.close_global) {
+        const auto d = io::describe_dem(dem);
+        wrap = d.global_longitude;
+        if (wrap) {
+            const double row_degrees = (d.lat_max - d.lat_min) / H;
+            pole[0] = d.lat_max > 90.0 - 0.25 * row_degrees;
+            pole[1] = d.lat_min < -90.0 + 0.25 * row_degrees;
+        }
+    }
+
+    TriangleMesh mesh;
+    mesh.frame = frame;
+    mesh.body = dem.body;
+    mesh.crs_wkt = dem.crs_wkt;
+    mesh.grid_width = W;
+    mesh.grid_height = H;
+    mesh.seam_closed = wrap;
+
+    // Vertex numbering: valid pixels in row-major order; a collapsed pole row is one vertex.
+    std::vector<std::int32_t> vertex_of(dem.size(), -1);
+    std::int32_t count = 0;
+    for (int row = 0; row < H; ++row) {
+        const int which = row == 0 && pole[0] ? 0 : (row == H - 1 && pole[1] ? 1 : -1);
+        std::int32_t pole_id = -1;
+        for (int col = 0; col < W; ++col) {
+            if (!dem.valid(col, row)) continue;
+            const auto p = dem.index(col, row);
+            if (which >= 0) {
+                if (pole_id < 0) {
+                    pole_id = count++;
+                    mesh.vertex_pixel.push_back(std::int32_t(p));
+                    mesh.pole_rows[which] = row;
+                    mesh.pole_vertices[which] = pole_id;
+                }
+                vertex_of[p] = pole_id;
+            } else {
+                vertex_of[p] = count++;
+                mesh.vertex_pixel.push_back(std::int32_t(p));
+            }
+        }
+    }
+    if (count < 3) throw Error("mesh", "'" + dem.source + "' has fewer than 3 valid pixels");
+    report_progress(progress, 0.05, "mesh");
+
+    // Positions in double, per row in parallel (one PROJ transformation per thread).
+    std::vector<std::array<double, 3>> xyz(static_cast<std::size_t>(count));
+    const double a = dem.body.semi_major_axis, f = dem.body.flattening;
+    const double unit = dem.crs_wkt.empty() ? 1.0 : crs_linear_unit(dem.crs_wkt);
+    std::unique_ptr<GeographicLib::Geocentric> earth;
+    if (need_lonlat) earth = std::make_unique<GeographicLib::Geocentric>(a, f);
+    std::unique_ptr<GeographicLib::LocalCartesian> tangent;
+    if (frame == MeshFrame::map && geographic_crs) {
+        const auto centre = dem.map_xy(W / 2.0, H / 2.0);
+        tangent = std::make_unique<GeographicLib::LocalCartesian>(centre[1], centre[0], 0.0,
+                                                                  *earth);
+    }
+    tbb::enumerable_thread_specific<std::unique_ptr<LonLatTransform>> transforms;
+    std::vector<std::uint8_t> failed(static_cast<std::size_t>(H), 0);
+    tbb::parallel_for(tbb::blocked_range<int>(0, H, 8), [&](const tbb::blocked_range<int>& rows) {
+        LonLatTransform* tr = nullptr;
+        if (need_lonlat && !geographic_crs) {
+            auto& local = transforms.local();
+            if (!local) local = std::make_unique<LonLatTransform>(make_lonlat(dem.crs_wkt));
+            tr = local.get();
+        }
+        std::vector<double> lon(W), lat(W);
+        std::vector<int> ok(W, 1);
+        for (int row = rows.begin(); row < rows.end(); ++row) {
+            for (int col = 0; col < W; ++col) {
+                const auto xy = dem.map_xy(col + 0.5, row + 0.5);
+                lon[col] = xy[0];
+                lat[col] = xy[1];
+            }
+            if (tr && !tr->ct->Transform(W, lon.data(), lat.data(), nullptr, ok.data()))
+                std::fill(ok.begin(), ok.end(), 0);
+            for (int col = 0; col < W; ++col) {
+                const auto p = dem.index(col, row);
+                const auto v = vertex_of[p];
+                if (v < 0) continue;
+                if (!ok[col] || !std::isfinite(lon[col]) || !std::isfinite(lat[col])) {
+                    failed[row] = 1;
+                    continue;
+                }
+                const double value = dem.values[p];
+                auto& out = xyz[v];
+                if (frame == MeshFrame::body) {
+                    if (dem.elevation == ElevationKind::radius) {
+                        // Radii are distances from the centre along the geocentric direction.
+                        const double cl = std::cos(lat[col] * kDegree);
+                        out = {value * cl * std::cos(lon[col] * kDegree),
+                               value * cl * std::sin(lon[col] * kDegree),
+                               value * std::sin(lat[col] * kDegree)};
+                    } else {
+                        earth->Forward(lat[col], lon[col], value, out[0], out[1], out[2]);
+                    }
+                } else if (tangent) {
+                    tangent->Forward(lat[col], lon[col], dem.height_at(col, row), out[0], out[1],
+                                     out[2]);
+                } else {
+                    out = {lon[col] * unit, lat[col] * unit, dem.height_at(col, row)};
+                }
+            }
+        }
+    });
+    if (std::find(failed.begin(), failed.end(), 1) != failed.end())
+        throw Error("mesh", "some pixels of '" + dem.source +
+                                "' fall outside the CRS's valid area and cannot be placed");
+    // The pole vertices: at the pole, at the mean radius (height) of their row.
+    for (int which = 0; which < 2; ++which) {
+        if (mesh.pole_rows[which] < 0) continue;
+        const int row = mesh.pole_rows[which];
+        double sum = 0;
+        int n = 0;
+        for (int col = 0; col < W; ++col)
+            if (dem.valid(col, row)) sum += dem.at(col, row), ++n;
+        const double value = sum / n, lat = which == 0 ? 90.0 : -90.0;
+        auto& out = xyz[mesh.pole_vertices[which]];
+        if (dem.elevation == ElevationKind::radius)
+            out = {0.0, 0.0, which == 0 ? value : -value};
+        else
+            earth->Forward(lat, 0.0, value, out[0], out[1], out[2]);
+    }
+    report_progress(progress, 0.4, "mesh");
+
+    // Re-centre on the bounding box's centre and keep floats.
+    std::array<double, 3> lo{}, hi{};
+    lo.fill(std::numeric_limits<double>::infinity());
+    hi.fill(-std::numeric_limits<double>::infinity());
+    for (const auto& p : xyz)
+        for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], p[k]), hi[k] = std::max(hi[k], p[k]);
+    for (int k = 0; k < 3; ++k) mesh.origin[k] = 0.5 * (lo[k] + hi[k]);
+    mesh.positions.resize(xyz.size());
+    for (std::size_t v = 0; v < xyz.size(); ++v)
+        for (int k = 0; k < 3; ++k)
+            mesh.positions[v][k] = static_cast<float>(xyz[v][k] - mesh.origin[k]);
+    xyz = {};
+
+    // Triangles, block by block. With rows growing southwards and columns eastwards (the
+    // geotransform's determinant negative) the orders below are counter-clockwise seen from
+    // above/outside; otherwise the last two corners swap.
+    const auto& t = dem.transform;
+    const bool flip = t[1] * t[5] - t[2] * t[4] > 0;
+    const int block_cols = wrap ? W : W - 1;
+    const int block_rows = H - 1;
+    std::vector<std::vector<Triangle>> per_row(static_cast<std::size_t>(block_rows));
+    tbb::parallel_for(tbb::blocked_range<int>(0, block_rows, 16), [&](const auto& rows) {
+        for (int row = rows.begin(); row < rows.end(); ++row) {
+            auto& out = per_row[row];
+            out.reserve(2 * std::size_t(block_cols));
+            auto emit = [&](std::int32_t p, std::int32_t q, std::int32_t r) {
+                if (p < 0 || q < 0 || r < 0 || p == q || q == r || p == r) return;
+                out.push_back(flip ? Triangle{p, r, q} : Triangle{p, q, r});
+            };
+            for (int col = 0; col < block_cols; ++col) {
+                const int right = (col + 1) % W;
+                const auto v00 = vertex_of[dem.index(col, row)];
+                const auto v10 = vertex_of[dem.index(right, row)];
+                const auto v01 = vertex_of[dem.index(col, row + 1)];
+                const auto v11 = vertex_of[dem.index(right, row + 1)];
+                const int valid = (v00 >= 0) + (v10 >= 0) + (v01 >= 0) + (v11 >= 0);
+                if (valid < 3) continue;
+                if (valid == 3) {
+                    if (v00 < 0) emit(v10, v01, v11);
+                    else if (v10 < 0) emit(v00, v01, v11);
+                    else if (v01 < 0) emit(v00, v11, v10);
+                    else emit(v00, v01, v10);
+                    continue;
+                }
+                auto dist2 = [&](std::int32_t i, std::int32_t j) {
+                    const auto& p = mesh.positions[i];
+                    const auto& q = mesh.positions[j];
+                    const double d[3] = {double(p[0]) - q[0], double(p[1]) - q[1],
+                                         double(p[2]) - q[2]};
+                    return d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+                };
+                if (dist2(v00, v11) <= dist2(v10, v01)) {
+                    emit(v00, v01, v11);
+                    emit(v00, v11, v10);
+                } else {
+                    emit(v00, v01, v10);
+                    emit(v10, v01, v11);
+                }
+            }
+        }
+    });
+    std::size_t total = 0;
+    for (const auto& r : per_row) total += r.size();
+    mesh.triangles.reserve(total);
+    for (auto& r : per_row) {
+        mesh.triangles.insert(mesh.triangles.end(), r.begin(), r.end());
+        r = {};
+    }
+    per_row = {};
+    if (mesh.triangles.empty())
+        throw Error("mesh", "'" + dem.source +
+                                "' gives no triangle: no 2x2 block has three valid pixels");
+    report_progress(progress, 0.7, "mesh");
+
+    // Leave out valid pixels in no triangle (isolated, or only in degenerate blocks).
+    mesh.isolated_vertices = remove_unreferenced_vertices(mesh);
+    mesh.pinched_vertices = split_pinched_vertices(mesh);
+    mesh.positions.shrink_to_fit();
+    mesh.vertex_pixel.shrink_to_fit();
+    finish_mesh(mesh);
+    report_progress(progress, 1.0, "mesh");
+    return mesh;
+}
+
+std::vector<std::int32_t> pixel_to_vertex(const TriangleMesh& mesh, const Dem& dem) {
+    std::vector<std::int32_t> out(std::size_t(mesh.grid_width) * mesh.grid_height, -1);
+    // Backwards, so that the first copy of a split pinch wins.
+    for (std::size_t v = mesh.vertex_pixel.size(); v-- > 0;)
+        out[mesh.vertex_pixel[v]] = std::int32_t(v);
+    for (int which = 0; which < 2; ++which) {
+        const int row = mesh.pole_rows[which];
+        if (row < 0 || mesh.pole_vertices[which] < 0) continue;
+        for (int col = 0; col < mesh.grid_width; ++col)
+            if (dem.valid(col, row)) out[dem.index(col, row)] = mesh.pole_vertices[which];
+    }
+    return out;
+}
+
+}  // namespace terrain::mesh

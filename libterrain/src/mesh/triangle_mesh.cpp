@@ -1,0 +1,225 @@
+#include "terrain/mesh/triangle_mesh.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+namespace terrain {
+
+const char* to_string(MeshFrame frame) {
+    switch (frame) {
+        case MeshFrame::body: return "body";
+        case MeshFrame::map: return "map";
+        default: return "file";
+    }
+}
+
+std::size_t TriangleMesh::memory_bytes() const {
+    return positions.capacity() * sizeof(positions[0]) +
+           triangles.capacity() * sizeof(triangles[0]) +
+           vertex_areas.capacity() * sizeof(float) +
+           neighbor_offsets.capacity() * sizeof(std::int32_t) +
+           neighbors.capacity() * sizeof(std::int32_t) +
+           vertex_pixel.capacity() * sizeof(std::int32_t);
+}
+
+namespace {
+
+double triangle_area(const TriangleMesh& m, const std::array<std::int32_t, 3>& t) {
+    const auto& a = m.positions[t[0]];
+    const auto& b = m.positions[t[1]];
+    const auto& c = m.positions[t[2]];
+    const double u[3] = {double(b[0]) - a[0], double(b[1]) - a[1], double(b[2]) - a[2]};
+    const double v[3] = {double(c[0]) - a[0], double(c[1]) - a[1], double(c[2]) - a[2]};
+    const double n[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2],
+                         u[0] * v[1] - u[1] * v[0]};
+    return 0.5 * std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+}
+
+}  // namespace
+
+void finish_mesh(TriangleMesh& mesh) {
+    const std::size_t n = mesh.positions.size();
+    // Vertex areas: one third of each incident triangle (serial: the same sums every run).
+    std::vector<double> area(n, 0.0);
+    for (const auto& t : mesh.triangles) {
+        const double third = triangle_area(mesh, t) / 3.0;
+        for (int k = 0; k < 3; ++k) area[t[k]] += third;
+    }
+    mesh.vertex_areas.assign(area.begin(), area.end());
+    area = {};
+
+    // CSR adjacency from the triangles' edges, each list sorted and without repeats.
+    std::vector<std::int32_t> offsets(n + 1, 0);
+    for (const auto& t : mesh.triangles)
+        for (int k = 0; k < 3; ++k) offsets[t[k] + 1] += 2;
+    std::partial_sum(offsets.begin(), offsets.end(), offsets.begin());
+    std::vector<std::int32_t> all(offsets.back());
+    std::vector<std::int32_t> fill(offsets.begin(), offsets.end() - 1);
+    for (const auto& t : mesh.triangles)
+        for (int k = 0; k < 3; ++k) {
+            all[fill[t[k]]++] = t[(k + 1) % 3];
+            all[fill[t[k]]++] = t[(k + 2) % 3];
+        }
+    fill = {};
+    mesh.neighbor_offsets.assign(n + 1, 0);
+    std::size_t write = 0;
+    for (std::size_t v = 0; v < n; ++v) {
+        auto begin = all.begin() + offsets[v], end = all.begin() + offsets[v + 1];
+        std::sort(begin, end);
+        end = std::unique(begin, end);
+        for (auto it = begin; it != end; ++it) all[write++] = *it;
+        mesh.neighbor_offsets[v + 1] = static_cast<std::int32_t>(write);
+    }
+    all.resize(write);
+    all.shrink_to_fit();
+    mesh.neighbors = std::move(all);
+}
+
+MeshTopology mesh_topology(const TriangleMesh& mesh) {
+    MeshTopology topo;
+    topo.vertices = mesh.vertex_count();
+    topo.faces = mesh.triangle_count();
+    // Edges as sorted (min,max) keys; an edge's multiplicity is the number of triangles.
+    std::vector<std::uint64_t> edges;
+    edges.reserve(3 * mesh.triangles.size());
+    for (const auto& t : mesh.triangles)
+        for (int k = 0; k < 3; ++k) {
+            const auto a = static_cast<std::uint32_t>(t[k]);
+            const auto b = static_cast<std::uint32_t>(t[(k + 1) % 3]);
+            edges.push_back((std::uint64_t(std::min(a, b)) << 32) | std::max(a, b));
+        }
+    std::sort(edges.begin(), edges.end());
+    std::vector<std::uint32_t> parent(topo.vertices);
+    std::iota(parent.begin(), parent.end(), 0u);
+    auto find = [&](std::uint32_t x) {
+        while (parent[x] != x) x = parent[x] = parent[parent[x]];
+        return x;
+    };
+    std::vector<std::uint32_t> boundary_parent;
+    std::vector<std::uint64_t> boundary;
+    for (std::size_t i = 0; i < edges.size();) {
+        std::size_t j = i;
+        while (j < edges.size() && edges[j] == edges[i]) ++j;
+        ++topo.edges;
+        if (j - i == 1) boundary.push_back(edges[i]);
+        i = j;
+    }
+    // Boundary loops: components of the graph of boundary edges.
+    for (auto e : boundary) {
+        const auto a = find(std::uint32_t(e >> 32)), b = find(std::uint32_t(e & 0xffffffffu));
+        if (a != b) parent[a] = b;
+    }
+    topo.boundary_edges = boundary.size();
+    {
+        std::vector<std::uint32_t> roots;
+        for (auto e : boundary) roots.push_back(find(std::uint32_t(e >> 32)));
+        std::sort(roots.begin(), roots.end());
+        topo.boundary_loops =
+            std::size_t(std::unique(roots.begin(), roots.end()) - roots.begin());
+    }
+    // Components by triangles.
+    std::iota(parent.begin(), parent.end(), 0u);
+    for (const auto& t : mesh.triangles)
+        for (int k = 1; k < 3; ++k) {
+            const auto a = find(std::uint32_t(t[0])), b = find(std::uint32_t(t[k]));
+            if (a != b) parent[a] = b;
+        }
+    std::vector<char> used(topo.vertices, 0);
+    for (const auto& t : mesh.triangles)
+        for (int k = 0; k < 3; ++k) used[t[k]] = 1;
+    for (std::size_t v = 0; v < topo.vertices; ++v)
+        if (used[v] && find(std::uint32_t(v)) == v) ++topo.components;
+    topo.euler_characteristic = std::int64_t(topo.vertices) - std::int64_t(topo.edges) +
+                                std::int64_t(topo.faces);
+    return topo;
+}
+
+// Fans around each vertex: triangles incident to v joined when they share an edge at v.
+// Every fan after the largest (ties: the one holding the lowest triangle index) gets a copy
+// of v. Returns the number of vertices split.
+std::size_t split_pinched_vertices(TriangleMesh& mesh, std::int32_t* first_pinched) {
+    const std::size_t n = mesh.positions.size();
+    std::vector<std::int32_t> offsets(n + 1, 0);
+    for (const auto& t : mesh.triangles)
+        for (auto v : t) ++offsets[v + 1];
+    for (std::size_t v = 0; v < n; ++v) offsets[v + 1] += offsets[v];
+    std::vector<std::int32_t> incident(offsets.back());
+    {
+        std::vector<std::int32_t> fill(offsets.begin(), offsets.end() - 1);
+        for (std::size_t t = 0; t < mesh.triangles.size(); ++t)
+            for (auto v : mesh.triangles[t]) incident[fill[v]++] = std::int32_t(t);
+    }
+    std::size_t split = 0;
+    std::vector<std::pair<std::int32_t, std::int32_t>> others;  // (other vertex, local index)
+    std::vector<std::int32_t> parent;
+    for (std::size_t v = 0; v < n; ++v) {
+        const auto begin = offsets[v], end = offsets[v + 1];
+        const auto k = end - begin;
+        if (k < 2) continue;
+        others.clear();
+        for (std::int32_t i = 0; i < k; ++i)
+            for (auto w : mesh.triangles[incident[begin + i]])
+                if (w != std::int32_t(v)) others.emplace_back(w, i);
+        std::sort(others.begin(), others.end());
+        parent.resize(k);
+        for (std::int32_t i = 0; i < k; ++i) parent[i] = i;
+        auto find = [&](std::int32_t x) {
+            while (parent[x] != x) x = parent[x] = parent[parent[x]];
+            return x;
+        };
+        for (std::size_t i = 1; i < others.size(); ++i)
+            if (others[i].first == others[i - 1].first) {
+                const auto a = find(others[i].second), b = find(others[i - 1].second);
+                if (a != b) parent[std::max(a, b)] = std::min(a, b);
+            }
+        // Fan sizes by root; roots are the lowest local index of their fan.
+        std::vector<std::int32_t> size(k, 0);
+        for (std::int32_t i = 0; i < k; ++i) ++size[find(i)];
+        std::int32_t keep = -1, fans = 0;
+        for (std::int32_t i = 0; i < k; ++i)
+            if (size[i] > 0) {
+                ++fans;
+                if (keep < 0 || size[i] > size[keep]) keep = i;
+            }
+        if (fans < 2) continue;
+        if (split++ == 0 && first_pinched) *first_pinched = std::int32_t(v);
+        for (std::int32_t root = 0; root < k; ++root) {
+            if (size[root] == 0 || root == keep) continue;
+            const auto copy = std::int32_t(mesh.positions.size());
+            mesh.positions.push_back(mesh.positions[v]);
+            if (!mesh.vertex_pixel.empty()) mesh.vertex_pixel.push_back(mesh.vertex_pixel[v]);
+            for (std::int32_t i = 0; i < k; ++i)
+                if (find(i) == root)
+                    for (auto& w : mesh.triangles[incident[begin + i]])
+                        if (w == std::int32_t(v)) w = copy;
+        }
+    }
+    return split;
+}
+
+
+std::size_t remove_unreferenced_vertices(TriangleMesh& mesh) {
+    std::vector<std::int32_t> remap(mesh.positions.size(), -1);
+    for (const auto& tri : mesh.triangles)
+        for (auto v : tri) remap[v] = 0;
+    const bool pixels = !mesh.vertex_pixel.empty();
+    std::int32_t next = 0;
+    for (std::size_t v = 0; v < remap.size(); ++v) {
+        if (remap[v] < 0) continue;
+        remap[v] = next;
+        mesh.positions[next] = mesh.positions[v];
+        if (pixels) mesh.vertex_pixel[next] = mesh.vertex_pixel[v];
+        ++next;
+    }
+    const std::size_t removed = remap.size() - std::size_t(next);
+    mesh.positions.resize(next);
+    if (pixels) mesh.vertex_pixel.resize(next);
+    for (auto& tri : mesh.triangles)
+        for (auto& v : tri) v = remap[v];
+    for (auto& pv : mesh.pole_vertices)
+        if (pv >= 0) pv = remap[pv];
+    return removed;
+}
+
+}  // namespace terrain

@@ -1,0 +1,282 @@
+#include <catch2/catch.hpp>
+#include <tbb/global_control.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <limits>
+#include <numbers>
+
+#include "support/test_support.hpp"
+#include "terrain/core/error.hpp"
+#include "terrain/io/read_dem.hpp"
+#include "terrain/mesh/dem_to_mesh.hpp"
+
+using namespace terrain;
+
+namespace {
+
+const double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// A local-grid DEM (no CRS) of w x h pixels of `pixel` metres, values from f(col,row).
+template <class F>
+Dem grid_dem(int w, int h, double pixel, F f) {
+    Dem dem;
+    dem.width = w;
+    dem.height = h;
+    dem.transform = {0, pixel, 0, 0, 0, -pixel};
+    dem.has_transform = true;
+    dem.body = body_from_crs("");
+    for (int r = 0; r < h; ++r)
+        for (int c = 0; c < w; ++c) dem.values.push_back(f(c, r));
+    return dem;
+}
+
+double total_area(const TriangleMesh& m) {
+    double a = 0;
+    for (float v : m.vertex_areas) a += v;
+    return a;
+}
+
+// Signed volume enclosed (divergence theorem); positive when triangles face outwards.
+double signed_volume(const TriangleMesh& m) {
+    double vol = 0;
+    for (const auto& t : m.triangles) {
+        const auto a = m.position(t[0]), b = m.position(t[1]), c = m.position(t[2]);
+        vol += a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
+               a[2] * (b[0] * c[1] - b[1] * c[0]);
+    }
+    return vol / 6.0;
+}
+
+void check_manifold(const TriangleMesh& mesh) {
+    // Every edge in at most two triangles, each direction at most once (consistent
+    // orientation); every vertex link a single fan.
+    std::map<std::pair<int, int>, int> directed;
+    for (const auto& t : mesh.triangles)
+        for (int k = 0; k < 3; ++k) ++directed[{t[k], t[(k + 1) % 3]}];
+    std::size_t repeated = 0;
+    for (const auto& [edge, count] : directed) repeated += count != 1;
+    CHECK(repeated == 0);
+    TriangleMesh copy = mesh;
+    CHECK(split_pinched_vertices(copy) == 0);
+}
+
+}  // namespace
+
+TEST_CASE("dem_to_mesh: counts on a full grid", "[mesh]") {
+    const Dem dem = grid_dem(4, 3, 10.0, [](int c, int r) { return c * 1.0 + r * 0.5; });
+    const auto mesh = mesh::dem_to_mesh(dem);
+    const auto topo = mesh_topology(mesh);
+    CHECK(topo.vertices == 12);
+    CHECK(topo.faces == 12);
+    CHECK(topo.boundary_edges == 10);
+    CHECK(topo.boundary_loops == 1);
+    CHECK(topo.euler_characteristic == 1);
+    CHECK(mesh.frame == MeshFrame::map);
+    check_manifold(mesh);
+    // Every vertex keeps its pixel.
+    for (std::size_t v = 0; v < mesh.vertex_count(); ++v) {
+        const int col = mesh.vertex_pixel[v] % 4, row = mesh.vertex_pixel[v] / 4;
+        const auto p = mesh.position(v);
+        CHECK(p[0] == Approx(10.0 * (col + 0.5)));
+        CHECK(p[1] == Approx(-10.0 * (row + 0.5)));
+        CHECK(p[2] == Approx(col * 1.0 + row * 0.5));
+    }
+    // Triangles face up (counter-clockwise seen from +z).
+    for (const auto& t : mesh.triangles) {
+        const auto a = mesh.position(t[0]), b = mesh.position(t[1]), c = mesh.position(t[2]);
+        CHECK((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]) > 0);
+    }
+}
+
+TEST_CASE("dem_to_mesh: a NoData hole makes an annulus", "[mesh]") {
+    const Dem dem = grid_dem(5, 5, 1.0, [](int c, int r) { return c == 2 && r == 2 ? kNaN : 0.0; });
+    const auto mesh = mesh::dem_to_mesh(dem);
+    const auto topo = mesh_topology(mesh);
+    CHECK(topo.vertices == 24);
+    CHECK(topo.faces == 28);  // 12 full blocks x 2 + 4 blocks of three pixels
+    CHECK(topo.boundary_loops == 2);
+    CHECK(topo.euler_characteristic == 0);
+    check_manifold(mesh);
+    const auto p2v = mesh::pixel_to_vertex(mesh, dem);
+    CHECK(p2v[12] == -1);
+    CHECK(p2v[0] == 0);
+}
+
+TEST_CASE("dem_to_mesh: the shorter 3-D diagonal splits a block", "[mesh]") {
+    // A high top-right corner makes the top-right/bottom-left diagonal the longer one.
+    const Dem dem = grid_dem(2, 2, 1.0, [](int c, int r) { return c == 1 && r == 0 ? 5.0 : 0.0; });
+    const auto mesh = mesh::dem_to_mesh(dem);
+    REQUIRE(mesh.triangle_count() == 2);
+    for (const auto& t : mesh.triangles) {
+        const bool has_00 = std::find(t.begin(), t.end(), 0) != t.end();
+        const bool has_11 = std::find(t.begin(), t.end(), 3) != t.end();
+        CHECK((has_00 && has_11));
+    }
+    const Dem other = grid_dem(2, 2, 1.0, [](int c, int r) { return c + r == 0 ? 5.0 : 0.0; });
+    for (const auto& t : mesh::dem_to_mesh(other).triangles) {
+        const bool has_10 = std::find(t.begin(), t.end(), 1) != t.end();
+        const bool has_01 = std::find(t.begin(), t.end(), 2) != t.end();
+        CHECK((has_10 && has_01));
+    }
+}
+
+TEST_CASE("dem_to_mesh: a pinched vertex is split, one copy per fan", "[mesh]") {
+    // V . V / V V V / V . V: the centre's left and right fans meet only at it.
+    const Dem dem = grid_dem(3, 3, 1.0, [](int c, int r) { return c == 1 && r != 1 ? kNaN : 1.0; });
+    const auto mesh = mesh::dem_to_mesh(dem);
+    CHECK(mesh.pinched_vertices == 1);
+    const auto topo = mesh_topology(mesh);
+    CHECK(topo.vertices == 8);
+    CHECK(topo.faces == 4);
+    CHECK(topo.components == 2);
+    CHECK(topo.euler_characteristic == 2);
+    check_manifold(mesh);
+    // Both copies keep the centre pixel; the pixel maps back to the first.
+    CHECK(mesh.vertex_pixel[7] == 4);
+    CHECK(mesh::pixel_to_vertex(mesh, dem)[4] < 7);
+}
+
+TEST_CASE("dem_to_mesh: isolated pixels are left out and counted", "[mesh]") {
+    const Dem dem = grid_dem(4, 4, 1.0, [](int c, int r) {
+        if (c == 3 && r == 3) return 1.0;  // alone in a corner
+        return c < 2 && r < 2 ? 0.0 : kNaN;
+    });
+    const auto mesh = mesh::dem_to_mesh(dem);
+    CHECK(mesh.isolated_vertices == 1);
+    CHECK(mesh.vertex_count() == 4);
+}
+
+TEST_CASE("dem_to_mesh: the global LOLA Moon is a closed sphere", "[mesh]") {
+    const Dem dem = io::read_dem(test::sample("moon_ldem1_global.tif"));
+    const auto mesh = mesh::dem_to_mesh(dem);
+    const auto topo = mesh_topology(mesh);
+    CHECK(mesh.frame == MeshFrame::body);
+    CHECK(mesh.seam_closed);
+    CHECK(mesh.pole_rows[0] == 0);
+    CHECK(mesh.pole_rows[1] == 179);
+    CHECK(topo.boundary_edges == 0);
+    CHECK(topo.euler_characteristic == 2);
+    CHECK(topo.vertices == 360 * 178 + 2);
+    check_manifold(mesh);
+    const double r = 1737400, pi = std::numbers::pi;
+    CHECK(total_area(mesh) == Approx(4 * pi * r * r).epsilon(0.01));
+    CHECK(signed_volume(mesh) == Approx(4.0 / 3.0 * pi * r * r * r).epsilon(0.01));
+    // Every valid pixel maps to a vertex, the pole rows to their pole.
+    const auto p2v = mesh::pixel_to_vertex(mesh, dem);
+    CHECK(std::count(p2v.begin(), p2v.end(), -1) == 0);
+    CHECK(p2v[5] == mesh.pole_vertices[0]);
+}
+
+TEST_CASE("dem_to_mesh: LDEM_4 closes, area within 1% of 4 pi R^2", "[mesh][shared]") {
+    const auto path = test::shared_data("moon_lola_ldem4/LDEM_4.LBL");
+    REQUIRE(path.has_value());
+    const auto mesh = mesh::dem_to_mesh(io::read_dem(*path));
+    const auto topo = mesh_topology(mesh);
+    CHECK(topo.boundary_edges == 0);
+    CHECK(topo.euler_characteristic == 2);
+    const double r = 1737400;
+    CHECK(total_area(mesh) == Approx(4 * std::numbers::pi * r * r).epsilon(0.01));
+    CHECK(double(mesh.memory_bytes()) / double(mesh.vertex_count()) < 100);
+}
+
+TEST_CASE("dem_to_mesh: a projected tile's area is planimetric area x mean slope factor",
+          "[mesh][shared]") {
+    const auto path = test::shared_data("earth/bigtujunga_srtm30m_utm11.tif");
+    REQUIRE(path.has_value());
+    const Dem dem = io::read_dem(*path);
+    const auto mesh = mesh::dem_to_mesh(dem);
+    CHECK(mesh.frame == MeshFrame::map);
+    // Slope factor sqrt(1 + gx^2 + gy^2) from central differences, over interior pixels.
+    const double px = dem.transform[1], py = -dem.transform[5];
+    double factor = 0;
+    std::size_t n = 0;
+    for (int r = 1; r + 1 < dem.height; ++r)
+        for (int c = 1; c + 1 < dem.width; ++c) {
+            const double gx = (dem.at(c + 1, r) - dem.at(c - 1, r)) / (2 * px);
+            const double gy = (dem.at(c, r + 1) - dem.at(c, r - 1)) / (2 * py);
+            factor += std::sqrt(1 + gx * gx + gy * gy);
+            ++n;
+        }
+    factor /= double(n);
+    const double planimetric = (dem.width - 1) * px * (dem.height - 1) * py;
+    CHECK(total_area(mesh) == Approx(planimetric * factor).epsilon(0.01));
+    CHECK(double(mesh.memory_bytes()) / double(mesh.vertex_count()) < 100);
+}
+
+TEST_CASE("dem_to_mesh: a lon/lat grid has the same shape in the body and map frames",
+          "[mesh]") {
+    // A Gaussian hill on a 0.001 degree grid at 45 N on WGS84.
+    Dem dem;
+    dem.width = dem.height = 40;
+    dem.crs_wkt = "EPSG:4326";
+    {
+        const auto body = body_from_crs(dem.crs_wkt);
+        dem.body = body;
+    }
+    dem.transform = {7.0, 0.001, 0, 45.02, 0, -0.001};
+    dem.has_transform = true;
+    for (int r = 0; r < 40; ++r)
+        for (int c = 0; c < 40; ++c) {
+            const double x = (c - 19.5) * 78.8, y = (r - 19.5) * 111.1;
+            dem.values.push_back(300 * std::exp(-(x * x + y * y) / (2 * 600.0 * 600.0)));
+        }
+    // The mesh code reads WKT; EPSG:4326 is accepted as any SetFromUserInput text.
+    mesh::DemToMeshOptions body_frame, map_frame;
+    body_frame.frame = MeshFrame::body;
+    map_frame.frame = MeshFrame::map;
+    const auto a = mesh::dem_to_mesh(dem, body_frame);
+    const auto b = mesh::dem_to_mesh(dem, map_frame);
+    REQUIRE(a.vertex_count() == b.vertex_count());
+    // Same shape: every distance between grid neighbours (row, column and both diagonals)
+    // agrees to within a centimetre. (Triangles may differ where the two diagonals of a
+    // block tie to within float rounding.)
+    double worst = 0;
+    for (std::size_t v = 0; v + 41 < a.vertex_count(); ++v)
+        for (std::size_t w : {v + 1, v + 40, v + 41}) {
+            auto len = [&](const TriangleMesh& m) {
+                const auto p = m.position(v), q = m.position(w);
+                return std::hypot(p[0] - q[0], p[1] - q[1], p[2] - q[2]);
+            };
+            worst = std::max(worst, std::abs(len(a) - len(b)));
+        }
+    CHECK(worst < 0.01);
+    // Degrees are never used as metres: a 0.001 degree step is about 79 m east-west here.
+    const auto p0 = b.position(0), p1 = b.position(1);
+    CHECK(std::hypot(p1[0] - p0[0], p1[1] - p0[1]) == Approx(78.8).epsilon(0.01));
+    CHECK(total_area(a) == Approx(total_area(b)).epsilon(1e-5));
+}
+
+TEST_CASE("dem_to_mesh: the same mesh whatever the thread count", "[mesh]") {
+    const Dem dem = io::read_dem(test::sample("moon_ldem4_copernicus.tif"));
+    TriangleMesh one, two;
+    {
+        tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
+        one = mesh::dem_to_mesh(dem);
+    }
+    {
+        tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 2);
+        two = mesh::dem_to_mesh(dem);
+    }
+    CHECK(one.positions == two.positions);
+    CHECK(one.triangles == two.triangles);
+    CHECK(one.vertex_areas == two.vertex_areas);
+    CHECK(one.neighbors == two.neighbors);
+}
+
+TEST_CASE("dem_to_mesh: frames and refusals", "[mesh]") {
+    const Dem local = io::read_dem(test::sample("mars_hirise_crop.tif"));
+    mesh::DemToMeshOptions body;
+    body.frame = MeshFrame::body;
+    CHECK_THROWS_AS(mesh::dem_to_mesh(local, body), Error);
+    // A projected planetary grid in the map frame: flat, no seam even when global.
+    const Dem moon = io::read_dem(test::sample("moon_ldem1_global.tif"));
+    mesh::DemToMeshOptions map;
+    map.frame = MeshFrame::map;
+    const auto flat = mesh::dem_to_mesh(moon, map);
+    CHECK_FALSE(flat.seam_closed);
+    CHECK(mesh_topology(flat).euler_characteristic == 1);
+    const Dem nothing = grid_dem(3, 3, 1.0, [](int c, int r) { return c == r ? 1.0 : kNaN; });
+    CHECK_THROWS_AS(mesh::dem_to_mesh(nothing), Error);
+}
