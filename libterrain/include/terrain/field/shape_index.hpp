@@ -1,0 +1,40 @@
+#pragma once
+// Koenderink's shape index on mesh vertices (Koenderink & van Doorn 1992), from principal
+// curvatures of a quadric fitted in each vertex's tangent frame; mapped to [0,1] as Dorai &
+// Jain (1997) do and scaled by 100, the units of the paper's thresholds (METHOD.md s.2).
+// Sign convention fixed by behaviour: cap +1 (100), cup -1 (0), ridge +0.5 (75),
+// valley -0.5 (25), saddle and plane 0 (50).
+
+#include <vector>
+
+#include "terrain/core/progress.hpp"
+#include "terrain/mesh/triangle_mesh.hpp"
+
+namespace terrain::field {
+
+struct ShapeIndexOptions {
+    int rings = 2;        // neighbourhood: vertices within this many mesh edges
+    double radius = 0;    // > 0: vertices within this distance in metres instead of rings
+    // Curvedness times the mean neighbour distance below this is a planar point (SI 0).
+    double planar_curvedness = 1e-4;
+};
+
+struct PrincipalCurvatures {
+    double k1 = 0, k2 = 0;  // k1 >= k2, positive where the surface is convex (a cap)
+};
+
+// Shape index in [-1, 1] of principal curvatures (k1 >= k2, convex positive); 0 when both
+// vanish.
+double shape_index(double k1, double k2);
+
+// Per-vertex principal curvatures (convex positive, normals outwards/up).
+std::vector<PrincipalCurvatures> principal_curvatures(const TriangleMesh& mesh,
+                                                      const ShapeIndexOptions& options = {},
+                                                      const ProgressFn& progress = {});
+
+// Per-vertex shape index mapped to [0, 100]: 50 * (SI + 1). Multi-threaded, deterministic.
+std::vector<float> shape_index_field(const TriangleMesh& mesh,
+                                     const ShapeIndexOptions& options = {},
+                                     const ProgressFn& progress = {});
+
+}  // namespace terrain::field
