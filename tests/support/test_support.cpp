@@ -3,6 +3,7 @@
 #include <gdal_priv.h>
 #include <ogr_spatialref.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <cstdlib>
 #include <fstream>
@@ -75,8 +76,10 @@ CliResult run_cli(const std::vector<std::string>& args) {
     static int counter = 0;
     const auto dir = std::filesystem::current_path() / "scratch" / "cli";
     std::filesystem::create_directories(dir);
-    const auto out = dir / ("out" + std::to_string(counter) + ".txt");
-    const auto err = dir / ("err" + std::to_string(counter++) + ".txt");
+    // CTest runs test cases as parallel processes: the pid keeps their files apart.
+    const std::string id = std::to_string(::getpid()) + "_" + std::to_string(counter++);
+    const auto out = dir / ("out" + id + ".txt");
+    const auto err = dir / ("err" + id + ".txt");
     std::string command = quote(TERRAIN_CLI);
     for (const auto& a : args) command += " " + quote(a);
     command += " </dev/null >" + quote(out) + " 2>" + quote(err);

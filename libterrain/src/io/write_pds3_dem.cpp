@@ -47,6 +47,23 @@ std::string real(double v) {
     return s;
 }
 
+// `v` rounded to `decimals` places, trailing zeros dropped (keeping one after the point).
+std::string fixed(double v, int decimals) {
+    char buffer[400];
+    const auto r =
+        std::to_chars(buffer, buffer + sizeof buffer, v, std::chars_format::fixed, decimals);
+    std::string s(buffer, r.ptr);
+    if (s.find('.') == std::string::npos) return s + ".0";
+    while (s.back() == '0') s.pop_back();
+    if (s.back() == '.') s += '0';
+    return s == "-0.0" ? "0.0" : s;
+}
+
+// Angles in degrees and pixel offsets: 1e-10 degree is 0.5 mm on Vesta, 1e-10 pixel less.
+std::string angle(double v) {
+    return fixed(v, 10);
+}
+
 // The label: KEY = VALUE lines, '=' aligned, CR LF line ends as PDS3 asks.
 class Label {
   public:
@@ -57,16 +74,20 @@ class Label {
         if (k.size() < kColumn) k.resize(kColumn, ' ');
         line(k + " = " + value);
     }
-    // A quoted text value wrapped to 72 columns, continuation lines indented.
+    // A quoted text value wrapped so that lines with their CR LF fit 80 bytes, continuation
+    // lines indented.
     void text(const std::string& key, std::string value) {
         std::replace(value.begin(), value.end(), '"', '\'');
+        const std::size_t first_width = 78 - std::max(kColumn, indent_ + key.size()) - 5;
+        const std::size_t next_width = 78 - indent_ - 4 - 1;
         std::vector<std::string> lines{""};
         std::size_t start = 0;
         while (start < value.size()) {
             std::size_t end = value.find(' ', start);
             if (end == std::string::npos) end = value.size();
             const std::string word = value.substr(start, end - start);
-            if (!lines.back().empty() && lines.back().size() + 1 + word.size() > 60)
+            const std::size_t width = lines.size() == 1 ? first_width : next_width;
+            if (!lines.back().empty() && lines.back().size() + 1 + word.size() > width)
                 lines.emplace_back();
             if (!lines.back().empty()) lines.back() += ' ';
             lines.back() += word;
@@ -161,7 +182,7 @@ std::string target_name(const Dem& dem, const Pds3DemOptions& options) {
 
 std::string normalise_lon(double lon) {
     lon -= 360.0 * std::floor(lon / 360.0);
-    return real(lon);
+    return angle(lon);
 }
 
 void write_file(const fs::path& path, const void* data, std::size_t size) {
@@ -319,8 +340,8 @@ void write_pds3_dem(const Dem& dem, const std::string& label_path, const Pds3Dem
     l.field("FIRST_STANDARD_PARALLEL", "\"N/A\"");
     l.field("SECOND_STANDARD_PARALLEL", "\"N/A\"");
     l.field("POSITIVE_LONGITUDE_DIRECTION", "\"EAST\"");
-    l.field("CENTER_LATITUDE", real(p.center_lat) + " <DEG>");
-    l.field("CENTER_LONGITUDE", real(p.center_lon) + " <DEG>");
+    l.field("CENTER_LATITUDE", angle(p.center_lat) + " <DEG>");
+    l.field("CENTER_LONGITUDE", angle(p.center_lon) + " <DEG>");
     l.field("REFERENCE_LATITUDE", "\"N/A\"");
     l.field("REFERENCE_LONGITUDE", "\"N/A\"");
     l.field("LINE_FIRST_PIXEL", "1");
@@ -328,14 +349,14 @@ void write_pds3_dem(const Dem& dem, const std::string& label_path, const Pds3Dem
     l.field("SAMPLE_FIRST_PIXEL", "1");
     l.field("SAMPLE_LAST_PIXEL", std::to_string(dem.width));
     l.field("MAP_PROJECTION_ROTATION", "0.0 <DEG>");
-    l.field("MAP_RESOLUTION", real(p.a * kDegree / p.pixel) + " <PIX/DEG>");
+    l.field("MAP_RESOLUTION", angle(p.a * kDegree / p.pixel) + " <PIX/DEG>");
     l.field("MAP_SCALE", real(p.pixel / 1000.0) + " <KM/PIXEL>");
-    l.field("MAXIMUM_LATITUDE", real(lat_max) + " <DEG>");
-    l.field("MINIMUM_LATITUDE", real(lat_min) + " <DEG>");
+    l.field("MAXIMUM_LATITUDE", angle(lat_max) + " <DEG>");
+    l.field("MINIMUM_LATITUDE", angle(lat_min) + " <DEG>");
     l.field("EASTERNMOST_LONGITUDE", normalise_lon(lon_east) + " <DEG>");
     l.field("WESTERNMOST_LONGITUDE", normalise_lon(lon_west) + " <DEG>");
-    l.field("LINE_PROJECTION_OFFSET", real(p.top / p.pixel - 0.5) + " <PIXEL>");
-    l.field("SAMPLE_PROJECTION_OFFSET", real(-p.left / p.pixel - 0.5) + " <PIXEL>");
+    l.field("LINE_PROJECTION_OFFSET", angle(p.top / p.pixel - 0.5) + " <PIXEL>");
+    l.field("SAMPLE_PROJECTION_OFFSET", angle(-p.left / p.pixel - 0.5) + " <PIXEL>");
     l.field("COORDINATE_SYSTEM_TYPE", "\"BODY-FIXED ROTATING\"");
     l.field("COORDINATE_SYSTEM_NAME", "PLANETOCENTRIC");
     l.end("IMAGE_MAP_PROJECTION");

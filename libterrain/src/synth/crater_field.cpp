@@ -18,7 +18,9 @@
 // asin, exp, pow) only sets up the geometry and the crater sizes; the last-ulp differences
 // between libms vanish under the 2 m DN quantisation.
 #if defined(__clang__)
-#pragma STDC FP_CONTRACT OFF
+#pragma clang fp contract(off)
+#elif defined(__GNUC__)
+#pragma GCC optimize("fp-contract=off")
 #endif
 
 namespace terrain::synth {

@@ -4,7 +4,8 @@
 // 64 pixels per degree on the 255 km reference sphere (about 69.54 m per pixel), in an
 // equirectangular projection. The surface is a cratered plain: a regional tilt and
 // long-wavelength undulation, fractal roughness, and a power-law population of simple craters
-// added oldest first, the older ones degraded. Same options, same bytes, on any platform.
+// added oldest first, the older ones degraded. Same options, same bytes: our own PRNG (no
+// std:: distributions), single-threaded, no fused multiply-adds.
 
 #include <cstdint>
 #include <optional>
