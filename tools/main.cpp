@@ -10,6 +10,7 @@ namespace terrain::cli {
 int run_info(int argc, char** argv);
 int run_synth(int argc, char** argv);
 int run_mesh(int argc, char** argv);
+int run_field(int argc, char** argv);
 }  // namespace terrain::cli
 
 namespace {
@@ -25,6 +26,8 @@ constexpr Command kCommands[] = {
      terrain::cli::run_info},
     {"mesh", "triangulate a DEM on its body (or check a mesh file) into a binary PLY",
      terrain::cli::run_mesh},
+    {"field", "the scalar field (shape index, height) on a DEM's grid or a mesh's vertices",
+     terrain::cli::run_field},
     {"synth", "generate a synthetic cratered DEM tile (the Vesta sample)",
      terrain::cli::run_synth},
 };

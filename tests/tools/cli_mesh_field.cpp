@@ -1,0 +1,135 @@
+// `terrain mesh` and `terrain field` as users run them, outputs read back with GDAL.
+#include <catch2/catch.hpp>
+#include <gdal_priv.h>
+#include <ogr_spatialref.h>
+
+#include <cmath>
+#include <fstream>
+#include <memory>
+
+#include "support/test_support.hpp"
+
+using terrain::test::run_cli;
+using Catch::Matchers::Contains;
+
+TEST_CASE("terrain mesh on the shared DEMs and the samples", "[cli][mesh]") {
+    const auto dir = terrain::test::scratch_dir("cli_mesh");
+    struct Case {
+        std::string input, expect;
+    };
+    const std::vector<Case> cases = {
+        {terrain::test::shared_data("moon_lola_ldem4/LDEM_4.LBL").value(),
+         "0 boundary edges in 0 loop(s), Euler characteristic 2, frame body"},
+        {terrain::test::shared_data("earth/bigtujunga_srtm30m_utm11.tif").value(), "frame map"},
+        {terrain::test::shared_data("mars_hirise_crop/mars_dtm.tif").value(), "8400 vertices"},
+        {terrain::test::sample("vesta_hamo_tile.lbl"), "262144 vertices"},
+        {terrain::test::sample("moon_ldem1_global.tif"), "Euler characteristic 2"},
+    };
+    int i = 0;
+    for (const auto& c : cases) {
+        const auto out = (dir / ("m" + std::to_string(i++) + ".ply")).string();
+        const auto r = run_cli({"mesh", c.input, "-o", out, "-q"});
+        INFO(c.input << ": " << r.err);
+        CHECK(r.status == 0);
+        CHECK_THAT(r.out, Contains(c.expect));
+        CHECK(r.err.empty());  // -q: no progress
+    }
+    // Existing output refused without --overwrite; progress shown without -q.
+    const auto out = (dir / "m0.ply").string();
+    const auto again = run_cli({"mesh", terrain::test::sample("mars_hirise_crop.tif"), "-o", out});
+    CHECK(again.status == 1);
+    CHECK_THAT(again.err, Contains("--overwrite"));
+    const auto over =
+        run_cli({"mesh", terrain::test::sample("mars_hirise_crop.tif"), "-o", out, "--overwrite"});
+    CHECK(over.status == 0);
+    CHECK_THAT(over.err, Contains("0...10...20") && Contains("100 - done."));
+    CHECK(run_cli({"mesh", terrain::test::sample("mars_hirise_crop.tif"), "-o", out,
+                   "--overwrite", "--frame", "body"})
+              .status == 1);  // no CRS: no body
+    CHECK(run_cli({"mesh", terrain::test::sample("mars_hirise_crop.tif"), "-o",
+                   (dir / "no/dir/x.ply").string()})
+              .status == 1);
+}
+
+TEST_CASE("terrain field writes a Float32 raster on the DEM's exact grid", "[cli][field]") {
+    const auto dir = terrain::test::scratch_dir("cli_field");
+    // A UTM tile with a NoData hole.
+    terrain::test::RasterSpec spec;
+    spec.width = 30;
+    spec.height = 20;
+    spec.crs = "EPSG:32611";
+    spec.geotransform = {400000, 30, 0, 3800000, 0, -30};
+    spec.nodata = -9999;
+    for (int r = 0; r < 20; ++r)
+        for (int c = 0; c < 30; ++c)
+            spec.values.push_back(c > 12 && c < 16 && r > 8 && r < 12
+                                      ? -9999
+                                      : 100 * std::sin(c * 0.3) * std::cos(r * 0.2));
+    const auto dem = terrain::test::write_raster(dir / "dem.tif", spec);
+    const auto out = (dir / "si.tif").string();
+    const auto r = run_cli({"field", dem, "--field", "shape-index", "-o", out, "-q"});
+    INFO(r.err);
+    REQUIRE(r.status == 0);
+
+    GDALAllRegister();
+    std::unique_ptr<GDALDataset> ds(GDALDataset::Open(out.c_str(), GDAL_OF_RASTER));
+    REQUIRE(ds);
+    CHECK(ds->GetRasterXSize() == 30);
+    CHECK(ds->GetRasterYSize() == 20);
+    double gt[6];
+    REQUIRE(ds->GetGeoTransform(gt) == CE_None);
+    for (int k = 0; k < 6; ++k) CHECK(gt[k] == spec.geotransform[k]);
+    OGRSpatialReference utm;
+    utm.SetFromUserInput("EPSG:32611");
+    REQUIRE(ds->GetSpatialRef());
+    CHECK(ds->GetSpatialRef()->IsSame(&utm));
+    GDALRasterBand* band = ds->GetRasterBand(1);
+    CHECK(band->GetRasterDataType() == GDT_Float32);
+    int has_nodata = 0;
+    CHECK(std::isnan(band->GetNoDataValue(&has_nodata)));
+    CHECK(has_nodata);
+    std::vector<float> values(600);
+    REQUIRE(band->RasterIO(GF_Read, 0, 0, 30, 20, values.data(), 30, 20, GDT_Float32, 0, 0) ==
+            CE_None);
+    std::size_t nan = 0, out_of_range = 0;
+    for (float v : values) {
+        if (std::isnan(v))
+            ++nan;
+        else
+            out_of_range += v < 0 || v > 100;
+    }
+    CHECK(nan == 9);  // exactly the DEM's NoData pixels
+    CHECK(out_of_range == 0);
+    CHECK(std::isnan(values[10 * 30 + 14]));
+
+    // Height: metres above the reference, equal to the DEM's values.
+    const auto height = (dir / "h.tif").string();
+    REQUIRE(run_cli({"field", dem, "--field", "height", "-o", height, "-q"}).status == 0);
+    std::unique_ptr<GDALDataset> h(GDALDataset::Open(height.c_str(), GDAL_OF_RASTER));
+    float v = 0;
+    REQUIRE(h->GetRasterBand(1)->RasterIO(GF_Read, 5, 3, 1, 1, &v, 1, 1, GDT_Float32, 0, 0) ==
+            CE_None);
+    CHECK(v == Approx(100 * std::sin(5 * 0.3) * std::cos(3 * 0.2)).margin(1e-3));
+}
+
+TEST_CASE("terrain field on a mesh writes a PLY property, bad options are refused", "[cli][field]") {
+    const auto dir = terrain::test::scratch_dir("cli_field_mesh");
+    std::ofstream(dir / "octa.off") << "OFF\n6 8 0\n1 0 0\n-1 0 0\n0 1 0\n0 -1 0\n0 0 1\n0 0 -1\n"
+                                       "3 0 2 4\n3 2 1 4\n3 1 3 4\n3 3 0 4\n3 2 0 5\n3 1 2 5\n"
+                                       "3 3 1 5\n3 0 3 5\n";
+    const auto mesh = (dir / "octa.off").string();
+    const auto ply = (dir / "octa.ply").string();
+    const auto r = run_cli({"field", mesh, "--field", "height", "-o", ply, "-q"});
+    INFO(r.err);
+    REQUIRE(r.status == 0);
+    std::ifstream in(ply, std::ios::binary);
+    std::string header, line;
+    while (std::getline(in, line) && line != "end_header") header += line + "\n";
+    CHECK_THAT(header, Contains("property float height"));
+    CHECK(run_cli({"field", mesh, "--field", "sdf", "-o", (dir / "s.ply").string()}).status == 2);
+    CHECK(run_cli({"field", mesh, "--field", "nonsense", "-o", (dir / "n.ply").string()}).status ==
+          1);
+    CHECK(run_cli({"field", mesh, "-o", (dir / "x.tif").string()}).status == 2);
+    CHECK(run_cli({"field", mesh, "-o", (dir / "x.png").string()}).status == 2);
+    CHECK(run_cli({"field", mesh, "-o", ply}).status == 1);  // exists
+}

@@ -1,0 +1,39 @@
+#include "input.hpp"
+
+#include "terrain/io/mesh_files.hpp"
+#include "terrain/mesh/dem_to_mesh.hpp"
+
+namespace terrain::cli {
+
+void add_input_options(po::options_description& options, InputOptionValues& values) {
+    add_dem_options(options, values.dem);
+    options.add_options()
+        ("frame", po::value(&values.frame)->default_value("auto"),
+         "body|map|auto: body-fixed X,Y,Z on the body, or map easting/northing/height "
+         "(auto: body for planetary and geographic CRSs, map otherwise)")
+        ("repair", po::bool_switch(&values.repair),
+         "mesh input: repair degenerate or non-manifold elements instead of refusing");
+}
+
+Input load_input(const std::string& path, const InputOptionValues& values,
+                 const ProgressFn& progress) {
+    Input input;
+    if (io::is_mesh_file(path)) {
+        io::ReadMeshOptions read_options;
+        read_options.repair = values.repair;
+        input.mesh = io::read_mesh(path, read_options, progress);
+        return input;
+    }
+    mesh::DemToMeshOptions mesh_options;
+    if (values.frame == "body")
+        mesh_options.frame = MeshFrame::body;
+    else if (values.frame == "map")
+        mesh_options.frame = MeshFrame::map;
+    else if (values.frame != "auto")
+        throw UsageError("--frame must be body, map or auto, not '" + values.frame + "'");
+    input.dem = io::read_dem(path, to_read_options(values.dem), scaled_progress(progress, 0, 0.3));
+    input.mesh = mesh::dem_to_mesh(*input.dem, mesh_options, scaled_progress(progress, 0.3, 1));
+    return input;
+}
+
+}  // namespace terrain::cli
