@@ -1,7 +1,7 @@
 #include "cli.hpp"
 
-#include <iostream>
 #include <cmath>
+#include <iostream>
 #include <memory>
 
 #include "terrain/core/error.hpp"
@@ -69,15 +69,15 @@ int guarded(const std::string& command, const std::function<int()>& body) {
 namespace terrain::cli {
 
 void add_dem_options(po::options_description& options, DemOptionValues& values) {
-    options.add_options()
-        ("band,b", po::value(&values.band)->default_value(1), "raster band to read (1-based)")
-        ("elevation", po::value(&values.elevation)->default_value("auto"),
-         "radius|height|auto: whether values are radii from the body's centre or heights "
-         "above its reference (auto: radius when they sit near the body's radius)")
-        ("nan-nodata", po::bool_switch(&values.nan_nodata),
-         "treat NaN/Inf pixels as NoData holes instead of refusing the raster")
-        ("pixel-size", po::value(&values.pixel_size),
-         "metres per pixel, for a raster with no geotransform (default 1)");
+    options.add_options()("band,b", po::value(&values.band)->default_value(1),
+                          "raster band to read (1-based)")(
+        "elevation", po::value(&values.elevation)->default_value("auto"),
+        "radius|height|auto: whether values are radii from the body's centre or heights "
+        "above its reference (auto: radius when they sit near the body's radius)")(
+        "nan-nodata", po::bool_switch(&values.nan_nodata),
+        "treat NaN/Inf pixels as NoData holes instead of refusing the raster")(
+        "pixel-size", po::value(&values.pixel_size),
+        "metres per pixel, for a raster with no geotransform (default 1)");
 }
 
 io::ReadDemOptions to_read_options(const DemOptionValues& values) {

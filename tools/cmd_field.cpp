@@ -15,13 +15,12 @@ namespace terrain::cli {
 
 void add_field_options(po::options_description& options, std::string& field_name,
                        field::ShapeIndexOptions& shape_index) {
-    options.add_options()
-        ("field", po::value(&field_name)->default_value("shape-index"),
-         "shape-index (x100, in [0,100]) or height (metres above the reference)")
-        ("rings", po::value(&shape_index.rings)->default_value(2),
-         "shape index: fit over the vertices within N mesh edges")
-        ("radius", po::value(&shape_index.radius)->default_value(0.0),
-         "shape index: fit over the vertices within M metres instead of rings");
+    options.add_options()("field", po::value(&field_name)->default_value("shape-index"),
+                          "shape-index (x100, in [0,100]) or height (metres above the reference)")(
+        "rings", po::value(&shape_index.rings)->default_value(2),
+        "shape index: fit over the vertices within N mesh edges")(
+        "radius", po::value(&shape_index.radius)->default_value(0.0),
+        "shape index: fit over the vertices within M metres instead of rings");
 }
 
 int run_field(int argc, char** argv) {
@@ -31,12 +30,12 @@ int run_field(int argc, char** argv) {
         InputOptionValues input_values;
         field::FieldOptions field_options;
         po::options_description options("terrain field options");
-        options.add_options()
-            ("input", po::value(&input_path)->required(), "a DEM or a mesh (.off, .ply, .obj)")
-            ("output,o", po::value(&output)->required(),
-             "OUT.tif (DEM input: Float32 on the DEM's grid) or OUT.ply (per-vertex property)")
-            ("overwrite", po::bool_switch(&overwrite), "replace an existing output")
-            ("quiet,q", po::bool_switch(&quiet), "no progress output");
+        options.add_options()("input", po::value(&input_path)->required(),
+                              "a DEM or a mesh (.off, .ply, .obj)")(
+            "output,o", po::value(&output)->required(),
+            "OUT.tif (DEM input: Float32 on the DEM's grid) or OUT.ply (per-vertex property)")(
+            "overwrite", po::bool_switch(&overwrite), "replace an existing output")(
+            "quiet,q", po::bool_switch(&quiet), "no progress output");
         add_field_options(options, field_name, field_options.shape_index);
         add_input_options(options, input_values);
         po::positional_options_description positional;
@@ -65,8 +64,9 @@ int run_field(int argc, char** argv) {
             io::write_ply(input.mesh, output, overwrite, {{name, &values}});
         } else {
             if (!input.dem) throw UsageError("a mesh input gives a .ply output, not a raster");
-            io::write_float_raster(*input.dem, field::field_to_pixels(input.mesh, *input.dem, values),
-                                   output, overwrite, name);
+            io::write_float_raster(*input.dem,
+                                   field::field_to_pixels(input.mesh, *input.dem, values), output,
+                                   overwrite, name);
         }
         const auto [lo, hi] = std::minmax_element(values.begin(), values.end());
         std::printf("%s: %s on %zu vertices, range %.6g .. %.6g\n", output.c_str(), name.c_str(),

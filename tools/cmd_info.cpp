@@ -67,7 +67,8 @@ void write_text(std::ostream& out, const io::DemDescription& d, const Dem& dem) 
     if (d.body.is_local_grid()) {
         out << "Body:        none (local metric grid)\n";
     } else {
-        std::snprintf(line, sizeof line, "Body:        %s, semi-major axis %.10g m, flattening %.10g%s\n",
+        std::snprintf(line, sizeof line,
+                      "Body:        %s, semi-major axis %.10g m, flattening %.10g%s\n",
                       d.body.name.c_str(), d.body.semi_major_axis, d.body.flattening,
                       d.body.flattening > 0 ? "" : " (sphere)");
         out << line;
@@ -101,10 +102,10 @@ int run_info(int argc, char** argv) {
         bool json = false, quiet = false;
         DemOptionValues dem_values;
         po::options_description options("terrain info options");
-        options.add_options()
-            ("dem", po::value(&path)->required(), "the DEM (any raster GDAL opens)")
-            ("json", po::bool_switch(&json), "print JSON instead of text")
-            ("quiet,q", po::bool_switch(&quiet), "no progress output");
+        options.add_options()("dem", po::value(&path)->required(),
+                              "the DEM (any raster GDAL opens)")("json", po::bool_switch(&json),
+                                                                 "print JSON instead of text")(
+            "quiet,q", po::bool_switch(&quiet), "no progress output");
         add_dem_options(options, dem_values);
         po::positional_options_description positional;
         positional.add("dem", 1);

@@ -7,12 +7,12 @@ namespace terrain::cli {
 
 void add_input_options(po::options_description& options, InputOptionValues& values) {
     add_dem_options(options, values.dem);
-    options.add_options()
-        ("frame", po::value(&values.frame)->default_value("auto"),
-         "body|map|auto: body-fixed X,Y,Z on the body, or map easting/northing/height "
-         "(auto: body for planetary and geographic CRSs, map otherwise)")
-        ("repair", po::bool_switch(&values.repair),
-         "mesh input: repair degenerate or non-manifold elements instead of refusing");
+    options.add_options()(
+        "frame", po::value(&values.frame)->default_value("auto"),
+        "body|map|auto: body-fixed X,Y,Z on the body, or map easting/northing/height "
+        "(auto: body for planetary and geographic CRSs, map otherwise)")(
+        "repair", po::bool_switch(&values.repair),
+        "mesh input: repair degenerate or non-manifold elements instead of refusing");
 }
 
 Input load_input(const std::string& path, const InputOptionValues& values,

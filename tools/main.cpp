@@ -28,14 +28,14 @@ constexpr Command kCommands[] = {
      terrain::cli::run_mesh},
     {"field", "the scalar field (shape index, height) on a DEM's grid or a mesh's vertices",
      terrain::cli::run_field},
-    {"synth", "generate a synthetic cratered DEM tile (the Vesta sample)",
-     terrain::cli::run_synth},
+    {"synth", "generate a synthetic cratered DEM tile (the Vesta sample)", terrain::cli::run_synth},
 };
 
 void print_usage(std::ostream& out) {
     out << "Usage: terrain <command> [options]   (terrain <command> --help for details)\n\n"
            "Commands:\n";
-    for (const auto& c : kCommands) out << "  " << c.name << std::string(10 - std::strlen(c.name), ' ') << c.summary << "\n";
+    for (const auto& c : kCommands)
+        out << "  " << c.name << std::string(10 - std::strlen(c.name), ' ') << c.summary << "\n";
     out << "\nOptions:\n  --version   print the versions of terrain and its libraries\n"
            "  --help      show this help\n";
 }

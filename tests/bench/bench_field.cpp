@@ -34,7 +34,8 @@ int main(int argc, char** argv) {
         for (int i = 0; i < 3; ++i) {
             const auto t0 = std::chrono::steady_clock::now();
             const auto field = field::shape_index_field(mesh, options);
-            best = std::min(best, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+            best = std::min(
+                best, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
         }
         std::printf("shape index %-12s %.3f s  %.2f M vertices/s\n", name, best,
                     mesh.vertex_count() / best / 1e6);

@@ -27,8 +27,9 @@ Dem synthetic(int n, const std::string& crs, const GeoTransform& transform, doub
     dem.values.resize(std::size_t(n) * n);
     for (int r = 0; r < n; ++r)
         for (int c = 0; c < n; ++c)
-            dem.values[std::size_t(r) * n + c] =
-                base + 200 * std::sin(c * 0.05) * std::cos(r * 0.037) + 30 * std::sin(c * 0.9 + r * 1.3);
+            dem.values[std::size_t(r) * n + c] = base +
+                                                 200 * std::sin(c * 0.05) * std::cos(r * 0.037) +
+                                                 30 * std::sin(c * 0.9 + r * 1.3);
     return dem;
 }
 
@@ -38,12 +39,13 @@ void run(const char* name, const Dem& dem) {
     for (int i = 0; i < 3; ++i) {
         const auto t0 = std::chrono::steady_clock::now();
         mesh = mesh::dem_to_mesh(dem);
-        best = std::min(best, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+        best = std::min(
+            best, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
     }
-    std::printf("%-28s %9zu vertices %9zu triangles  %.3f s  %.2f M vertices/s  %.1f bytes/vertex\n",
-                name, mesh.vertex_count(), mesh.triangle_count(), best,
-                mesh.vertex_count() / best / 1e6,
-                double(mesh.memory_bytes()) / double(mesh.vertex_count()));
+    std::printf(
+        "%-28s %9zu vertices %9zu triangles  %.3f s  %.2f M vertices/s  %.1f bytes/vertex\n", name,
+        mesh.vertex_count(), mesh.triangle_count(), best, mesh.vertex_count() / best / 1e6,
+        double(mesh.memory_bytes()) / double(mesh.vertex_count()));
 }
 
 }  // namespace
@@ -51,8 +53,9 @@ void run(const char* name, const Dem& dem) {
 int main(int argc, char** argv) {
     const int n = argc > 1 ? std::atoi(argv[1]) : 1000;
     std::printf("bench_mesh: %dx%d DEM, %d threads\n", n, n, tbb::info::default_concurrency());
-    run("map frame (UTM 11N, 30 m)", synthetic(n, "EPSG:32611", {400000, 30, 0, 3800000, 0, -30}, 0));
-    run("body frame (Vesta lon/lat)",
-        synthetic(n, "+proj=longlat +R=255000 +no_defs", {10, 1.0 / 64, 0, -20, 0, -1.0 / 64}, 255000));
+    run("map frame (UTM 11N, 30 m)",
+        synthetic(n, "EPSG:32611", {400000, 30, 0, 3800000, 0, -30}, 0));
+    run("body frame (Vesta lon/lat)", synthetic(n, "+proj=longlat +R=255000 +no_defs",
+                                                {10, 1.0 / 64, 0, -20, 0, -1.0 / 64}, 255000));
     return 0;
 }

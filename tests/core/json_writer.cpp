@@ -1,5 +1,5 @@
-#include <catch2/catch.hpp>
 #include <cpl_json.h>
+#include <catch2/catch.hpp>
 
 #include <cmath>
 #include <limits>

@@ -1,5 +1,5 @@
-#include <catch2/catch.hpp>
 #include <tbb/global_control.h>
+#include <catch2/catch.hpp>
 
 #include <array>
 #include <cmath>
@@ -34,7 +34,8 @@ using Derivatives = std::array<double, 5>;
 // The exact shape index (x100) of the graph of f from its derivatives (convex positive).
 double exact_shape_index(const Derivatives& d) {
     const auto [fx, fy, fxx, fxy, fyy] = d;
-    const double E = 1 + fx * fx, F = fx * fy, G = 1 + fy * fy, W = std::sqrt(1 + fx * fx + fy * fy);
+    const double E = 1 + fx * fx, F = fx * fy, G = 1 + fy * fy,
+                 W = std::sqrt(1 + fx * fx + fy * fy);
     const double L = fxx / W, M = fxy / W, N = fyy / W, det = E * G - F * F;
     const double K = (L * N - M * M) / det, H = -(E * N - 2 * F * M + G * L) / (2 * det);
     const double root = std::sqrt(std::max(0.0, H * H - K));
@@ -78,13 +79,19 @@ TEST_CASE("shape_index of principal curvatures follows METHOD.md's convention", 
 TEST_CASE("shape index known answers on analytic DEMs", "[shape_index]") {
     const double k = 1 / R;
     SECTION("cap z = -(x^2+y^2)/2R: +1 (100) at the top") {
-        const auto dem = analytic(31, 1.0, [&](double x, double y) { return -(x * x + y * y) * k / 2; });
-        check_known_answer(dem, [&](double x, double y) { return Derivatives{-x * k, -y * k, -k, 0, -k}; });
+        const auto dem =
+            analytic(31, 1.0, [&](double x, double y) { return -(x * x + y * y) * k / 2; });
+        check_known_answer(dem, [&](double x, double y) {
+            return Derivatives{-x * k, -y * k, -k, 0, -k};
+        });
         CHECK(exact_shape_index({0, 0, -k, 0, -k}) == Approx(100));
     }
     SECTION("cup z = (x^2+y^2)/2R: -1 (0) at the bottom") {
-        const auto dem = analytic(31, 1.0, [&](double x, double y) { return (x * x + y * y) * k / 2; });
-        check_known_answer(dem, [&](double x, double y) { return Derivatives{x * k, y * k, k, 0, k}; });
+        const auto dem =
+            analytic(31, 1.0, [&](double x, double y) { return (x * x + y * y) * k / 2; });
+        check_known_answer(dem, [&](double x, double y) {
+            return Derivatives{x * k, y * k, k, 0, k};
+        });
         CHECK(exact_shape_index({0, 0, k, 0, k}) == Approx(0).margin(1e-9));
     }
     SECTION("ridge z = -x^2/2R: +0.5 (75) everywhere") {
@@ -98,22 +105,33 @@ TEST_CASE("shape index known answers on analytic DEMs", "[shape_index]") {
         CHECK(exact_shape_index({-0.2, 0, k, 0, 0}) == Approx(25));
     }
     SECTION("symmetric saddle z = (x^2-y^2)/2R: 0 (50) at the centre") {
-        const auto dem = analytic(31, 1.0, [&](double x, double y) { return (x * x - y * y) * k / 2; });
-        check_known_answer(dem, [&](double x, double y) { return Derivatives{x * k, -y * k, k, 0, -k}; });
+        const auto dem =
+            analytic(31, 1.0, [&](double x, double y) { return (x * x - y * y) * k / 2; });
+        check_known_answer(dem, [&](double x, double y) {
+            return Derivatives{x * k, -y * k, k, 0, -k};
+        });
         CHECK(exact_shape_index({0, 0, k, 0, -k}) == Approx(50));
     }
     SECTION("tilted plane: planar, 50") {
-        const auto dem = analytic(31, 1.0, [](double x, double y) { return 0.3 * x - 0.2 * y + 5; });
-        check_known_answer(dem, [](double, double) { return Derivatives{0.3, -0.2, 0, 0, 0}; }, {}, 0, 0.0);
+        const auto dem =
+            analytic(31, 1.0, [](double x, double y) { return 0.3 * x - 0.2 * y + 5; });
+        check_known_answer(
+            dem,
+            [](double, double) {
+                return Derivatives{0.3, -0.2, 0, 0, 0};
+            },
+            {}, 0, 0.0);
     }
     SECTION("sphere cap on a projected grid: umbilic, +1 (100) everywhere") {
         const double r = 60;
-        const auto dem = analytic(41, 1.0, [&](double x, double y) { return std::sqrt(r * r - x * x - y * y); });
+        const auto dem =
+            analytic(41, 1.0, [&](double x, double y) { return std::sqrt(r * r - x * x - y * y); });
         check_known_answer(dem, [](double, double) { return Derivatives{0, 0, -1, 0, -1}; });
     }
     SECTION("inside of a spherical bowl: -1 (0) everywhere") {
         const double r = 60;
-        const auto dem = analytic(41, 1.0, [&](double x, double y) { return -std::sqrt(r * r - x * x - y * y); });
+        const auto dem = analytic(
+            41, 1.0, [&](double x, double y) { return -std::sqrt(r * r - x * x - y * y); });
         check_known_answer(dem, [](double, double) { return Derivatives{0, 0, 1, 0, 1}; });
     }
 }
@@ -136,7 +154,8 @@ TEST_CASE("shape index is unchanged when x, y and z are scaled together", "[shap
 TEST_CASE("shape index near edges and NoData is finite and in range", "[shape_index]") {
     Dem dem = analytic(20, 1.0, [](double x, double y) { return std::sin(x * 0.4) + y * 0.1; });
     for (int r = 5; r < 9; ++r)
-        for (int c = 6; c < 10; ++c) dem.values[dem.index(c, r)] = std::numeric_limits<double>::quiet_NaN();
+        for (int c = 6; c < 10; ++c)
+            dem.values[dem.index(c, r)] = std::numeric_limits<double>::quiet_NaN();
     dem.values[dem.index(19, 0)] = std::numeric_limits<double>::quiet_NaN();  // a lone corner
     const auto mesh = mesh::dem_to_mesh(dem);
     for (int rings : {1, 2, 3}) {
@@ -157,16 +176,21 @@ TEST_CASE("shape index near edges and NoData is finite and in range", "[shape_in
 
 TEST_CASE("shape index with --radius gives the known answer too", "[shape_index]") {
     const double k = 1 / R;
-    const auto dem = analytic(31, 1.0, [&](double x, double y) { return (x * x - 0.5 * y * y) * k / 2; });
+    const auto dem =
+        analytic(31, 1.0, [&](double x, double y) { return (x * x - 0.5 * y * y) * k / 2; });
     field::ShapeIndexOptions options;
     options.radius = 2.9;
-    check_known_answer(dem, [&](double x, double y) { return Derivatives{x * k, -0.5 * y * k, k, 0, -0.5 * k}; },
-                       options, 4);
+    check_known_answer(
+        dem,
+        [&](double x, double y) {
+            return Derivatives{x * k, -0.5 * y * k, k, 0, -0.5 * k};
+        },
+        options, 4);
 }
 
 TEST_CASE("shape index is the same whatever the thread count", "[shape_index]") {
-    const auto mesh = mesh::dem_to_mesh(
-        analytic(64, 2.0, [](double x, double y) { return std::sin(x * 0.1) * std::cos(y * 0.13) * 10; }));
+    const auto mesh = mesh::dem_to_mesh(analytic(
+        64, 2.0, [](double x, double y) { return std::sin(x * 0.1) * std::cos(y * 0.13) * 10; }));
     std::vector<float> one, two;
     {
         tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);

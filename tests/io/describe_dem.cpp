@@ -6,7 +6,8 @@
 
 using namespace terrain;
 
-TEST_CASE("describe_dem on LDEM_4: the Moon, radii, 7581 m pixels, global", "[describe_dem][shared]") {
+TEST_CASE("describe_dem on LDEM_4: the Moon, radii, 7581 m pixels, global",
+          "[describe_dem][shared]") {
     const auto path = test::shared_data("moon_lola_ldem4/LDEM_4.LBL");
     REQUIRE(path.has_value());  // CI always has ../shared beside the project
     const auto d = io::describe_dem(io::read_dem(*path));

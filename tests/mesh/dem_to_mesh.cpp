@@ -1,10 +1,10 @@
-#include <catch2/catch.hpp>
 #include <tbb/global_control.h>
+#include <catch2/catch.hpp>
 
 #include <algorithm>
 #include <cmath>
-#include <map>
 #include <limits>
+#include <map>
 #include <numbers>
 
 #include "support/test_support.hpp"
@@ -205,8 +205,7 @@ TEST_CASE("dem_to_mesh: a projected tile's area is planimetric area x mean slope
     CHECK(double(mesh.memory_bytes()) / double(mesh.vertex_count()) < 100);
 }
 
-TEST_CASE("dem_to_mesh: a lon/lat grid has the same shape in the body and map frames",
-          "[mesh]") {
+TEST_CASE("dem_to_mesh: a lon/lat grid has the same shape in the body and map frames", "[mesh]") {
     // A Gaussian hill on a 0.001 degree grid at 45 N on WGS84.
     Dem dem;
     dem.width = dem.height = 40;

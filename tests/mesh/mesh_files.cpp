@@ -58,13 +58,13 @@ TEST_CASE("read_mesh refuses bad meshes naming the first bad element", "[mesh_fi
                                "5 3 0\n0 0 0\n1 0 0\n0 1 0\n0 -1 0\n0 0 1\n"
                                "3 0 1 2\n3 1 0 3\n3 0 1 4\n");
     CHECK_THAT(error_of(fin), Contains("edge 0-1 is non-manifold"));
-    const auto degenerate = write_off(dir / "degenerate.off",
-                                      "4 2 0\n0 0 0\n1 0 0\n2 0 0\n0 1 0\n3 0 1 3\n3 0 1 2\n");
+    const auto degenerate =
+        write_off(dir / "degenerate.off", "4 2 0\n0 0 0\n1 0 0\n2 0 0\n0 1 0\n3 0 1 3\n3 0 1 2\n");
     CHECK_THAT(error_of(degenerate), Contains("face 1") && Contains("area is zero"));
     const auto repeated = write_off(dir / "repeated.off", "3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 0 1\n");
     CHECK_THAT(error_of(repeated), Contains("face 0") && Contains("repeats"));
-    const auto flipped = write_off(dir / "flipped.off",
-                                   "4 2 0\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n3 0 1 2\n3 1 2 3\n");
+    const auto flipped =
+        write_off(dir / "flipped.off", "4 2 0\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n3 0 1 2\n3 1 2 3\n");
     CHECK_THAT(error_of(flipped), Contains("oriented inconsistently"));
     const auto bowtie = write_off(dir / "bowtie.off",
                                   "5 2 0\n0 0 0\n1 0 0\n0 1 0\n-1 0 0\n0 -1 0\n3 0 1 2\n3 0 3 4\n");

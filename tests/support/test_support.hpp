@@ -23,7 +23,7 @@ struct RasterSpec {
     std::string type = "Float32";  // a GDAL data type name
     std::vector<double> values;    // row-major, width*height
     std::optional<double> nodata;
-    std::string crs;               // empty: none; else anything SetFromUserInput takes
+    std::string crs;                   // empty: none; else anything SetFromUserInput takes
     std::vector<double> geotransform;  // empty: none
     double scale = 1, offset = 0;
 };

@@ -1,17 +1,19 @@
 // The `terrain` command line as users and scripts see it: exit codes, one-line errors, output.
-#include <catch2/catch.hpp>
 #include <cpl_json.h>
+#include <catch2/catch.hpp>
 
 #include <algorithm>
 #include <fstream>
 
 #include "support/test_support.hpp"
 
-using terrain::test::run_cli;
 using Catch::Matchers::Contains;
+using terrain::test::run_cli;
 
 namespace {
-std::size_t line_count(const std::string& s) { return std::count(s.begin(), s.end(), '\n'); }
+std::size_t line_count(const std::string& s) {
+    return std::count(s.begin(), s.end(), '\n');
+}
 }  // namespace
 
 TEST_CASE("terrain --version names terrain and its libraries", "[cli]") {

@@ -1,7 +1,7 @@
 // `terrain mesh` and `terrain field` as users run them, outputs read back with GDAL.
-#include <catch2/catch.hpp>
 #include <gdal_priv.h>
 #include <ogr_spatialref.h>
+#include <catch2/catch.hpp>
 
 #include <cmath>
 #include <fstream>
@@ -9,8 +9,8 @@
 
 #include "support/test_support.hpp"
 
-using terrain::test::run_cli;
 using Catch::Matchers::Contains;
+using terrain::test::run_cli;
 
 TEST_CASE("terrain mesh on the shared DEMs and the samples", "[cli][mesh]") {
     const auto dir = terrain::test::scratch_dir("cli_mesh");
@@ -43,8 +43,8 @@ TEST_CASE("terrain mesh on the shared DEMs and the samples", "[cli][mesh]") {
         run_cli({"mesh", terrain::test::sample("mars_hirise_crop.tif"), "-o", out, "--overwrite"});
     CHECK(over.status == 0);
     CHECK_THAT(over.err, Contains("0...10...20") && Contains("100 - done."));
-    CHECK(run_cli({"mesh", terrain::test::sample("mars_hirise_crop.tif"), "-o", out,
-                   "--overwrite", "--frame", "body"})
+    CHECK(run_cli({"mesh", terrain::test::sample("mars_hirise_crop.tif"), "-o", out, "--overwrite",
+                   "--frame", "body"})
               .status == 1);  // no CRS: no body
     CHECK(run_cli({"mesh", terrain::test::sample("mars_hirise_crop.tif"), "-o",
                    (dir / "no/dir/x.ply").string()})
@@ -112,7 +112,8 @@ TEST_CASE("terrain field writes a Float32 raster on the DEM's exact grid", "[cli
     CHECK(v == Approx(100 * std::sin(5 * 0.3) * std::cos(3 * 0.2)).margin(1e-3));
 }
 
-TEST_CASE("terrain field on a mesh writes a PLY property, bad options are refused", "[cli][field]") {
+TEST_CASE("terrain field on a mesh writes a PLY property, bad options are refused",
+          "[cli][field]") {
     const auto dir = terrain::test::scratch_dir("cli_field_mesh");
     std::ofstream(dir / "octa.off") << "OFF\n6 8 0\n1 0 0\n-1 0 0\n0 1 0\n0 -1 0\n0 0 1\n0 0 -1\n"
                                        "3 0 2 4\n3 2 1 4\n3 1 3 4\n3 3 0 4\n3 2 0 5\n3 1 2 5\n"

@@ -15,7 +15,7 @@ namespace {
 
 struct KnownBody {
     std::string_view name;
-    double mean_radius;  // metres, used only when no name matches
+    double mean_radius;                        // metres, used only when no name matches
     std::array<std::string_view, 4> keywords;  // upper case, matched inside datum/CRS names
 };
 

@@ -1,19 +1,21 @@
 #include "terrain/core/version.hpp"
 
 #include <CGAL/version.h>
-#include <Eigen/Core>
 #include <GeographicLib/Config.h>
 #include <OpenImageIO/oiioversion.h>
-#include <boost/version.hpp>
 #include <gdal.h>
 #include <oneapi/tbb/version.h>
 #include <proj.h>
+#include <Eigen/Core>
+#include <boost/version.hpp>
 
 #include "terrain/version.hpp"
 
 namespace terrain {
 
-std::string version() { return TERRAIN_VERSION_STRING; }
+std::string version() {
+    return TERRAIN_VERSION_STRING;
+}
 
 std::vector<std::pair<std::string, std::string>> dependency_versions() {
     const auto dotted = [](int a, int b, int c) {

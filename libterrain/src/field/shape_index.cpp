@@ -23,7 +23,9 @@ Vec3 sub(const std::array<float, 3>& a, const std::array<float, 3>& b) {
 Vec3 cross(const Vec3& a, const Vec3& b) {
     return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
 }
-double dot(const Vec3& a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+double dot(const Vec3& a, const Vec3& b) {
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
 Vec3 normalized(const Vec3& a) {
     const double n = std::sqrt(dot(a, a));
     return n > 0 ? Vec3{a[0] / n, a[1] / n, a[2] / n} : Vec3{0, 0, 1};
@@ -48,8 +50,8 @@ struct Scratch {
     std::vector<std::int32_t> gathered;
 };
 
-// The neighbourhood of v (gathered[0] is v itself): `rings` rings of mesh edges, or everything within
-// `radius` metres reachable through vertices within it.
+// The neighbourhood of v (gathered[0] is v itself): `rings` rings of mesh edges, or everything
+// within `radius` metres reachable through vertices within it.
 void gather(const TriangleMesh& mesh, std::int32_t v, const ShapeIndexOptions& options,
             Scratch& s) {
     if (s.stamp.size() != mesh.vertex_count()) s.stamp.assign(mesh.vertex_count(), 0);

@@ -41,7 +41,8 @@ std::vector<float> vertex_field(const TriangleMesh& mesh, const Dem* dem,
             report_progress(progress, 1.0, "height");
             return out;
         }
-        default: return shape_index_field(mesh, options.shape_index, progress);
+        default:
+            return shape_index_field(mesh, options.shape_index, progress);
     }
 }
 

@@ -13,7 +13,7 @@ void ensure_gdal_registered();
 // While alive, GDAL errors and warnings raised on this thread are kept here instead of being
 // printed (the library never prints). suffix() gives ": <last error>" for a message.
 class GdalErrorCapture {
-public:
+  public:
     GdalErrorCapture();
     ~GdalErrorCapture();
     GdalErrorCapture(const GdalErrorCapture&) = delete;
@@ -22,7 +22,7 @@ public:
     const std::string& last_error() const { return last_error_; }
     std::string suffix() const { return last_error_.empty() ? "" : " (" + last_error_ + ")"; }
 
-private:
+  private:
     static void CPL_STDCALL handler(CPLErr level, CPLErrorNum number, const char* message);
     std::string last_error_;
 };

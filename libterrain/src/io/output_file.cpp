@@ -43,7 +43,8 @@ AtomicOutput::~AtomicOutput() {
 void AtomicOutput::commit() {
     std::error_code ec;
     fs::rename(temp_, path_, ec);
-    if (ec) throw Error("write", "cannot rename '" + temp_ + "' to '" + path_ + "': " + ec.message());
+    if (ec)
+        throw Error("write", "cannot rename '" + temp_ + "' to '" + path_ + "': " + ec.message());
     committed_ = true;
 }
 

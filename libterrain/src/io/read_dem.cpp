@@ -10,8 +10,8 @@
 #include <limits>
 #include <memory>
 
-#include "terrain/core/error.hpp"
 #include "gdal_support.hpp"
+#include "terrain/core/error.hpp"
 
 namespace terrain::io {
 
@@ -32,13 +32,13 @@ Dem read_dem(const std::string& path, const ReadDemOptions& options, const Progr
     std::unique_ptr<GDALDataset> dataset(
         GDALDataset::Open(path.c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY));
     if (!dataset)
-        throw Error("read", "'" + path + "' is not a raster GDAL can open" +
-                                errors.suffix() + "; give a DEM such as a GeoTIFF or a PDS label");
+        throw Error("read", "'" + path + "' is not a raster GDAL can open" + errors.suffix() +
+                                "; give a DEM such as a GeoTIFF or a PDS label");
     const int band_count = dataset->GetRasterCount();
     if (band_count == 0) throw Error("read", "'" + path + "' has no raster band");
     if (options.band < 1 || options.band > band_count)
-        throw Error("read", "band " + std::to_string(options.band) + " does not exist in '" +
-                                path + "', which has " + std::to_string(band_count) +
+        throw Error("read", "band " + std::to_string(options.band) + " does not exist in '" + path +
+                                "', which has " + std::to_string(band_count) +
                                 " band(s); choose --band 1.." + std::to_string(band_count));
     Dem dem;
     dem.source = path;
@@ -89,8 +89,8 @@ Dem read_dem(const std::string& path, const ReadDemOptions& options, const Progr
             CE_None)
             throw Error("read", "cannot read row " + std::to_string(row) + " of '" + path + "'" +
                                     errors.suffix());
-        if (!all_valid && mask->RasterIO(GF_Read, 0, row, dem.width, 1, mask_row.data(),
-                                         dem.width, 1, GDT_Byte, 0, 0) != CE_None)
+        if (!all_valid && mask->RasterIO(GF_Read, 0, row, dem.width, 1, mask_row.data(), dem.width,
+                                         1, GDT_Byte, 0, 0) != CE_None)
             throw Error("read", "cannot read the NoData mask of '" + path + "'" + errors.suffix());
         for (std::size_t col = 0; col < width; ++col) {
             double& v = out[col];
@@ -121,8 +121,9 @@ Dem read_dem(const std::string& path, const ReadDemOptions& options, const Progr
                                 "); declare NoData (gdal_edit.py -a_nodata nan) or pass "
                                 "--nan-nodata to treat them as holes");
     if (valid == 0)
-        throw Error("read", "'" + path + "' band " + std::to_string(options.band) +
-                                " has no valid pixel (all NoData); check the band and NoData value");
+        throw Error("read",
+                    "'" + path + "' band " + std::to_string(options.band) +
+                        " has no valid pixel (all NoData); check the band and NoData value");
     if (valid < 3)
         throw Error("read", "'" + path + "' has only " + std::to_string(valid) +
                                 " valid pixel(s); a surface needs at least three");

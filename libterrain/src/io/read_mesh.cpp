@@ -74,7 +74,8 @@ std::string first_problem(const std::vector<Point>& points, const std::vector<Po
     std::vector<std::array<std::size_t, 3>> directed;  // (from, to, face)
     directed.reserve(3 * polygons.size());
     for (std::size_t f = 0; f < polygons.size(); ++f)
-        for (int k = 0; k < 3; ++k) directed.push_back({polygons[f][k], polygons[f][(k + 1) % 3], f});
+        for (int k = 0; k < 3; ++k)
+            directed.push_back({polygons[f][k], polygons[f][(k + 1) % 3], f});
     std::vector<std::array<std::size_t, 3>> undirected = directed;
     for (auto& e : undirected)
         if (e[0] > e[1]) std::swap(e[0], e[1]);
@@ -89,8 +90,9 @@ std::string first_problem(const std::vector<Point>& points, const std::vector<Po
     for (std::size_t i = 0; i + 1 < directed.size(); ++i)
         if (directed[i][0] == directed[i + 1][0] && directed[i][1] == directed[i + 1][1])
             return "faces " + std::to_string(directed[i][2]) + " and " +
-                   std::to_string(directed[i + 1][2]) + " are oriented inconsistently across edge " +
-                   std::to_string(directed[i][0]) + "-" + std::to_string(directed[i][1]);
+                   std::to_string(directed[i + 1][2]) +
+                   " are oriented inconsistently across edge " + std::to_string(directed[i][0]) +
+                   "-" + std::to_string(directed[i][1]);
     return {};
 }
 
@@ -105,8 +107,7 @@ TriangleMesh read_mesh(const std::string& path, const ReadMeshOptions& options,
                        const ProgressFn& progress) {
     if (!std::filesystem::exists(path))
         throw Error("mesh", "'" + path + "' does not exist; check the path");
-    if (!is_mesh_file(path))
-        throw Error("mesh", "'" + path + "' is not a .off, .ply or .obj mesh");
+    if (!is_mesh_file(path)) throw Error("mesh", "'" + path + "' is not a .off, .ply or .obj mesh");
     std::vector<Point> points;
     std::vector<Polygon> polygons;
     bool ok = false;

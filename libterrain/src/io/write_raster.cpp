@@ -12,8 +12,8 @@
 
 namespace terrain::io {
 
-void write_float_raster(const Dem& grid, const std::vector<float>& pixels,
-                        const std::string& path, bool overwrite, const std::string& description) {
+void write_float_raster(const Dem& grid, const std::vector<float>& pixels, const std::string& path,
+                        bool overwrite, const std::string& description) {
     if (pixels.size() != grid.size())
         throw Error("write", "raster of " + std::to_string(pixels.size()) + " pixels for a " +
                                  std::to_string(grid.width) + "x" + std::to_string(grid.height) +

@@ -1,11 +1,11 @@
 #include "terrain/mesh/dem_to_mesh.hpp"
 
-#include <GeographicLib/Geocentric.hpp>
-#include <GeographicLib/LocalCartesian.hpp>
 #include <ogr_spatialref.h>
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
+#include <GeographicLib/Geocentric.hpp>
+#include <GeographicLib/LocalCartesian.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -128,8 +128,8 @@ TriangleMesh dem_to_mesh(const Dem& dem, const DemToMeshOptions& options,
     std::unique_ptr<GeographicLib::LocalCartesian> tangent;
     if (frame == MeshFrame::map && geographic_crs) {
         const auto centre = dem.map_xy(W / 2.0, H / 2.0);
-        tangent = std::make_unique<GeographicLib::LocalCartesian>(centre[1], centre[0], 0.0,
-                                                                  *earth);
+        tangent =
+            std::make_unique<GeographicLib::LocalCartesian>(centre[1], centre[0], 0.0, *earth);
     }
     tbb::enumerable_thread_specific<std::unique_ptr<LonLatTransform>> transforms;
     std::vector<std::uint8_t> failed(static_cast<std::size_t>(H), 0);
@@ -237,10 +237,14 @@ TriangleMesh dem_to_mesh(const Dem& dem, const DemToMeshOptions& options,
                 const int valid = (v00 >= 0) + (v10 >= 0) + (v01 >= 0) + (v11 >= 0);
                 if (valid < 3) continue;
                 if (valid == 3) {
-                    if (v00 < 0) emit(v10, v01, v11);
-                    else if (v10 < 0) emit(v00, v01, v11);
-                    else if (v01 < 0) emit(v00, v11, v10);
-                    else emit(v00, v01, v10);
+                    if (v00 < 0)
+                        emit(v10, v01, v11);
+                    else if (v10 < 0)
+                        emit(v00, v01, v11);
+                    else if (v01 < 0)
+                        emit(v00, v11, v10);
+                    else
+                        emit(v00, v01, v10);
                     continue;
                 }
                 auto dist2 = [&](std::int32_t i, std::int32_t j) {
@@ -269,8 +273,8 @@ TriangleMesh dem_to_mesh(const Dem& dem, const DemToMeshOptions& options,
     }
     per_row = {};
     if (mesh.triangles.empty())
-        throw Error("mesh", "'" + dem.source +
-                                "' gives no triangle: no 2x2 block has three valid pixels");
+        throw Error("mesh",
+                    "'" + dem.source + "' gives no triangle: no 2x2 block has three valid pixels");
     report_progress(progress, 0.7, "mesh");
 
     // Leave out valid pixels in no triangle (isolated, or only in degenerate blocks).

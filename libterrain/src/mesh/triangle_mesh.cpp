@@ -8,16 +8,18 @@ namespace terrain {
 
 const char* to_string(MeshFrame frame) {
     switch (frame) {
-        case MeshFrame::body: return "body";
-        case MeshFrame::map: return "map";
-        default: return "file";
+        case MeshFrame::body:
+            return "body";
+        case MeshFrame::map:
+            return "map";
+        default:
+            return "file";
     }
 }
 
 std::size_t TriangleMesh::memory_bytes() const {
     return positions.capacity() * sizeof(positions[0]) +
-           triangles.capacity() * sizeof(triangles[0]) +
-           vertex_areas.capacity() * sizeof(float) +
+           triangles.capacity() * sizeof(triangles[0]) + vertex_areas.capacity() * sizeof(float) +
            neighbor_offsets.capacity() * sizeof(std::int32_t) +
            neighbors.capacity() * sizeof(std::int32_t) +
            vertex_pixel.capacity() * sizeof(std::int32_t);
@@ -115,8 +117,7 @@ MeshTopology mesh_topology(const TriangleMesh& mesh) {
         std::vector<std::uint32_t> roots;
         for (auto e : boundary) roots.push_back(find(std::uint32_t(e >> 32)));
         std::sort(roots.begin(), roots.end());
-        topo.boundary_loops =
-            std::size_t(std::unique(roots.begin(), roots.end()) - roots.begin());
+        topo.boundary_loops = std::size_t(std::unique(roots.begin(), roots.end()) - roots.begin());
     }
     // Components by triangles.
     std::iota(parent.begin(), parent.end(), 0u);
@@ -130,8 +131,8 @@ MeshTopology mesh_topology(const TriangleMesh& mesh) {
         for (int k = 0; k < 3; ++k) used[t[k]] = 1;
     for (std::size_t v = 0; v < topo.vertices; ++v)
         if (used[v] && find(std::uint32_t(v)) == v) ++topo.components;
-    topo.euler_characteristic = std::int64_t(topo.vertices) - std::int64_t(topo.edges) +
-                                std::int64_t(topo.faces);
+    topo.euler_characteristic =
+        std::int64_t(topo.vertices) - std::int64_t(topo.edges) + std::int64_t(topo.faces);
     return topo;
 }
 
@@ -197,7 +198,6 @@ std::size_t split_pinched_vertices(TriangleMesh& mesh, std::int32_t* first_pinch
     }
     return split;
 }
-
 
 std::size_t remove_unreferenced_vertices(TriangleMesh& mesh) {
     std::vector<std::int32_t> remap(mesh.positions.size(), -1);

@@ -8,11 +8,11 @@
 namespace terrain {
 
 class Error : public std::runtime_error {
-public:
+  public:
     Error(const std::string& stage, const std::string& message);
     const std::string& stage() const noexcept { return stage_; }
 
-private:
+  private:
     std::string stage_;
 };
 

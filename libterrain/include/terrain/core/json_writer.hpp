@@ -11,7 +11,7 @@
 namespace terrain {
 
 class JsonWriter {
-public:
+  public:
     explicit JsonWriter(std::ostream& out, bool pretty = true) : out_(out), pretty_(pretty) {}
 
     JsonWriter& begin_object();
@@ -39,7 +39,7 @@ public:
     static std::string escape(std::string_view text);
     static std::string number(double v);  // shortest round-trip text, "null" if not finite
 
-private:
+  private:
     void before_value();
     void newline();
     std::ostream& out_;

@@ -13,8 +13,8 @@
 namespace terrain::field {
 
 struct ShapeIndexOptions {
-    int rings = 2;        // neighbourhood: vertices within this many mesh edges
-    double radius = 0;    // > 0: vertices within this distance in metres instead of rings
+    int rings = 2;      // neighbourhood: vertices within this many mesh edges
+    double radius = 0;  // > 0: vertices within this distance in metres instead of rings
     // Curvedness times the mean neighbour distance below this is a planar point (SI 0).
     double planar_curvedness = 1e-4;
 };

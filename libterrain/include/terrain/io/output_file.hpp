@@ -10,9 +10,9 @@ namespace terrain::io {
 void check_output_path(const std::string& path, bool overwrite);
 
 class AtomicOutput {
-public:
+  public:
     AtomicOutput(std::string path, bool overwrite);  // runs check_output_path
-    ~AtomicOutput();                                  // removes the temporary unless committed
+    ~AtomicOutput();                                 // removes the temporary unless committed
     AtomicOutput(const AtomicOutput&) = delete;
     AtomicOutput& operator=(const AtomicOutput&) = delete;
 
@@ -20,7 +20,7 @@ public:
     const std::string& path() const { return path_; }
     void commit();  // renames the temporary onto the final path
 
-private:
+  private:
     std::string path_, temp_;
     bool committed_ = false;
 };

@@ -10,10 +10,10 @@
 namespace terrain::io {
 
 struct ReadDemOptions {
-    int band = 1;                                // 1-based, as in GDAL
-    std::optional<ElevationKind> elevation;      // unset: detect (docs/bodies-and-elevation.md)
-    bool nan_as_nodata = false;                  // NaN/Inf pixels become holes instead of an error
-    std::optional<double> pixel_size;            // metres per pixel for rasters with no geotransform
+    int band = 1;                            // 1-based, as in GDAL
+    std::optional<ElevationKind> elevation;  // unset: detect (docs/bodies-and-elevation.md)
+    bool nan_as_nodata = false;              // NaN/Inf pixels become holes instead of an error
+    std::optional<double> pixel_size;        // metres per pixel for rasters with no geotransform
 };
 
 // Scale and offset of the band are applied; NoData (and the band's mask) become NaN.

@@ -37,8 +37,8 @@ struct TriangleMesh {
     int grid_width = 0, grid_height = 0;
 
     MeshFrame frame = MeshFrame::file;
-    Body body;                 // the body for DEM meshes in the body frame
-    std::string crs_wkt;       // the DEM's CRS (map frame: the CRS of x, y)
+    Body body;            // the body for DEM meshes in the body frame
+    std::string crs_wkt;  // the DEM's CRS (map frame: the CRS of x, y)
 
     // What the triangulation met (DEM meshes).
     std::size_t pinched_vertices = 0;   // vertices split because fans met only at them
@@ -64,9 +64,9 @@ struct TriangleMesh {
 // Counts of a mesh's topology.
 struct MeshTopology {
     std::size_t vertices = 0, edges = 0, faces = 0;
-    std::size_t boundary_edges = 0;      // edges in one triangle
-    std::size_t boundary_loops = 0;      // connected cycles of boundary edges
-    std::size_t components = 0;          // connected components (by triangles)
+    std::size_t boundary_edges = 0;         // edges in one triangle
+    std::size_t boundary_loops = 0;         // connected cycles of boundary edges
+    std::size_t components = 0;             // connected components (by triangles)
     std::int64_t euler_characteristic = 0;  // V - E + F
 };
 
