@@ -15,24 +15,6 @@ namespace {
 
 constexpr double kDegree = std::numbers::pi / 180.0;
 
-struct Transformer {
-    std::unique_ptr<OGRSpatialReference> source, geographic;
-    std::unique_ptr<OGRCoordinateTransformation> to_lonlat;
-};
-
-// Maps the DEM's CRS to longitude/latitude in degrees on the same body, or nothing.
-Transformer make_lonlat_transformer(const std::string& wkt) {
-    Transformer t;
-    t.source = std::make_unique<OGRSpatialReference>();
-    if (t.source->SetFromUserInput(wkt.c_str()) != OGRERR_NONE) return {};
-    t.source->SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
-    t.geographic.reset(t.source->CloneGeogCS());
-    if (!t.geographic) return {};
-    t.geographic->SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
-    t.to_lonlat.reset(OGRCreateCoordinateTransformation(t.source.get(), t.geographic.get()));
-    return t;
-}
-
 bool to_lonlat(OGRCoordinateTransformation& ct, double x, double y, double& lon, double& lat) {
     int ok = 0;
     lon = x;
@@ -81,8 +63,8 @@ DemDescription describe_dem(const Dem& dem) {
     d.pixel_height_m = step_y;
     if (dem.crs_wkt.empty()) return d;
 
-    Transformer tr = make_lonlat_transformer(dem.crs_wkt);
-    if (tr.source) {
+    const LonLatTransform tr = make_lonlat_transform(dem.crs_wkt);
+    if (tr.geographic) {
         if (const char* name = tr.source->GetName()) d.crs_name = name;
         if (tr.source->IsProjected()) {
             const double unit = tr.source->GetLinearUnits();

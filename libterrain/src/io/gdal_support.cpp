@@ -6,6 +6,18 @@
 
 namespace terrain::io {
 
+LonLatTransform make_lonlat_transform(const std::string& crs) {
+    LonLatTransform t;
+    t.source = std::make_unique<OGRSpatialReference>();
+    if (t.source->SetFromUserInput(crs.c_str()) != OGRERR_NONE) return t;
+    t.source->SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+    t.geographic.reset(t.source->CloneGeogCS());
+    if (!t.geographic) return t;
+    t.geographic->SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+    t.to_lonlat.reset(OGRCreateCoordinateTransformation(t.source.get(), t.geographic.get()));
+    return t;
+}
+
 void ensure_gdal_registered() {
     static std::once_flag once;
     std::call_once(once, [] { GDALAllRegister(); });

@@ -2,10 +2,21 @@
 // Private helpers for the GDAL-facing code of libterrain (not installed).
 
 #include <cpl_error.h>
+#include <ogr_spatialref.h>
 
+#include <memory>
 #include <string>
 
 namespace terrain::io {
+
+// A CRS (any text SetFromUserInput takes) and the transformation from it to longitude and
+// latitude in degrees on the same body (its geographic base), lon first. `to_lonlat` is null
+// when the CRS cannot be read or transformed. Not thread-safe: one per thread.
+struct LonLatTransform {
+    std::unique_ptr<OGRSpatialReference> source, geographic;
+    std::unique_ptr<OGRCoordinateTransformation> to_lonlat;
+};
+LonLatTransform make_lonlat_transform(const std::string& crs);
 
 // GDALAllRegister once per process.
 void ensure_gdal_registered();

@@ -146,17 +146,10 @@ TriangleMesh read_mesh(const std::string& path, const ReadMeshOptions& options,
 
     TriangleMesh mesh;
     mesh.frame = MeshFrame::file;
-    // Re-centre on the bounding box for float precision.
-    std::array<double, 3> lo, hi;
-    lo.fill(std::numeric_limits<double>::infinity());
-    hi.fill(-std::numeric_limits<double>::infinity());
-    for (const auto& p : points)
-        for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], p[k]), hi[k] = std::max(hi[k], p[k]);
-    for (int k = 0; k < 3; ++k) mesh.origin[k] = 0.5 * (lo[k] + hi[k]);
-    mesh.positions.reserve(points.size());
-    for (const auto& p : points)
-        mesh.positions.push_back({float(p.x() - mesh.origin[0]), float(p.y() - mesh.origin[1]),
-                                  float(p.z() - mesh.origin[2])});
+    std::vector<std::array<double, 3>> xyz;
+    xyz.reserve(points.size());
+    for (const auto& p : points) xyz.push_back({p.x(), p.y(), p.z()});
+    set_positions(mesh, xyz);
     mesh.triangles.reserve(polygons.size());
     for (const auto& poly : polygons)
         mesh.triangles.push_back(

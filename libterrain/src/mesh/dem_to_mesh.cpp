@@ -13,6 +13,7 @@
 #include <memory>
 #include <numbers>
 
+#include "../io/gdal_support.hpp"
 #include "terrain/core/error.hpp"
 #include "terrain/io/describe_dem.hpp"
 
@@ -22,22 +23,11 @@ namespace {
 constexpr double kDegree = std::numbers::pi / 180.0;
 using Triangle = std::array<std::int32_t, 3>;
 
-struct LonLatTransform {
-    std::unique_ptr<OGRSpatialReference> source, geographic;
-    std::unique_ptr<OGRCoordinateTransformation> ct;
-};
-
-LonLatTransform make_lonlat(const std::string& wkt) {
-    LonLatTransform t;
-    t.source = std::make_unique<OGRSpatialReference>();
-    if (t.source->SetFromUserInput(wkt.c_str()) != OGRERR_NONE)
-        throw Error("mesh", "cannot read the DEM's CRS");
-    t.source->SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
-    t.geographic.reset(t.source->CloneGeogCS());
-    if (!t.geographic) throw Error("mesh", "the DEM's CRS has no geographic base");
-    t.geographic->SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
-    t.ct.reset(OGRCreateCoordinateTransformation(t.source.get(), t.geographic.get()));
-    if (!t.ct) throw Error("mesh", "cannot transform the DEM's CRS to longitude/latitude");
+// The shared transformation, or an error saying why there is none.
+io::LonLatTransform make_lonlat(const std::string& crs) {
+    auto t = io::make_lonlat_transform(crs);
+    if (!t.to_lonlat)
+        throw Error("mesh", "cannot transform the DEM's CRS to longitude/latitude on its body");
     return t;
 }
 
@@ -131,13 +121,13 @@ TriangleMesh dem_to_mesh(const Dem& dem, const DemToMeshOptions& options,
         tangent =
             std::make_unique<GeographicLib::LocalCartesian>(centre[1], centre[0], 0.0, *earth);
     }
-    tbb::enumerable_thread_specific<std::unique_ptr<LonLatTransform>> transforms;
+    tbb::enumerable_thread_specific<std::unique_ptr<io::LonLatTransform>> transforms;
     std::vector<std::uint8_t> failed(static_cast<std::size_t>(H), 0);
     tbb::parallel_for(tbb::blocked_range<int>(0, H, 8), [&](const tbb::blocked_range<int>& rows) {
-        LonLatTransform* tr = nullptr;
+        io::LonLatTransform* tr = nullptr;
         if (need_lonlat && !geographic_crs) {
             auto& local = transforms.local();
-            if (!local) local = std::make_unique<LonLatTransform>(make_lonlat(dem.crs_wkt));
+            if (!local) local = std::make_unique<io::LonLatTransform>(make_lonlat(dem.crs_wkt));
             tr = local.get();
         }
         std::vector<double> lon(W), lat(W);
@@ -148,7 +138,7 @@ TriangleMesh dem_to_mesh(const Dem& dem, const DemToMeshOptions& options,
                 lon[col] = xy[0];
                 lat[col] = xy[1];
             }
-            if (tr && !tr->ct->Transform(W, lon.data(), lat.data(), nullptr, ok.data()))
+            if (tr && !tr->to_lonlat->Transform(W, lon.data(), lat.data(), nullptr, ok.data()))
                 std::fill(ok.begin(), ok.end(), 0);
             for (int col = 0; col < W; ++col) {
                 const auto p = dem.index(col, row);
@@ -199,17 +189,7 @@ TriangleMesh dem_to_mesh(const Dem& dem, const DemToMeshOptions& options,
     }
     report_progress(progress, 0.4, "mesh");
 
-    // Re-centre on the bounding box's centre and keep floats.
-    std::array<double, 3> lo{}, hi{};
-    lo.fill(std::numeric_limits<double>::infinity());
-    hi.fill(-std::numeric_limits<double>::infinity());
-    for (const auto& p : xyz)
-        for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], p[k]), hi[k] = std::max(hi[k], p[k]);
-    for (int k = 0; k < 3; ++k) mesh.origin[k] = 0.5 * (lo[k] + hi[k]);
-    mesh.positions.resize(xyz.size());
-    for (std::size_t v = 0; v < xyz.size(); ++v)
-        for (int k = 0; k < 3; ++k)
-            mesh.positions[v][k] = static_cast<float>(xyz[v][k] - mesh.origin[k]);
+    set_positions(mesh, xyz);
     xyz = {};
 
     // Triangles, block by block. With rows growing southwards and columns eastwards (the

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 
 namespace terrain {
@@ -39,6 +40,19 @@ double triangle_area(const TriangleMesh& m, const std::array<std::int32_t, 3>& t
 }
 
 }  // namespace
+
+void set_positions(TriangleMesh& mesh, const std::vector<std::array<double, 3>>& points) {
+    std::array<double, 3> lo, hi;
+    lo.fill(std::numeric_limits<double>::infinity());
+    hi.fill(-std::numeric_limits<double>::infinity());
+    for (const auto& p : points)
+        for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], p[k]), hi[k] = std::max(hi[k], p[k]);
+    for (int k = 0; k < 3; ++k) mesh.origin[k] = points.empty() ? 0.0 : 0.5 * (lo[k] + hi[k]);
+    mesh.positions.resize(points.size());
+    for (std::size_t v = 0; v < points.size(); ++v)
+        for (int k = 0; k < 3; ++k)
+            mesh.positions[v][k] = static_cast<float>(points[v][k] - mesh.origin[k]);
+}
 
 void finish_mesh(TriangleMesh& mesh) {
     const std::size_t n = mesh.positions.size();

@@ -70,6 +70,10 @@ struct MeshTopology {
     std::int64_t euler_characteristic = 0;  // V - E + F
 };
 
+// Sets origin to the centre of the points' bounding box and positions to the points
+// relative to it, as floats.
+void set_positions(TriangleMesh& mesh, const std::vector<std::array<double, 3>>& points);
+
 // Fills vertex_areas and the CSR adjacency from positions and triangles.
 void finish_mesh(TriangleMesh& mesh);
 
