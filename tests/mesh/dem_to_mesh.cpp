@@ -1,4 +1,6 @@
 #include <tbb/global_control.h>
+#include <GeographicLib/LocalCartesian.hpp>
+#include <GeographicLib/UTMUPS.hpp>
 #include <catch2/catch.hpp>
 
 #include <algorithm>
@@ -278,4 +280,73 @@ TEST_CASE("dem_to_mesh: frames and refusals", "[mesh]") {
     CHECK(mesh_topology(flat).euler_characteristic == 1);
     const Dem nothing = grid_dem(3, 3, 1.0, [](int c, int r) { return c == r ? 1.0 : kNaN; });
     CHECK_THROWS_AS(mesh::dem_to_mesh(nothing), Error);
+}
+
+TEST_CASE("dem_to_mesh: the same hill on a lon/lat grid and on a UTM grid has the same shape",
+          "[mesh]") {
+    // A Gaussian hill (300 m high, sigma 600 m) at 45 N 9 E, sampled on a 0.001 degree
+    // lon/lat grid and on a 75 m UTM 32N grid. Both meshes must show the same hill: the same
+    // height above their flat surroundings and the same extra area the relief adds.
+    const double lon0 = 9.0, lat0 = 45.0, sigma = 600, top = 300;
+    const GeographicLib::LocalCartesian local(lat0, lon0, 0);
+    auto hill = [&](double east, double north) {
+        return top * std::exp(-(east * east + north * north) / (2 * sigma * sigma));
+    };
+    Dem lonlat;
+    lonlat.width = 50;
+    lonlat.height = 36;
+    lonlat.crs_wkt = "EPSG:4326";
+    lonlat.body = body_from_crs(lonlat.crs_wkt);
+    lonlat.transform = {lon0 - 0.025, 0.001, 0, lat0 + 0.018, 0, -0.001};
+    lonlat.has_transform = true;
+    for (int r = 0; r < lonlat.height; ++r)
+        for (int c = 0; c < lonlat.width; ++c) {
+            const auto p = lonlat.map_xy(c + 0.5, r + 0.5);
+            double e, n, u;
+            local.Forward(p[1], p[0], 0, e, n, u);
+            lonlat.values.push_back(hill(e, n));
+        }
+    // The UTM grid centred on the same point (UTM 32N easting/northing of 9 E 45 N).
+    int zone;
+    bool northp;
+    double x0, y0;
+    GeographicLib::UTMUPS::Forward(lat0, lon0, zone, northp, x0, y0, 32);
+    Dem utm;
+    utm.width = utm.height = 52;
+    utm.crs_wkt = "EPSG:32632";
+    utm.body = body_from_crs(utm.crs_wkt);
+    utm.transform = {x0 - 26 * 75.0, 75, 0, y0 + 26 * 75.0, 0, -75};
+    utm.has_transform = true;
+    for (int r = 0; r < utm.height; ++r)
+        for (int c = 0; c < utm.width; ++c) {
+            const auto p = utm.map_xy(c + 0.5, r + 0.5);
+            double lat, lon;
+            GeographicLib::UTMUPS::Reverse(32, true, p[0], p[1], lat, lon);
+            double e, n, u;
+            local.Forward(lat, lon, 0, e, n, u);
+            utm.values.push_back(hill(e, n));
+        }
+    auto relief = [](const TriangleMesh& m) {
+        // Extra area over the flat footprint, and the top's height above the lowest vertex.
+        double area = 0, flat = 0, lo = 1e300, hi = -1e300;
+        for (const auto& t : m.triangles) {
+            const auto a = m.position(t[0]), b = m.position(t[1]), c = m.position(t[2]);
+            const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+            const double v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+            const double nx = u[1] * v[2] - u[2] * v[1], ny = u[2] * v[0] - u[0] * v[2],
+                         nz = u[0] * v[1] - u[1] * v[0];
+            area += 0.5 * std::sqrt(nx * nx + ny * ny + nz * nz);
+            flat += 0.5 * std::abs(nz);
+        }
+        for (std::size_t v = 0; v < m.vertex_count(); ++v)
+            lo = std::min(lo, m.position(v)[2]), hi = std::max(hi, m.position(v)[2]);
+        return std::pair{area - flat, hi - lo};
+    };
+    mesh::DemToMeshOptions tangent_plane;
+    tangent_plane.frame = MeshFrame::map;
+    const auto a = relief(mesh::dem_to_mesh(lonlat, tangent_plane));
+    const auto b = relief(mesh::dem_to_mesh(utm));  // map frame: UTM metres
+    CHECK(a.second == Approx(b.second).epsilon(0.005));
+    CHECK(a.first == Approx(b.first).epsilon(0.005));
+    CHECK(a.first > 0.02 * 2 * std::numbers::pi * sigma * sigma);  // the hill adds real area
 }
