@@ -15,14 +15,16 @@ void check_output_path(const std::string& path, bool overwrite) {
     const fs::path p(path);
     std::error_code ec;
     if (fs::exists(p, ec) && !overwrite)
-        throw Error("write", "'" + path + "' exists; pass --overwrite to replace it");
+        throw Error("write", "'" + path + "' already exists; pass --overwrite to replace it");
     if (fs::is_directory(p, ec))
         throw Error("write", "'" + path + "' is a directory; give a file name");
     const fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
     if (!fs::is_directory(dir, ec))
-        throw Error("write", "directory '" + dir.string() + "' does not exist; create it first");
+        throw Error("write", "cannot write '" + path + "': '" + dir.string() + "' " +
+                                 (fs::exists(dir, ec) ? "is not a directory" : "does not exist") +
+                                 "; create the directory first");
     if (::access(dir.c_str(), W_OK) != 0)
-        throw Error("write", "directory '" + dir.string() + "' is not writable");
+        throw Error("write", "cannot create files in '" + dir.string() + "': it is not writable");
 }
 
 AtomicOutput::AtomicOutput(std::string path, bool overwrite) : path_(std::move(path)) {

@@ -17,6 +17,7 @@
 #include "gdal_support.hpp"
 #include "terrain/core/error.hpp"
 #include "terrain/core/version.hpp"
+#include "terrain/io/output_file.hpp"
 
 namespace terrain::io {
 namespace {
@@ -200,14 +201,6 @@ void write_file(const fs::path& path, const void* data, std::size_t size) {
 }
 
 // Removes the temporary files unless released.
-struct TemporaryFiles {
-    std::vector<fs::path> paths;
-    ~TemporaryFiles() {
-        std::error_code ec;
-        for (const auto& p : paths) fs::remove(p, ec);
-    }
-};
-
 }  // namespace
 
 std::string pds3_image_path(const std::string& label_path) {
@@ -363,34 +356,15 @@ void write_pds3_dem(const Dem& dem, const std::string& label_path, const Pds3Dem
     l.line();
     l.line("END");
 
-    // Files: the directory must exist; existing files only with overwrite.
+    // Both files under temporary names (existing ones only with overwrite), then the image
+    // first, so that a label never points at a missing or older image.
+    AtomicOutput image_out(image.string(), options.overwrite);
+    AtomicOutput label_out(label.string(), options.overwrite);
+    write_file(image_out.temp_path(), bytes.data(), bytes.size());
+    write_file(label_out.temp_path(), l.str().data(), l.str().size());
+    image_out.commit();
+    label_out.commit();
     std::error_code ec;
-    const fs::path directory = label.has_parent_path() ? label.parent_path() : fs::path(".");
-    if (!fs::is_directory(directory, ec))
-        fail("cannot write '" + label_path + "': '" + directory.string() + "' " +
-             (fs::exists(directory, ec) ? "is not a directory" : "does not exist") +
-             "; create the directory first");
-    const auto refuse_existing = [&] {
-        if (options.overwrite) return;
-        for (const auto& path : {label, image})
-            if (fs::exists(path, ec))
-                fail("'" + path.string() +
-                     "' already exists; remove it or allow overwriting (--overwrite)");
-    };
-    refuse_existing();
-    TemporaryFiles temporary;
-    const fs::path image_tmp = image.string() + ".partial";
-    const fs::path label_tmp = label.string() + ".partial";
-    temporary.paths = {image_tmp, label_tmp};
-    write_file(image_tmp, bytes.data(), bytes.size());
-    write_file(label_tmp, l.str().data(), l.str().size());
-    refuse_existing();
-    // The image first, so that a label never points at a missing or older image.
-    for (const auto& [from, to] : {std::pair{image_tmp, image}, std::pair{label_tmp, label}}) {
-        fs::rename(from, to, ec);
-        if (ec)
-            fail("cannot rename '" + from.string() + "' to '" + to.string() + "': " + ec.message());
-    }
     // A GDAL side-car of an earlier product would override what was just written.
     if (options.overwrite) fs::remove(label.string() + ".aux.xml", ec);
 }
