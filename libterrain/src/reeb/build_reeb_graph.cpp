@@ -244,6 +244,336 @@ inline std::uint32_t float_key(float f) {
     return (u & 0x80000000u) ? ~u : (u | 0x80000000u);
 }
 
+// Sorts the vertices into events (nodes) in increasing value: adjacent vertices with equal
+// values form one event; other ties go by the plateau's lowest vertex, then by vertex. Fills
+// the graph's node_vertex_offsets, node_vertices and vertex_nodes.
+void order_events(const TriangleMesh& mesh, const std::vector<float>& field, ReebGraph& g) {
+    const std::size_t nv = field.size();
+    std::vector<i32> rep(nv);
+    std::iota(rep.begin(), rep.end(), 0);
+    bool any_plateau = false;
+    auto root = [&](i32 x) {
+        while (rep[z(x)] != x) x = rep[z(x)] = rep[z(rep[z(x)])];
+        return x;
+    };
+    for (std::size_t v = 0; v < nv; ++v)
+        for (auto i = mesh.neighbor_offsets[v]; i < mesh.neighbor_offsets[v + 1]; ++i) {
+            const i32 w = mesh.neighbors[z(i)];
+            if (z(w) > v && field[z(w)] == field[v]) {
+                const i32 a = root(static_cast<i32>(v)), b = root(w);
+                if (a != b) rep[z(std::max(a, b))] = std::min(a, b);
+                any_plateau = true;
+            }
+        }
+    if (any_plateau)
+        for (std::size_t v = 0; v < nv; ++v) rep[v] = root(static_cast<i32>(v));
+
+    // Stable LSD radix sort on (value bits, plateau), 16 bits per pass; ties keep vertex order.
+    struct Key {
+        std::uint64_t key;
+        i32 vertex;
+    };
+    std::vector<Key> keys(nv), tmp(nv);
+    for (std::size_t v = 0; v < nv; ++v)
+        keys[v] = {(std::uint64_t{float_key(field[v])} << 32) | static_cast<std::uint32_t>(rep[v]),
+                   static_cast<i32>(v)};
+    std::vector<std::uint32_t> count(65537);
+    for (int shift = 0; shift < 64; shift += 16) {
+        std::fill(count.begin(), count.end(), 0u);
+        for (const Key& k : keys) ++count[((k.key >> shift) & 0xffffu) + 1];
+        if (count[((keys.empty() ? 0 : keys[0].key >> shift) & 0xffffu) + 1] == nv) continue;
+        for (std::size_t i = 1; i < count.size(); ++i) count[i] += count[i - 1];
+        for (const Key& k : keys) tmp[count[(k.key >> shift) & 0xffffu]++] = k;
+        keys.swap(tmp);
+    }
+    g.node_vertices.resize(nv);
+    g.vertex_nodes.resize(nv);
+    g.node_vertex_offsets.clear();
+    g.node_vertex_offsets.reserve(nv + 1);
+    for (std::size_t i = 0; i < nv; ++i) {
+        if (i == 0 || keys[i].key != keys[i - 1].key)
+            g.node_vertex_offsets.push_back(static_cast<i32>(i));
+        g.node_vertices[i] = keys[i].vertex;
+        g.vertex_nodes[z(keys[i].vertex)] = static_cast<i32>(g.node_vertex_offsets.size() - 1);
+    }
+    g.node_vertex_offsets.push_back(static_cast<i32>(nv));
+    g.node_vertex_offsets.shrink_to_fit();
+    const std::size_t n_nodes = g.node_vertex_offsets.size() - 1;
+    g.node_values.resize(n_nodes);
+    for (std::size_t e = 0; e < n_nodes; ++e)
+        g.node_values[e] = field[z(g.node_vertices[z(g.node_vertex_offsets[e])])];
+}
+
+// True when the Reeb graph of any field on the mesh is a tree: every connected component is
+// of genus 0 with at most one boundary loop (a disk or a sphere).
+bool loop_free(const TriangleMesh& mesh) {
+    const std::size_t nv = mesh.vertex_count();
+    std::vector<i32> comp(nv);
+    std::iota(comp.begin(), comp.end(), 0);
+    auto root = [&](std::vector<i32>& p, i32 x) {
+        while (p[z(x)] != x) x = p[z(x)] = p[z(p[z(x)])];
+        return x;
+    };
+    for (const auto& t : mesh.triangles)
+        for (int k = 0; k < 2; ++k) {
+            const i32 a = root(comp, t[z(k)]), b = root(comp, t[z(k + 1)]);
+            if (a != b) comp[z(std::max(a, b))] = std::min(a, b);
+        }
+    // Per component: 2 - chi - b = 2 g must be 0, and b <= 1.
+    const auto& off = mesh.neighbor_offsets;
+    const auto& nb = mesh.neighbors;
+    std::vector<std::uint8_t> uses(nb.size(), 0);
+    for (const auto& t : mesh.triangles)
+        for (int k = 0; k < 3; ++k) {
+            const i32 a = std::min(t[z(k)], t[z((k + 1) % 3)]),
+                      b = std::max(t[z(k)], t[z((k + 1) % 3)]);
+            const auto first = nb.begin() + off[z(a)], last = nb.begin() + off[z(a) + 1];
+            const auto it = std::lower_bound(first, last, b);
+            if (it != last && *it == b && uses[z(static_cast<i32>(it - nb.begin()))] < 2)
+                ++uses[z(static_cast<i32>(it - nb.begin()))];
+        }
+    std::vector<i32> bparent(nv);
+    std::iota(bparent.begin(), bparent.end(), 0);
+    std::vector<std::int64_t> chi(nv, 0);
+    std::vector<char> on_boundary(nv, 0);
+    for (std::size_t v = 0; v < nv; ++v) {
+        const i32 c = root(comp, static_cast<i32>(v));
+        chi[z(c)] += 1;
+        for (i32 i = off[v]; i < off[v + 1]; ++i) {
+            const i32 w = nb[z(i)];
+            if (z(w) <= v) continue;
+            chi[z(c)] -= 1;
+            if (uses[z(i)] == 1) {
+                on_boundary[v] = on_boundary[z(w)] = 1;
+                const i32 a = root(bparent, static_cast<i32>(v)), b = root(bparent, w);
+                if (a != b) bparent[z(std::max(a, b))] = std::min(a, b);
+            }
+        }
+    }
+    for (const auto& t : mesh.triangles) chi[z(root(comp, t[0]))] += 1;
+    std::vector<std::int64_t> loops(nv, 0);
+    for (std::size_t v = 0; v < nv; ++v)
+        if (on_boundary[v] && root(bparent, static_cast<i32>(v)) == static_cast<i32>(v))
+            ++loops[z(root(comp, static_cast<i32>(v)))];
+    for (std::size_t v = 0; v < nv; ++v)
+        if (comp[v] == static_cast<i32>(v) && (loops[v] > 1 || 2 - chi[v] - loops[v] != 0))
+            return false;
+    return true;
+}
+
+// Numbers of connected components of each critical node's lower and upper links (the link
+// graph: the vertices around the node and the star's edges between them).
+void classify_links(const TriangleMesh& mesh, ReebGraph& g) {
+    const std::size_t nv = mesh.vertex_count();
+    std::vector<i32> tri_off(nv + 1, 0), tris(mesh.triangle_count() * 3);
+    for (const auto& t : mesh.triangles)
+        for (const i32 c : t) ++tri_off[z(c) + 1];
+    std::partial_sum(tri_off.begin(), tri_off.end(), tri_off.begin());
+    {
+        std::vector<i32> fill(tri_off.begin(), tri_off.end() - 1);
+        for (std::size_t t = 0; t < mesh.triangle_count(); ++t)
+            for (const i32 c : mesh.triangles[t]) tris[z(fill[z(c)]++)] = static_cast<i32>(t);
+    }
+    std::vector<i32> verts, parent;
+    for (std::size_t n = 0; n < g.node_count(); ++n) {
+        if (g.node_kinds[n] == NodeKind::regular) {
+            g.node_lower_links[n] = g.node_upper_links[n] = 1;
+            continue;
+        }
+        const i32 e = static_cast<i32>(n);
+        verts.clear();
+        for (i32 i = g.node_vertex_offsets[n]; i < g.node_vertex_offsets[n + 1]; ++i) {
+            const i32 v = g.node_vertices[z(i)];
+            for (i32 k = mesh.neighbor_offsets[z(v)]; k < mesh.neighbor_offsets[z(v) + 1]; ++k)
+                if (g.vertex_nodes[z(mesh.neighbors[z(k)])] != e)
+                    verts.push_back(mesh.neighbors[z(k)]);
+        }
+        if (g.node_vertex_offsets[n + 1] - g.node_vertex_offsets[n] > 1) {  // CSR lists are sorted
+            std::sort(verts.begin(), verts.end());
+            verts.erase(std::unique(verts.begin(), verts.end()), verts.end());
+        }
+        parent.resize(verts.size());
+        std::iota(parent.begin(), parent.end(), 0);
+        auto index = [&](i32 v) {
+            if (verts.size() <= 16) {
+                i32 i = 0;
+                while (verts[z(i)] != v) ++i;
+                return i;
+            }
+            return static_cast<i32>(std::lower_bound(verts.begin(), verts.end(), v) -
+                                    verts.begin());
+        };
+        auto find = [&](i32 x) {
+            while (parent[z(x)] != x) x = parent[z(x)] = parent[z(parent[z(x)])];
+            return x;
+        };
+        for (i32 i = g.node_vertex_offsets[n]; i < g.node_vertex_offsets[n + 1]; ++i) {
+            const i32 v = g.node_vertices[z(i)];
+            for (i32 k = tri_off[z(v)]; k < tri_off[z(v) + 1]; ++k) {
+                const auto& t = mesh.triangles[z(tris[z(k)])];
+                // Only the edge opposite v can join two link vertices.
+                const int j = t[0] == v ? 1 : t[1] == v ? 2 : 0;
+                {
+                    const i32 a = t[z(j)], b = t[z((j + 1) % 3)];
+                    const i32 na = g.vertex_nodes[z(a)], nb = g.vertex_nodes[z(b)];
+                    if (na == e || nb == e || (na < e) != (nb < e)) continue;
+                    const i32 ra = find(index(a)), rb = find(index(b));
+                    if (ra != rb) parent[z(ra)] = rb;
+                }
+            }
+        }
+        int lower = 0, upper = 0;
+        for (std::size_t i = 0; i < verts.size(); ++i)
+            if (find(static_cast<i32>(i)) == static_cast<i32>(i))
+                ++(g.vertex_nodes[z(verts[i])] < e ? lower : upper);
+        g.node_lower_links[n] = static_cast<std::uint8_t>(std::min(lower, 255));
+        g.node_upper_links[n] = static_cast<std::uint8_t>(std::min(upper, 255));
+    }
+}
+
+// The contour tree of a loop-free mesh (Carr, Snoeyink & Axen): join and split trees by
+// union-find sweeps over the events, merged leaf by leaf into the augmented contour tree,
+// whose chains of regular nodes become the arcs.
+void contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& progress) {
+    const std::size_t nn = g.node_count();
+    std::vector<i32> uf(nn), head(nn), jp(nn, kNone), sp(nn, kNone), jc(nn, 0), sc(nn, 0),
+        mark(nn, kNone);
+    std::vector<std::uint8_t> rank(nn);
+    auto find = [&](i32 x) {
+        i32 r = x;
+        while (uf[z(r)] != r) r = uf[z(r)];
+        while (uf[z(x)] != r) {
+            const i32 nx = uf[z(x)];
+            uf[z(x)] = r;
+            x = nx;
+        }
+        return r;
+    };
+    // Union by rank; head[root] is the last event added to the component.
+    auto sweep = [&](bool ascending, std::vector<i32>& parent, std::vector<i32>& children) {
+        std::iota(uf.begin(), uf.end(), 0);
+        std::iota(head.begin(), head.end(), 0);
+        std::fill(rank.begin(), rank.end(), 0);
+        std::fill(mark.begin(), mark.end(), kNone);
+        for (std::size_t k = 0; k < nn; ++k) {
+            const i32 e = static_cast<i32>(ascending ? k : nn - 1 - k);
+            i32 cur = e;
+            mark[z(e)] = e;
+            for (i32 i = g.node_vertex_offsets[z(e)]; i < g.node_vertex_offsets[z(e) + 1]; ++i) {
+                const i32 v = g.node_vertices[z(i)];
+                for (i32 j = mesh.neighbor_offsets[z(v)]; j < mesh.neighbor_offsets[z(v) + 1];
+                     ++j) {
+                    const i32 n = g.vertex_nodes[z(mesh.neighbors[z(j)])];
+                    if (ascending ? n >= e : n <= e) continue;
+                    const i32 c = find(n);
+                    if (mark[z(c)] == e) continue;
+                    parent[z(head[z(c)])] = e;
+                    ++children[z(e)];
+                    i32 r = cur, o = c;
+                    if (rank[z(r)] < rank[z(o)]) std::swap(r, o);
+                    if (rank[z(r)] == rank[z(o)]) ++rank[z(r)];
+                    uf[z(o)] = r;
+                    mark[z(r)] = e;
+                    head[z(r)] = e;
+                    cur = r;
+                }
+            }
+        }
+    };
+    sweep(true, jp, jc);
+    report_progress(progress, 0.45, "reeb: join tree");
+    sweep(false, sp, sc);
+    report_progress(progress, 0.6, "reeb: split tree");
+
+    // Merge: remove leaves one by one; each removal is one edge of the augmented tree.
+    std::vector<char> dead(nn, 0);
+    auto next_alive = [&](std::vector<i32>& parent, i32 x) {
+        i32 p = parent[z(x)];
+        while (p != kNone && dead[z(p)]) p = parent[z(p)];
+        for (i32 q = parent[z(x)]; q != p;) {
+            const i32 nx = parent[z(q)];
+            parent[z(q)] = p;
+            q = nx;
+        }
+        parent[z(x)] = p;
+        return p;
+    };
+    auto is_leaf = [&](i32 x) {
+        return (jc[z(x)] == 0 && sc[z(x)] == 1) || (sc[z(x)] == 0 && jc[z(x)] == 1);
+    };
+    std::vector<i32> queue, attach(nn, kNone), up_deg(nn, 0), down_deg(nn, 0);
+    std::vector<char> goes_up(nn, 0);
+    queue.reserve(nn);
+    for (std::size_t n = 0; n < nn; ++n)
+        if (is_leaf(static_cast<i32>(n))) queue.push_back(static_cast<i32>(n));
+    for (std::size_t qi = 0; qi < queue.size(); ++qi) {
+        const i32 x = queue[qi];
+        if (dead[z(x)] || !is_leaf(x)) continue;
+        const bool lower = jc[z(x)] == 0;
+        const i32 y = next_alive(lower ? jp : sp, x);
+        if (y == kNone) throw Error("reeb", "internal error: contour tree leaf without parent");
+        dead[z(x)] = 1;
+        attach[z(x)] = y;
+        goes_up[z(x)] = lower;
+        if (lower) {
+            --jc[z(y)];
+            ++up_deg[z(x)];
+            ++down_deg[z(y)];
+        } else {
+            --sc[z(y)];
+            ++down_deg[z(x)];
+            ++up_deg[z(y)];
+        }
+        if (is_leaf(y)) queue.push_back(y);
+    }
+    report_progress(progress, 0.75, "reeb: contour tree");
+
+    // Up-edges per node (CSR), then arcs from every critical node upwards.
+    std::vector<i32> up_off(nn + 1, 0), up_to(nn);
+    for (std::size_t x = 0; x < nn; ++x)
+        if (attach[x] != kNone) ++up_off[z(goes_up[x] ? static_cast<i32>(x) : attach[x]) + 1];
+    std::partial_sum(up_off.begin(), up_off.end(), up_off.begin());
+    {
+        std::vector<i32> fill(up_off.begin(), up_off.end() - 1);
+        for (std::size_t x = 0; x < nn; ++x) {
+            if (attach[x] == kNone) continue;
+            const i32 lo = goes_up[x] ? static_cast<i32>(x) : attach[x];
+            const i32 hi = goes_up[x] ? attach[x] : static_cast<i32>(x);
+            up_to[z(fill[z(lo)]++)] = hi;
+        }
+    }
+    g.node_kinds.assign(nn, NodeKind::regular);
+    g.node_arcs.assign(nn, kNone);
+    for (std::size_t n = 0; n < nn; ++n) {
+        const int d = down_deg[n], u = up_deg[n];
+        if (d == 1 && u == 1) continue;
+        g.node_kinds[n] = d == 0   ? NodeKind::minimum
+                          : u == 0 ? NodeKind::maximum
+                                   : NodeKind::saddle;
+    }
+    g.arcs.clear();
+    g.arc_offsets.assign(1, 0);
+    g.arc_nodes.clear();
+    g.arc_nodes.reserve(nn);
+    for (std::size_t c = 0; c < nn; ++c) {
+        if (g.node_kinds[c] == NodeKind::regular) continue;
+        for (i32 k = up_off[c]; k < up_off[c + 1]; ++k) {
+            const i32 arc = static_cast<i32>(g.arcs.size());
+            i32 n = up_to[z(k)];
+            while (g.node_kinds[z(n)] == NodeKind::regular) {
+                g.arc_nodes.push_back(n);
+                g.node_arcs[z(n)] = arc;
+                n = up_to[z(up_off[z(n)])];
+            }
+            g.arcs.push_back({static_cast<i32>(c), n});
+            g.arc_offsets.push_back(static_cast<i32>(g.arc_nodes.size()));
+        }
+    }
+    g.node_lower_links.assign(nn, 1);
+    g.node_upper_links.assign(nn, 1);
+    classify_links(mesh, g);
+}
+
 class Sweep {
   public:
     Sweep(const TriangleMesh& mesh, const std::vector<float>& field, ReebGraph& g)
@@ -271,7 +601,6 @@ class Sweep {
         bool complete;      // the piece to its destination was walked to the end
     };
 
-    void order_events();
     void process_event(i32 e, i32 begin, i32 end);
     bool try_regular(i32 e, i32 v);
     void general_event(i32 e, i32 begin, i32 end);
@@ -335,59 +664,12 @@ class Sweep {
     std::vector<i32> link_vertices_, link_parent_;
 };
 
-void Sweep::order_events() {
-    const std::size_t nv = field_.size();
-    // Plateaus: union-find over edges joining equal values; each keeps its lowest vertex.
-    std::vector<i32> rep(nv);
-    std::iota(rep.begin(), rep.end(), 0);
-    bool any_plateau = false;
-    auto root = [&](i32 x) {
-        while (rep[z(x)] != x) x = rep[z(x)] = rep[z(rep[z(x)])];
-        return x;
-    };
-    for (std::size_t v = 0; v < nv; ++v)
-        for (auto i = mesh_.neighbor_offsets[v]; i < mesh_.neighbor_offsets[v + 1]; ++i) {
-            const i32 w = mesh_.neighbors[z(i)];
-            if (z(w) > v && field_[z(w)] == field_[v]) {
-                const i32 a = root(static_cast<i32>(v)), b = root(w);
-                if (a != b) rep[z(std::max(a, b))] = std::min(a, b);
-                any_plateau = true;
-            }
-        }
-    if (any_plateau)
-        for (std::size_t v = 0; v < nv; ++v) rep[v] = root(static_cast<i32>(v));
-
-    struct Key {
-        std::uint64_t key;
-        i32 vertex;
-    };
-    std::vector<Key> keys(nv);
-    for (std::size_t v = 0; v < nv; ++v)
-        keys[v] = {(std::uint64_t{float_key(field_[v])} << 32) | static_cast<std::uint32_t>(rep[v]),
-                   static_cast<i32>(v)};
-    std::sort(keys.begin(), keys.end(), [](const Key& a, const Key& b) {
-        return a.key != b.key ? a.key < b.key : a.vertex < b.vertex;
-    });
-    g_.node_vertices.resize(nv);
-    g_.vertex_nodes.resize(nv);
-    g_.node_vertex_offsets.clear();
-    g_.node_vertex_offsets.reserve(nv + 1);
-    for (std::size_t i = 0; i < nv; ++i) {
-        if (i == 0 || keys[i].key != keys[i - 1].key)
-            g_.node_vertex_offsets.push_back(static_cast<i32>(i));
-        g_.node_vertices[i] = keys[i].vertex;
-        g_.vertex_nodes[z(keys[i].vertex)] = static_cast<i32>(g_.node_vertex_offsets.size() - 1);
-    }
-    g_.node_vertex_offsets.push_back(static_cast<i32>(nv));
-}
-
 void Sweep::run(const ProgressFn& progress) {
     topo_ = build_topology(mesh_);
     report_progress(progress, 0.1, "reeb: topology");
-    order_events();
+    order_events(mesh_, field_, g_);
     report_progress(progress, 0.3, "reeb: order");
     const std::size_t n_nodes = g_.node_vertex_offsets.size() - 1;
-    g_.node_values.resize(n_nodes);
     g_.node_kinds.assign(n_nodes, NodeKind::regular);
     g_.node_lower_links.assign(n_nodes, 0);
     g_.node_upper_links.assign(n_nodes, 0);
@@ -399,7 +681,6 @@ void Sweep::run(const ProgressFn& progress) {
     const std::size_t step = std::max<std::size_t>(n_nodes / 50, 1);
     for (std::size_t e = 0; e < n_nodes; ++e) {
         const i32 b = g_.node_vertex_offsets[e], en = g_.node_vertex_offsets[e + 1];
-        g_.node_values[e] = field_[z(g_.node_vertices[z(b)])];
         process_event(static_cast<i32>(e), b, en);
         if (e % step == 0)
             report_progress(progress, 0.3 + 0.65 * static_cast<double>(e) / n_nodes, "reeb");
@@ -813,8 +1094,12 @@ void Sweep::finish_graph() {
 
 }  // namespace
 
+bool reeb_is_tree(const TriangleMesh& mesh) {
+    return loop_free(mesh);
+}
+
 ReebGraph build_reeb_graph(const TriangleMesh& mesh, const std::vector<float>& field,
-                           const ProgressFn& progress) {
+                           const ReebOptions& options, const ProgressFn& progress) {
     if (field.size() != mesh.vertex_count())
         throw Error("reeb", "the field has " + std::to_string(field.size()) +
                                 " values for a mesh of " + std::to_string(mesh.vertex_count()) +
@@ -825,7 +1110,19 @@ ReebGraph build_reeb_graph(const TriangleMesh& mesh, const std::vector<float>& f
     if (mesh.vertex_count() >= static_cast<std::size_t>(INT32_MAX / 4))
         throw Error("reeb", "the mesh is too large (more than 500 million vertices)");
     ReebGraph g;
-    Sweep(mesh, field, g).run(progress);
+    const bool tree = options.algorithm != ReebAlgorithm::sweep && loop_free(mesh);
+    if (options.algorithm == ReebAlgorithm::contour_tree && !tree)
+        throw Error("reeb",
+                    "the contour-tree algorithm needs a mesh whose components are disks "
+                    "or spheres; this one has handles or holes");
+    if (tree) {
+        order_events(mesh, field, g);
+        report_progress(progress, 0.3, "reeb: order");
+        contour_tree(mesh, g, progress);
+        report_progress(progress, 1.0, "reeb");
+    } else {
+        Sweep(mesh, field, g).run(progress);
+    }
     return g;
 }
 

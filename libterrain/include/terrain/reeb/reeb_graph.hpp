@@ -99,11 +99,26 @@ struct NodeArcs {
 };
 NodeArcs node_arcs(const ReebGraph& graph);
 
-// The Reeb graph of `field` (one value per mesh vertex, no NaN) on a 2-manifold mesh.
-// Deterministic: ties between equal values that are not adjacent are broken by vertex index.
-// Throws terrain::Error when the field has the wrong size or NaN values.
+enum class ReebAlgorithm {
+    automatic,     // contour tree when every component is a disk or a sphere, else sweep
+    sweep,         // contour tracking: any genus, any number of holes
+    contour_tree,  // join and split trees merged: only for disks and spheres (no loops)
+};
+
+struct ReebOptions {
+    ReebAlgorithm algorithm = ReebAlgorithm::automatic;
+};
+
+// True when every connected component of the mesh is a disk or a sphere, so that the Reeb
+// graph of any field on it is a tree.
+bool reeb_is_tree(const TriangleMesh& mesh);
+
+// The Reeb graph of `field` (one value per mesh vertex, no NaN) on a 2-manifold mesh. Both
+// algorithms give the same graph. Deterministic: ties between equal values that are not
+// adjacent are broken by vertex index. Throws terrain::Error when the field has the wrong size
+// or NaN values, or when the contour tree is asked for on a mesh with loops.
 ReebGraph build_reeb_graph(const TriangleMesh& mesh, const std::vector<float>& field,
-                           const ProgressFn& progress = {});
+                           const ReebOptions& options = {}, const ProgressFn& progress = {});
 
 // Checks the graph's invariants against its mesh and field: every vertex in exactly one node,
 // node values equal their vertices' values, arcs go upwards with sorted regular nodes, node
