@@ -236,3 +236,46 @@ TEST_CASE("Reeb graph input errors", "[reeb]") {
     CHECK(g.node_count() == 1);
     CHECK(g.arc_count() == 0);
 }
+
+TEST_CASE("The contour tree and the sweep give the same graph on disks and spheres", "[reeb]") {
+    const auto dem = io::read_dem(test::sample("vesta_hamo_tile.lbl"));
+    const auto disk = mesh::dem_to_mesh(dem);
+    const auto globe_dem = io::read_dem(test::sample("moon_ldem1_global.tif"));
+    const auto sphere = mesh::dem_to_mesh(globe_dem);
+    const auto holed = mesh::dem_to_mesh(test::grid_dem(20, 20, [](int c, int r) {
+        return (c > 8 && c < 12 && r > 8 && r < 12) ? std::nan("") : double(c + r);
+    }));
+    CHECK(reeb::reeb_is_tree(disk));
+    CHECK(reeb::reeb_is_tree(sphere));
+    CHECK_FALSE(reeb::reeb_is_tree(holed));
+    CHECK_FALSE(reeb::reeb_is_tree(test::torus_mesh(3, 1, 12, 8, true)));
+    CHECK_THROWS_WITH(reeb::build_reeb_graph(holed, test::noise_field(holed.vertex_count(), 1),
+                                             {reeb::ReebAlgorithm::contour_tree}),
+                      Catch::Contains("disks or spheres"));
+    const std::vector<std::pair<const TriangleMesh*, std::vector<float>>> cases = {
+        {&disk, field::shape_index_field(disk)},
+        {&disk, field::height_field(disk, &dem)},
+        {&sphere, field::shape_index_field(sphere)},
+        {&sphere, test::noise_field(sphere.vertex_count(), 5)},
+    };
+    for (const auto& [mesh, f] : cases) {
+        const auto a = reeb::build_reeb_graph(*mesh, f, {reeb::ReebAlgorithm::sweep});
+        const auto b = reeb::build_reeb_graph(*mesh, f, {reeb::ReebAlgorithm::contour_tree});
+        REQUIRE(reeb::check_reeb_graph(b, f).empty());
+        CHECK(a.node_vertices == b.node_vertices);
+        CHECK(a.node_kinds == b.node_kinds);
+        CHECK(a.node_lower_links == b.node_lower_links);
+        CHECK(a.node_upper_links == b.node_upper_links);
+        auto arcs = [](const reeb::ReebGraph& g) {
+            std::set<std::vector<std::int32_t>> out;
+            for (std::size_t k = 0; k < g.arc_count(); ++k) {
+                std::vector<std::int32_t> arc{g.arcs[k][0], g.arcs[k][1]};
+                arc.insert(arc.end(), g.arc_nodes.begin() + g.arc_offsets[k],
+                           g.arc_nodes.begin() + g.arc_offsets[k + 1]);
+                out.insert(arc);
+            }
+            return out;
+        };
+        CHECK(arcs(a) == arcs(b));
+    }
+}

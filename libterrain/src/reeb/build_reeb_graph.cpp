@@ -1066,7 +1066,8 @@ void Sweep::general_event(i32 e, i32 begin, i32 end) {
             if (seg_parent_[k] != kNone && seg_root(static_cast<i32>(k)) == gr)
                 tri_label_[z(star_[k])] = id;
     }
-    if (regular) {
+    if (regular) {  // Reeb-regular (a boundary vertex may still have a split link)
+        g_.node_lower_links[z(e)] = g_.node_upper_links[z(e)] = 1;
         append_regular(continuing_arc, e);
         return;
     }

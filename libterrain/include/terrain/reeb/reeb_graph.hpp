@@ -49,8 +49,10 @@ struct ReebGraph {
     // node_vertex_offsets[n+1]) are the vertices of node n, all with value node_values[n].
     std::vector<float> node_values;
     std::vector<NodeKind> node_kinds;
-    std::vector<std::uint8_t> node_lower_links;  // link components below (capped at 255)
-    std::vector<std::uint8_t> node_upper_links;  // link components above (capped at 255)
+    // Components of a critical node's lower and upper links (capped at 255); 1 and 1 for
+    // regular nodes.
+    std::vector<std::uint8_t> node_lower_links;
+    std::vector<std::uint8_t> node_upper_links;
     std::vector<std::int32_t> node_vertex_offsets;
     std::vector<std::int32_t> node_vertices;
     std::vector<std::int32_t> vertex_nodes;  // the node of each mesh vertex
