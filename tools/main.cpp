@@ -11,6 +11,7 @@ int run_info(int argc, char** argv);
 int run_synth(int argc, char** argv);
 int run_mesh(int argc, char** argv);
 int run_field(int argc, char** argv);
+int run_reeb(int argc, char** argv);
 }  // namespace terrain::cli
 
 namespace {
@@ -28,6 +29,8 @@ constexpr Command kCommands[] = {
      terrain::cli::run_mesh},
     {"field", "the scalar field (shape index, height) on a DEM's grid or a mesh's vertices",
      terrain::cli::run_field},
+    {"reeb", "the Reeb graph of the field, simplified by persistence and area ratio",
+     terrain::cli::run_reeb},
     {"synth", "generate a synthetic cratered DEM tile (the Vesta sample)", terrain::cli::run_synth},
 };
 
