@@ -91,8 +91,18 @@ TEST_CASE("labels.tif: UInt32 on the DEM's grid, labels where the DEM is valid, 
         CHECK(rat->GetValueAsInt(row, column("Blue")) == colour[2]);
         CHECK(rat->GetValueAsInt(row, column("Alpha")) == 255);
     }
-    // GeoTIFF cannot hold a colour table on a 32-bit band: the colours are the RAT's.
+    // GeoTIFF cannot hold a colour table on a 32-bit band: the colours are the RAT's, and
+    // GDAL turns them into a colour table indexed by id.
     CHECK(band->GetColorTable() == nullptr);
+    std::unique_ptr<GDALColorTable> table(rat->TranslateToColorTable(-1));
+    REQUIRE(table);
+    CHECK(table->GetColorEntryCount() == int(t.region_count) + 1);
+    for (std::uint32_t id = 1; id <= t.region_count; ++id) {
+        const GDALColorEntry* e = table->GetColorEntry(int(id));
+        const auto colour = io::region_colour(id);
+        CHECK(std::array<int, 4>{e->c1, e->c2, e->c3, e->c4} ==
+              std::array<int, 4>{colour[0], colour[1], colour[2], colour[3]});
+    }
     CHECK(std::filesystem::exists(path + ".aux.xml"));
 }
 
