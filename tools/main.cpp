@@ -12,6 +12,7 @@ int run_synth(int argc, char** argv);
 int run_mesh(int argc, char** argv);
 int run_field(int argc, char** argv);
 int run_reeb(int argc, char** argv);
+int run_segment(int argc, char** argv);
 }  // namespace terrain::cli
 
 namespace {
@@ -31,6 +32,8 @@ constexpr Command kCommands[] = {
      terrain::cli::run_field},
     {"reeb", "the Reeb graph of the field, simplified by persistence and area ratio",
      terrain::cli::run_reeb},
+    {"segment", "the main job: regions from the Reeb graph, as rasters, polygons and graphs",
+     terrain::cli::run_segment},
     {"synth", "generate a synthetic cratered DEM tile (the Vesta sample)", terrain::cli::run_synth},
 };
 
