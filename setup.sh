@@ -24,6 +24,7 @@ packages=(
   libboost-program-options-dev
   libeigen3-dev libtbb-dev
   catch2
+  time
 )
 
 install_packages() {
@@ -55,11 +56,14 @@ case "$mode" in
   run)
     install_packages
     build
+    # The main job: the synthetic Vesta HAMO tile segmented with the paper's terrain
+    # parameters (shape index x100, persistence 10, area ratio 0.5 %, graph cost, lambda 20).
     sample=examples/data/vesta_hamo_tile.lbl
     mkdir -p "$out_dir"
     "$build_dir/tools/terrain" info "$sample"
-    "$build_dir/tools/terrain" info "$sample" --json > "$out_dir/vesta_hamo_tile.info.json"
-    echo "setup: outputs in $out_dir/: vesta_hamo_tile.info.json"
+    "$build_dir/tools/terrain" segment "$sample" -o "$out_dir/vesta_hamo_tile" --overwrite \
+      --persistence 10 --area-ratio 0.5 --cost graph --saddle-penalty 20 --timings
+    echo "setup: outputs in $out_dir/vesta_hamo_tile/ (labels.tif, regions.geojson, adjacency.*, preview.png, run.json)"
     ;;
   test)
     install_packages
