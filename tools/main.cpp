@@ -13,6 +13,7 @@ int run_mesh(int argc, char** argv);
 int run_field(int argc, char** argv);
 int run_reeb(int argc, char** argv);
 int run_segment(int argc, char** argv);
+int run_sweep(int argc, char** argv);
 }  // namespace terrain::cli
 
 namespace {
@@ -34,6 +35,8 @@ constexpr Command kCommands[] = {
      terrain::cli::run_reeb},
     {"segment", "the main job: regions from the Reeb graph, as rasters, polygons and graphs",
      terrain::cli::run_segment},
+    {"sweep", "segmentations at several area ratios from one Reeb graph, with their lineage",
+     terrain::cli::run_sweep},
     {"synth", "generate a synthetic cratered DEM tile (the Vesta sample)", terrain::cli::run_synth},
 };
 

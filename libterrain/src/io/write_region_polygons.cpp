@@ -2,6 +2,7 @@
 #include <gdal_priv.h>
 #include <ogrsf_frmts.h>
 
+#include <filesystem>
 #include <memory>
 #include <optional>
 #include <ostream>
@@ -137,14 +138,18 @@ void write_geojson(std::ostream& out, const std::vector<Geometry>& polygons,
 std::vector<std::string> write_ogr(GDALDriver& driver, const std::string& temp,
                                    const std::string& path, std::vector<Geometry>& polygons,
                                    const segment::RegionGraph& graph,
-                                   const OGRSpatialReference* srs, const GdalErrorCapture& errors) {
+                                   const OGRSpatialReference* srs, const GdalErrorCapture& errors,
+                                   const std::string& layer_name, bool append) {
     // GeoPackage stamps the current time unless told a fixed one: same bytes every run.
     CPLSetThreadLocalConfigOption("OGR_CURRENT_DATE", "2000-01-01T00:00:00.000Z");
-    std::unique_ptr<GDALDataset> ds(driver.Create(temp.c_str(), 0, 0, 0, GDT_Unknown, nullptr));
+    std::unique_ptr<GDALDataset> ds(
+        append && std::filesystem::exists(temp)
+            ? GDALDataset::Open(temp.c_str(), GDAL_OF_VECTOR | GDAL_OF_UPDATE)
+            : driver.Create(temp.c_str(), 0, 0, 0, GDT_Unknown, nullptr));
     CPLSetThreadLocalConfigOption("OGR_CURRENT_DATE", nullptr);
     if (!ds) throw Error("write", "cannot create '" + path + "'" + errors.suffix());
-    OGRLayer* layer =
-        ds->CreateLayer("regions", const_cast<OGRSpatialReference*>(srs), wkbMultiPolygon, nullptr);
+    OGRLayer* layer = ds->CreateLayer(layer_name.c_str(), const_cast<OGRSpatialReference*>(srs),
+                                      wkbMultiPolygon, nullptr);
     if (!layer) throw Error("write", "cannot create a layer in '" + path + "'" + errors.suffix());
     if (graph.regions.empty()) return dataset_files(ds.get());
     for (const auto& [name, value] : region_attributes(graph, graph.regions.front())) {
@@ -207,7 +212,9 @@ void write_region_polygons(const Dem& dem, const std::vector<std::uint32_t>& pix
                                      "' is not an OGR vector driver that creates files; try "
                                      "GeoJSON or GPKG");
     }
-    check_output_path(path, overwrite);
+    if (options.append_layer && geojson)
+        throw Error("write", "GeoJSON holds one layer; use GPKG for one layer per scale");
+    if (!options.append_layer || !std::filesystem::exists(path)) check_output_path(path, overwrite);
     auto polygons = polygonize(dem, pixels, graph.regions.size(), errors);
     std::optional<LonLatFrame> frame;
     if (!dem.crs_wkt.empty() && (geojson || options.lonlat)) frame.emplace(dem, "write");
@@ -223,8 +230,6 @@ void write_region_polygons(const Dem& dem, const std::vector<std::uint32_t>& pix
         return;
     }
     {
-        AtomicOutput output(path, overwrite);
-        TemporaryFiles temporary(output);
         std::unique_ptr<OGRSpatialReference> srs;
         if (frame) {
             srs.reset(frame->srs().Clone());
@@ -233,8 +238,14 @@ void write_region_polygons(const Dem& dem, const std::vector<std::uint32_t>& pix
             srs->SetFromUserInput(dem.crs_wkt.c_str());
             srs->SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
         }
-        const auto files =
-            write_ogr(*driver, output.temp_path(), path, polygons, graph, srs.get(), errors);
+        if (options.append_layer) {  // the caller makes the whole directory atomic
+            write_ogr(*driver, path, path, polygons, graph, srs.get(), errors, options.layer, true);
+            return;
+        }
+        AtomicOutput output(path, overwrite);
+        TemporaryFiles temporary(output);
+        const auto files = write_ogr(*driver, output.temp_path(), path, polygons, graph, srs.get(),
+                                     errors, options.layer, false);
         commit_dataset(output, files, overwrite);
         temporary.release();
     }

@@ -32,6 +32,10 @@ struct RegionPolygonOptions {
     // GeoJSON is always lon/lat (EPSG:4326 on Earth, the body's geographic CRS elsewhere);
     // other drivers keep the DEM's own CRS unless this is set.
     bool lonlat = false;
+    std::string layer = "regions";  // the layer's name (drivers other than GeoJSON)
+    // Add the layer to `path` if it exists (GPKG with one layer per scale), writing in place:
+    // the caller makes the outputs atomic (terrain sweep writes into a temporary directory).
+    bool append_layer = false;
 };
 
 // regions.geojson: one feature per region (Polygon, MultiPolygon where its pixels touch
@@ -77,6 +81,19 @@ void write_faces_seg(const TriangleMesh& mesh, const std::vector<std::uint32_t>&
 // The labels write_faces_seg writes.
 std::vector<std::uint32_t> face_labels(const TriangleMesh& mesh,
                                        const std::vector<std::uint32_t>& labels);
+
+// labels.tif of a sweep: one UInt32 band per scale on the DEM's exact grid, NoData 0, each
+// band's description saying its scale ("area_ratio=0.5").
+void write_label_stack(const Dem& dem, const std::vector<std::vector<std::uint32_t>>& bands,
+                       const std::vector<std::string>& descriptions, const std::string& path,
+                       bool overwrite);
+
+// sweep.png: region count (blue) and mean region area (red) against the area ratio (log
+// scale), each on its own axis from 0 to its maximum.
+void write_sweep_plot(const std::vector<double>& area_ratios,
+                      const std::vector<double>& region_counts,
+                      const std::vector<double>& mean_areas, const std::string& path,
+                      bool overwrite);
 
 struct SegmentOutputOptions {
     bool overwrite = false;
