@@ -24,6 +24,55 @@ inline std::size_t z(i32 i) {
     return static_cast<std::size_t>(i);
 }
 
+// The arcs at each node as doubly linked lists of arc ends (slot 2a and 2a+1 of arc a), so
+// that moving an arc end from one node to another allocates nothing.
+class Incidence {
+  public:
+    void init(std::size_t nodes, std::size_t arcs) {
+        head_.assign(nodes, kNone);
+        degree_.assign(nodes, 0);
+        next_.assign(2 * arcs, kNone);
+        prev_.assign(2 * arcs, kNone);
+        owner_.assign(2 * arcs, kNone);
+    }
+    void link(i32 slot, i32 node) {
+        owner_[z(slot)] = node;
+        prev_[z(slot)] = kNone;
+        next_[z(slot)] = head_[z(node)];
+        if (head_[z(node)] != kNone) prev_[z(head_[z(node)])] = slot;
+        head_[z(node)] = slot;
+        ++degree_[z(node)];
+    }
+    void unlink(i32 slot) {
+        const i32 node = owner_[z(slot)], p = prev_[z(slot)], n = next_[z(slot)];
+        if (p != kNone)
+            next_[z(p)] = n;
+        else
+            head_[z(node)] = n;
+        if (n != kNone) prev_[z(n)] = p;
+        --degree_[z(node)];
+        owner_[z(slot)] = kNone;
+    }
+    void move(i32 slot, i32 node) {
+        unlink(slot);
+        link(slot, node);
+    }
+    // The slot of arc a's end at node n.
+    i32 slot(i32 a, i32 n) const { return owner_[z(2 * a)] == n ? 2 * a : 2 * a + 1; }
+    i32 degree(i32 n) const { return degree_[z(n)]; }
+    template <class F>
+    void for_each(i32 n, F&& f) const {
+        for (i32 sl = head_[z(n)]; sl != kNone; sl = next_[z(sl)]) f(sl / 2);
+    }
+    void arcs(i32 n, std::vector<i32>& out) const {
+        out.clear();
+        for_each(n, [&](i32 a) { out.push_back(a); });
+    }
+
+  private:
+    std::vector<i32> head_, degree_, next_, prev_, owner_;
+};
+
 std::vector<double> node_areas(const TriangleMesh& mesh, const ReebGraph& g) {
     std::vector<double> area(g.node_count(), 0.0);
     for (std::size_t v = 0; v < g.vertex_nodes.size(); ++v)
@@ -47,14 +96,14 @@ class Simplifier {
         for (std::size_t n = 0; n < nn; ++n) critical_[n] = g.node_kinds[n] != NodeKind::regular;
         prev_.assign(nn, kNone);
         next_.assign(nn, kNone);
-        inc_.resize(nn);
+        inc_.init(nn, na);
         down_.assign(nn, 0);
         arcs_.resize(na);
         for (std::size_t a = 0; a < na; ++a) {
             Arc& arc = arcs_[a];
             arc.end = g.arcs[a];
-            inc_[z(arc.end[0])].push_back(static_cast<i32>(a));
-            inc_[z(arc.end[1])].push_back(static_cast<i32>(a));
+            inc_.link(static_cast<i32>(2 * a), arc.end[0]);
+            inc_.link(static_cast<i32>(2 * a + 1), arc.end[1]);
             ++down_[z(arc.end[1])];
             for (i32 i = g.arc_offsets[a]; i < g.arc_offsets[a + 1]; ++i) {
                 const i32 r = g.arc_nodes[z(i)];
@@ -104,10 +153,10 @@ class Simplifier {
 
     // Arcs below and above a node: its arcs ending there as the upper / lower end.
     i32 down(i32 n) const { return down_[z(n)]; }
-    i32 up(i32 n) const { return static_cast<i32>(inc_[z(n)].size()) - down_[z(n)]; }
+    i32 up(i32 n) const { return inc_.degree(n) - down_[z(n)]; }
     void recount(i32 n) {
         i32 d = 0;
-        for (const i32 a : inc_[z(n)]) d += arcs_[z(a)].end[1] == n;
+        inc_.for_each(n, [&](i32 a) { d += arcs_[z(a)].end[1] == n; });
         down_[z(n)] = d;
     }
     bool extremum(i32 n) const { return down(n) == 0 || up(n) == 0; }
@@ -118,21 +167,20 @@ class Simplifier {
     double area_ratio(i32 a) const {
         const Arc& arc = arcs_[z(a)];
         double s = arc.area;
-        for (const i32 n : arc.end) s += area_[z(n)] / static_cast<double>(inc_[z(n)].size());
+        for (const i32 n : arc.end) s += area_[z(n)] / static_cast<double>(inc_.degree(n));
         return s / total_area_;
     }
     bool multi(i32 a) const {
         const Arc& arc = arcs_[z(a)];
-        const i32 n =
-            inc_[z(arc.end[0])].size() <= inc_[z(arc.end[1])].size() ? arc.end[0] : arc.end[1];
-        for (const i32 b : inc_[z(n)]) {
-            if (b == a) continue;
+        const i32 n = inc_.degree(arc.end[0]) <= inc_.degree(arc.end[1]) ? arc.end[0] : arc.end[1];
+        bool found = false;
+        inc_.for_each(n, [&](i32 b) {
+            if (b == a) return;
             const auto& e = arcs_[z(b)].end;
-            if ((e[0] == arc.end[0] && e[1] == arc.end[1]) ||
-                (e[0] == arc.end[1] && e[1] == arc.end[0]))
-                return true;
-        }
-        return false;
+            found |= (e[0] == arc.end[0] && e[1] == arc.end[1]) ||
+                     (e[0] == arc.end[1] && e[1] == arc.end[0]);
+        });
+        return found;
     }
     bool candidate(i32 a) const {
         const Arc& arc = arcs_[z(a)];
@@ -165,7 +213,6 @@ class Simplifier {
         arc.head = arc.tail = kNone;
         arc.area = 0;
     }
-    static void erase(std::vector<i32>& v, i32 x) { v.erase(std::find(v.begin(), v.end(), x)); }
 
     // Arc b now ends at keep (whose value may have changed): regular nodes outside the new
     // value range join keep, and the ends swap if the other end is now on the wrong side.
@@ -214,7 +261,7 @@ class Simplifier {
         const bool lo_ext = down(lo) == 0, hi_ext = up(hi) == 0;
         i32 keep, gone;
         const i32 keep0 = lo_ext && hi_ext ? lo : (lo_ext ? hi : lo);
-        const double share_before = area_[z(keep0)] / static_cast<double>(inc_[z(keep0)].size());
+        const double share_before = area_[z(keep0)] / static_cast<double>(inc_.degree(keep0));
         const bool ext_before = extremum(keep0);
         if (lo_ext && hi_ext) {
             keep = lo;
@@ -228,22 +275,23 @@ class Simplifier {
         }
         modified_[z(keep)] = 1;
         arc.alive = false;
-        erase(inc_[z(lo)], a);
-        erase(inc_[z(hi)], a);
+        inc_.unlink(2 * a);
+        inc_.unlink(2 * a + 1);
+        --down_[z(hi)];
         absorb_list(arc, keep);
         absorb(gone, keep);
         std::vector<i32>& touched = touched_;
-        touched.assign(inc_[z(gone)].begin(), inc_[z(gone)].end());
-        for (const i32 b : inc_[z(gone)]) {
+        inc_.arcs(gone, touched);
+        for (const i32 b : touched) {
             Arc& other = arcs_[z(b)];
+            inc_.move(inc_.slot(b, gone), keep);
             for (auto& e : other.end)
                 if (e == gone) e = keep;
-            inc_[z(keep)].push_back(b);
         }
-        inc_[z(gone)].clear();
-        inc_[z(gone)].shrink_to_fit();
+        down_[z(gone)] = 0;
         if (lo_ext && hi_ext) {
-            for (const i32 b : inc_[z(keep)]) fit_arc(b, keep);
+            inc_.arcs(keep, all_);
+            for (const i32 b : all_) fit_arc(b, keep);
         } else {
             for (const i32 b : touched) fit_arc(b, keep);
         }
@@ -251,15 +299,15 @@ class Simplifier {
         // keep's other arcs need a new look only if they may have become candidates: its
         // value moved, it became an extremum, or its area share per arc went down. Arcs that
         // stopped being candidates are dropped when they reach the top of the heap.
-        const double share_after = inc_[z(keep)].empty()
-                                       ? 0.0
-                                       : area_[z(keep)] / static_cast<double>(inc_[z(keep)].size());
+        const double share_after =
+            inc_.degree(keep) == 0 ? 0.0 : area_[z(keep)] / static_cast<double>(inc_.degree(keep));
         if ((lo_ext && hi_ext) || extremum(keep) != ext_before || share_after < share_before)
-            touched.assign(inc_[z(keep)].begin(), inc_[z(keep)].end());
+            inc_.arcs(keep, touched);
 
         // A node left with one arc below and one above becomes regular: its arcs merge.
-        if (inc_[z(keep)].size() == 2 && down(keep) == 1 && up(keep) == 1) {
-            i32 lower = inc_[z(keep)][0], upper = inc_[z(keep)][1];
+        if (inc_.degree(keep) == 2 && down(keep) == 1 && up(keep) == 1) {
+            inc_.arcs(keep, all_);
+            i32 lower = all_[0], upper = all_[1];
             if (arcs_[z(lower)].end[1] != keep) std::swap(lower, upper);
             Arc& L = arcs_[z(lower)];
             Arc& U = arcs_[z(upper)];
@@ -273,15 +321,18 @@ class Simplifier {
                 if (U.head != kNone) prev_[z(U.head)] = keep;
                 L.tail = U.tail == kNone ? keep : U.tail;
                 L.area += area_[z(keep)] + U.area;
-                L.end[1] = U.end[1];
+                const i32 q = U.end[1];
+                L.end[1] = q;
                 U.alive = false;
-                std::replace(inc_[z(U.end[1])].begin(), inc_[z(U.end[1])].end(), upper, lower);
-                inc_[z(keep)].clear();
+                inc_.unlink(inc_.slot(upper, q));
+                inc_.unlink(inc_.slot(upper, keep));
+                inc_.move(inc_.slot(lower, keep), q);
                 down_[z(keep)] = 0;
                 critical_[z(keep)] = false;
                 touched.assign(1, lower);
-                for (const i32 b : inc_[z(L.end[0])])
+                inc_.for_each(L.end[0], [&](i32 b) {
                     if (b != lower && arcs_[z(b)].end == L.end) touched.push_back(b);
+                });
             }
         }
         for (const i32 b : touched) consider(b);
@@ -365,8 +416,8 @@ class Simplifier {
     double total_area_ = 0;
     std::vector<i32> forward_, prev_, next_, down_;
     std::vector<char> critical_, modified_;
-    std::vector<std::vector<i32>> inc_;
-    std::vector<i32> touched_;
+    Incidence inc_;
+    std::vector<i32> touched_, all_;
     std::vector<Arc> arcs_;
     std::priority_queue<std::uint64_t, std::vector<std::uint64_t>, std::greater<>> heap_;
 };
