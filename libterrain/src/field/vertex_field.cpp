@@ -9,12 +9,20 @@ namespace terrain::field {
 
 FieldKind parse_field_kind(const std::string& name) {
     if (name == "shape-index") return FieldKind::shape_index;
+    if (name == "sdf") return FieldKind::sdf;
     if (name == "height") return FieldKind::height;
-    throw Error("field", "unknown field '" + name + "'; use shape-index or height");
+    throw Error("field", "unknown field '" + name + "'; use shape-index, sdf or height");
 }
 
 const char* to_string(FieldKind kind) {
-    return kind == FieldKind::height ? "height" : "shape-index";
+    switch (kind) {
+        case FieldKind::height:
+            return "height";
+        case FieldKind::sdf:
+            return "sdf";
+        default:
+            return "shape-index";
+    }
 }
 
 std::vector<float> height_field(const TriangleMesh& mesh, const Dem* dem) {
@@ -41,6 +49,8 @@ std::vector<float> vertex_field(const TriangleMesh& mesh, const Dem* dem,
             report_progress(progress, 1.0, "height");
             return out;
         }
+        case FieldKind::sdf:
+            return shape_diameter_function(mesh, options.sdf, progress).values;
         default:
             return shape_index_field(mesh, options.shape_index, progress);
     }
