@@ -1,11 +1,16 @@
-// terrain field INPUT --field shape-index|height -o OUT.tif|OUT.ply: the scalar field, as a
-// Float32 raster on the DEM's grid or as a per-vertex PLY property.
+// terrain field INPUT --field shape-index|sdf|height -o OUT.tif|OUT.ply: the scalar field, as
+// a Float32 raster on the DEM's grid or as a per-vertex PLY property.
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <numbers>
+#include <optional>
+#include <string>
+#include <vector>
 
 #include "cli.hpp"
 #include "input.hpp"
+#include "terrain/core/error.hpp"
 #include "terrain/field/vertex_field.hpp"
 #include "terrain/io/mesh_files.hpp"
 #include "terrain/io/output_file.hpp"
@@ -13,22 +18,68 @@
 
 namespace terrain::cli {
 
-void add_field_options(po::options_description& options, std::string& field_name,
-                       field::ShapeIndexOptions& shape_index) {
-    options.add_options()("field", po::value(&field_name)->default_value("shape-index"),
-                          "shape-index (x100, in [0,100]) or height (metres above the reference)")(
-        "rings", po::value(&shape_index.rings)->default_value(2),
+// The field options as parsed; to_field_options turns them into the library's.
+struct FieldOptionValues {
+    std::string name = "shape-index";
+    double cone_angle_degrees = 120;
+    bool no_postprocess = false;
+    field::FieldOptions options;
+};
+
+void add_field_options(po::options_description& options, FieldOptionValues& values) {
+    auto& si = values.options.shape_index;
+    auto& sdf = values.options.sdf;
+    options.add_options()("field", po::value(&values.name)->default_value("shape-index"),
+                          "shape-index (x100, in [0,100]), sdf (Shape Diameter Function of a "
+                          "closed mesh, in [0,100]) or height (metres above the reference)")(
+        "rings", po::value(&si.rings)->default_value(2),
         "shape index: fit over the vertices within N mesh edges")(
-        "radius", po::value(&shape_index.radius)->default_value(0.0),
-        "shape index: fit over the vertices within M metres instead of rings");
+        "radius", po::value(&si.radius)->default_value(0.0),
+        "shape index: fit over the vertices within M metres instead of rings")(
+        "rays", po::value(&sdf.rays)->default_value(25), "sdf: rays per face")(
+        "cone-angle", po::value(&values.cone_angle_degrees)->default_value(120.0),
+        "sdf: opening of each face's cone of rays, degrees")(
+        "no-postprocess", po::bool_switch(&values.no_postprocess),
+        "sdf: no bilateral smoothing of the face values")(
+        "allow-open", po::bool_switch(&sdf.allow_open),
+        "sdf: compute on a mesh with holes (rays through them are lost)");
+}
+
+field::FieldOptions to_field_options(FieldOptionValues& values, const po::variables_map& vm) {
+    field::FieldOptions out = values.options;
+    out.kind = field::parse_field_kind(values.name);
+    if (!vm["rings"].defaulted() && out.shape_index.radius > 0)
+        throw UsageError("give --rings or --radius, not both");
+    out.sdf.cone_angle = values.cone_angle_degrees * std::numbers::pi / 180.0;
+    out.sdf.postprocess = !values.no_postprocess;
+    return out;
+}
+
+// What the SDF met, for the summary: degenerate faces, faces without a value, orientation.
+void print_sdf_notes(const field::SdfResult& sdf) {
+    std::printf("sdf: vertex diameters %.6g .. %.6g mapped to 0 .. 100", sdf.min_diameter,
+                sdf.max_diameter);
+    if (sdf.degenerate_faces > 0)
+        std::printf(
+            "; %zu degenerate (zero-area) faces got no rays and took their neighbours' "
+            "value",
+            sdf.degenerate_faces);
+    if (sdf.faces_without_value > 0)
+        std::printf("; %zu faces whose rays met no inner surface took their neighbours' value",
+                    sdf.faces_without_value);
+    if (sdf.reoriented) std::printf("; the faces point inwards, rays were cast the other way");
+    if (sdf.boundary_edges + sdf.nonmanifold_edges > 0)
+        std::printf("; open mesh (%zu boundary, %zu non-manifold edges): rays through holes lost",
+                    sdf.boundary_edges, sdf.nonmanifold_edges);
+    std::printf("\n");
 }
 
 int run_field(int argc, char** argv) {
     return guarded("field", [&] {
-        std::string input_path, output, field_name;
+        std::string input_path, output;
         bool quiet = false, overwrite = false;
         InputOptionValues input_values;
-        field::FieldOptions field_options;
+        FieldOptionValues field_values;
         po::options_description options("terrain field options");
         options.add_options()("input", po::value(&input_path)->required(),
                               "a DEM or a mesh (.off, .ply, .obj)")(
@@ -36,19 +87,16 @@ int run_field(int argc, char** argv) {
             "OUT.tif (DEM input: Float32 on the DEM's grid) or OUT.ply (per-vertex property)")(
             "overwrite", po::bool_switch(&overwrite), "replace an existing output")(
             "quiet,q", po::bool_switch(&quiet), "no progress output");
-        add_field_options(options, field_name, field_options.shape_index);
+        add_field_options(options, field_values);
         add_input_options(options, input_values);
         po::positional_options_description positional;
         positional.add("input", 1);
         po::variables_map vm;
-        if (!parse(argc, argv, "terrain field INPUT --field shape-index|height -o OUT.tif|OUT.ply",
-                   options, positional, vm))
+        if (!parse(argc, argv,
+                   "terrain field INPUT --field shape-index|sdf|height -o OUT.tif|OUT.ply", options,
+                   positional, vm))
             return 0;
-        if (field_name == "sdf")
-            throw UsageError("--field sdf is not available yet; use shape-index or height");
-        field_options.kind = field::parse_field_kind(field_name);
-        if (vm["rings"].defaulted() == false && field_options.shape_index.radius > 0)
-            throw UsageError("give --rings or --radius, not both");
+        const field::FieldOptions field_options = to_field_options(field_values, vm);
         const bool to_ply = io::is_mesh_file(output);
         const std::string ext = std::filesystem::path(output).extension().string();
         if (!to_ply && ext != ".tif" && ext != ".tiff")
@@ -57,9 +105,25 @@ int run_field(int argc, char** argv) {
 
         const auto progress = terminal_progress(quiet);
         const Input input = load_input(input_path, input_values, scaled_progress(progress, 0, 0.4));
-        const auto values = field::vertex_field(input.mesh, input.dem ? &*input.dem : nullptr,
-                                                field_options, scaled_progress(progress, 0.4, 1));
-        const std::string name = field_name == "height" ? "height" : "shape_index";
+        const auto field_progress = scaled_progress(progress, 0.4, 1);
+        std::vector<float> values;
+        std::optional<field::SdfResult> sdf;
+        if (field_options.kind == field::FieldKind::sdf) {
+            const std::size_t open = mesh_topology(input.mesh).boundary_edges;
+            if (input.dem && open > 0 && !field_options.sdf.allow_open)
+                throw Error("sdf", "a DEM tile is an open surface (" + std::to_string(open) +
+                                       " boundary edges; only a global DEM closes) and the SDF "
+                                       "needs a closed one; use --field shape-index, or "
+                                       "--allow-open to compute it anyway");
+            sdf = field::shape_diameter_function(input.mesh, field_options.sdf, field_progress);
+            values = std::move(sdf->values);
+        } else {
+            values = field::vertex_field(input.mesh, input.dem ? &*input.dem : nullptr,
+                                         field_options, field_progress);
+        }
+        const std::string name = field_options.kind == field::FieldKind::height ? "height"
+                                 : field_options.kind == field::FieldKind::sdf  ? "sdf"
+                                                                                : "shape_index";
         if (to_ply) {
             io::write_ply(input.mesh, output, overwrite, {{name, &values}});
         } else {
@@ -71,6 +135,7 @@ int run_field(int argc, char** argv) {
         const auto [lo, hi] = std::minmax_element(values.begin(), values.end());
         std::printf("%s: %s on %zu vertices, range %.6g .. %.6g\n", output.c_str(), name.c_str(),
                     values.size(), double(*lo), double(*hi));
+        if (sdf) print_sdf_notes(*sdf);
         return 0;
     });
 }
