@@ -1,7 +1,10 @@
 #pragma once
 // A bounding volume hierarchy over a mesh's triangles for first-hit ray queries (the SDF's
-// ray caster): binned surface-area-heuristic build, Moeller-Trumbore intersection, all in
-// double precision. Read-only after construction, so queries may run on many threads.
+// ray caster): a binary tree built with the binned surface-area heuristic, collapsed into a
+// 4-wide tree whose four child boxes are tested together (float, conservatively rounded);
+// Moeller-Trumbore intersection in double precision.
+// Corners are stored as floats: the callers' points must be floats widened to double. Read-only
+// after construction, so queries may run on many threads.
 
 #include <array>
 #include <cstdint>
@@ -32,22 +35,26 @@ class TriangleBvh {
     Hit first_hit(const Vec3& origin, const Vec3& direction, double t_max, std::int32_t skip) const;
 
     // Corners of the box around all the triangles.
-    Vec3 lower() const { return nodes_.empty() ? Vec3{0, 0, 0} : nodes_[0].box[0]; }
-    Vec3 upper() const { return nodes_.empty() ? Vec3{0, 0, 0} : nodes_[0].box[1]; }
+    Vec3 lower() const { return lower_; }
+    Vec3 upper() const { return upper_; }
 
+    // Four children, their boxes as [axis][lower, upper][child] for one SIMD-friendly test.
     struct Node {
-        std::array<Vec3, 2> box;  // lower and upper corner
-        std::int32_t first = 0;   // leaf: first triangle; inner: the left child (right = +1)
-        std::int32_t count = 0;   // leaf: number of triangles; 0 for an inner node
+        std::array<std::array<std::array<float, 4>, 2>, 3> bounds;
+        std::array<std::int32_t, 4> child;  // inner: a node; leaf: its first triangle; -1: none
+        std::array<std::int32_t, 4> count;  // leaf: its number of triangles; 0: an inner node
+    };
+    // The corners as floats (the mesh's own precision: exact, and half the memory of
+    // doubles); edges are formed in double when tested.
+    struct Triangle {
+        std::array<float, 9> corners;
+        std::int32_t face;
     };
 
   private:
-    struct Triangle {
-        Vec3 v0, e1, e2;  // corner and the two edges from it
-        std::int32_t face;
-    };
     std::vector<Node> nodes_;
     std::vector<Triangle> triangles_;  // in leaf order
+    Vec3 lower_{0, 0, 0}, upper_{0, 0, 0};
 };
 
 }  // namespace terrain::field::detail
