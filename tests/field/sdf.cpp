@@ -1,4 +1,3 @@
-#include <tbb/global_control.h>
 #include <catch2/catch.hpp>
 
 #include <algorithm>
@@ -299,15 +298,8 @@ TEST_CASE("SDF with degenerate faces: no rays for them, values from neighbours, 
 
 TEST_CASE("SDF is the same with 1 and 2 threads", "[sdf]") {
     const auto mesh = rod_and_drum();
-    field::SdfResult one, two;
-    {
-        tbb::global_control control(tbb::global_control::max_allowed_parallelism, 1);
-        one = field::shape_diameter_function(mesh);
-    }
-    {
-        tbb::global_control control(tbb::global_control::max_allowed_parallelism, 2);
-        two = field::shape_diameter_function(mesh);
-    }
+    auto sdf = [&] { return field::shape_diameter_function(mesh); };
+    const auto one = test::with_threads(1, sdf), two = test::with_threads(2, sdf);
     CHECK(one.values == two.values);
     CHECK(one.face_diameters == two.face_diameters);
 }

@@ -28,6 +28,9 @@
 namespace terrain::field {
 namespace {
 
+using detail::cross;
+using detail::dot;
+using detail::sub;
 using detail::TriangleBvh;
 using detail::Vec3;
 using Face = std::array<std::int32_t, 3>;
@@ -40,15 +43,6 @@ constexpr double kOutlierMads = 1.5;
 // reliable normal: it is degenerate (CGAL tests exact collinearity).
 constexpr double kDegenerateRatio = 1e-12;
 
-Vec3 sub(const Vec3& a, const Vec3& b) {
-    return {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
-}
-Vec3 cross(const Vec3& a, const Vec3& b) {
-    return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
-double dot(const Vec3& a, const Vec3& b) {
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
 Vec3 scaled(const Vec3& a, double s) {
     return {a[0] * s, a[1] * s, a[2] * s};
 }

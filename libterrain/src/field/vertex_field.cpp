@@ -15,14 +15,8 @@ FieldKind parse_field_kind(const std::string& name) {
 }
 
 const char* to_string(FieldKind kind) {
-    switch (kind) {
-        case FieldKind::height:
-            return "height";
-        case FieldKind::sdf:
-            return "sdf";
-        default:
-            return "shape-index";
-    }
+    constexpr const char* kNames[] = {"shape-index", "sdf", "height"};  // FieldKind's order
+    return kNames[static_cast<int>(kind)];
 }
 
 std::vector<float> height_field(const TriangleMesh& mesh, const Dem* dem) {
