@@ -174,7 +174,7 @@ TEST_CASE("SDF of a sphere: the chord along the inward normal, the same everywhe
     SECTION("CGAL's default cone of 120 degrees") {
         // A ray at angle t to the normal crosses the sphere in 2R cos t. CGAL's 25 rays
         // sit at tan t = tan(60 deg) i/25; the mean of those within 1.5 median absolute
-        // deviations of the median is 1.5835 R. The two longest rays sit right at that
+        // deviations of the median is 1.5835 R. The longest rays sit just inside that
         // threshold, so on a faceted sphere a face may lose them (down to 1.545 R).
         std::vector<double> d;
         for (int i = 0; i < 25; ++i) d.push_back(2 * R / std::sqrt(1 + 3.0 * i * i / 625));

@@ -339,8 +339,8 @@ SdfResult shape_diameter_function(const TriangleMesh& mesh, const SdfOptions& op
 
     const TriangleBvh bvh(data.points, mesh.triangles, data.ray_faces);
     report_progress(progress, 0.02, "sdf");
-    // CGAL casts segments as long as the diagonal of the box around the (non-degenerate)
-    // faces; the box is the BVH's root padded by a billionth, close enough.
+    // CGAL casts segments as long as the diagonal of the box around the non-degenerate
+    // faces (its AABB tree's); so do we.
     const Vec3 extent = sub(bvh.upper(), bvh.lower());
     RayCaster caster{mesh,
                      data,
