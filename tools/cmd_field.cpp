@@ -101,6 +101,8 @@ int run_field(int argc, char** argv) {
         const std::string ext = std::filesystem::path(output).extension().string();
         if (!to_ply && ext != ".tif" && ext != ".tiff")
             throw UsageError("the output must end in .tif or .ply");
+        if (!to_ply && io::is_mesh_file(input_path))
+            throw UsageError("a mesh input gives a .ply output, not a raster");
         io::check_output_path(output, overwrite);
 
         const auto progress = terminal_progress(quiet);
@@ -109,8 +111,10 @@ int run_field(int argc, char** argv) {
         std::vector<float> values;
         std::optional<field::SdfResult> sdf;
         if (field_options.kind == field::FieldKind::sdf) {
-            const std::size_t open = mesh_topology(input.mesh).boundary_edges;
-            if (input.dem && open > 0 && !field_options.sdf.allow_open)
+            const std::size_t open = input.dem && !field_options.sdf.allow_open
+                                         ? mesh_topology(input.mesh).boundary_edges
+                                         : 0;
+            if (open > 0)
                 throw Error("sdf", "a DEM tile is an open surface (" + std::to_string(open) +
                                        " boundary edges; only a global DEM closes) and the SDF "
                                        "needs a closed one; use --field shape-index, or "
@@ -121,13 +125,11 @@ int run_field(int argc, char** argv) {
             values = field::vertex_field(input.mesh, input.dem ? &*input.dem : nullptr,
                                          field_options, field_progress);
         }
-        const std::string name = field_options.kind == field::FieldKind::height ? "height"
-                                 : field_options.kind == field::FieldKind::sdf  ? "sdf"
-                                                                                : "shape_index";
+        std::string name = field::to_string(field_options.kind);  // shape-index -> shape_index
+        std::replace(name.begin(), name.end(), '-', '_');
         if (to_ply) {
             io::write_ply(input.mesh, output, overwrite, {{name, &values}});
         } else {
-            if (!input.dem) throw UsageError("a mesh input gives a .ply output, not a raster");
             io::write_float_raster(*input.dem,
                                    field::field_to_pixels(input.mesh, *input.dem, values), output,
                                    overwrite, name);
