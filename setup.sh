@@ -25,6 +25,7 @@ packages=(
   libboost-program-options-dev
   libeigen3-dev libtbb-dev
   catch2
+  time
 )
 # Only for `./setup.sh bench`: libcgal-demo ships CGAL's sample meshes (data.tar.gz), on
 # which bench_sdf compares our Shape Diameter Function with CGAL's.
@@ -62,11 +63,14 @@ case "$mode" in
   run)
     install_packages "${packages[@]}"
     build
+    # The main job: the synthetic Vesta HAMO tile segmented with the paper's terrain
+    # parameters (shape index x100, persistence 10, area ratio 0.5 %, graph cost, lambda 20).
     sample=examples/data/vesta_hamo_tile.lbl
     mkdir -p "$out_dir"
     "$build_dir/tools/terrain" info "$sample"
-    "$build_dir/tools/terrain" info "$sample" --json > "$out_dir/vesta_hamo_tile.info.json"
-    echo "setup: outputs in $out_dir/: vesta_hamo_tile.info.json"
+    "$build_dir/tools/terrain" segment "$sample" -o "$out_dir/vesta_hamo_tile" --overwrite \
+      --persistence 10 --area-ratio 0.5 --cost graph --saddle-penalty 20 --timings
+    echo "setup: outputs in $out_dir/vesta_hamo_tile/ (labels.tif, regions.geojson, adjacency.*, preview.png, run.json)"
     ;;
   test)
     install_packages "${packages[@]}"
@@ -89,6 +93,9 @@ case "$mode" in
     "$build_dir/tests/bench/bench_mesh"
     "$build_dir/tests/bench/bench_field"
     "$build_dir/tests/bench/bench_sdf" "${meshes[@]}"
+    "$build_dir/tests/bench/bench_reeb"
+    "$build_dir/tests/bench/bench_outputs"
+    tests/bench/bench_segment.sh "$build_dir"
     ;;
   *)
     echo "usage: ./setup.sh [run|test|bench]" >&2

@@ -1,5 +1,7 @@
 #include "input.hpp"
 
+#include <chrono>
+
 #include "terrain/io/mesh_files.hpp"
 #include "terrain/mesh/dem_to_mesh.hpp"
 
@@ -18,10 +20,16 @@ void add_input_options(po::options_description& options, InputOptionValues& valu
 Input load_input(const std::string& path, const InputOptionValues& values,
                  const ProgressFn& progress) {
     Input input;
+    using clock = std::chrono::steady_clock;
+    const auto t0 = clock::now();
+    auto seconds = [](clock::time_point a, clock::time_point b) {
+        return std::chrono::duration<double>(b - a).count();
+    };
     if (io::is_mesh_file(path)) {
         io::ReadMeshOptions read_options;
         read_options.repair = values.repair;
         input.mesh = io::read_mesh(path, read_options, progress);
+        input.read_seconds = seconds(t0, clock::now());
         return input;
     }
     mesh::DemToMeshOptions mesh_options;
@@ -32,7 +40,10 @@ Input load_input(const std::string& path, const InputOptionValues& values,
     else if (values.frame != "auto")
         throw UsageError("--frame must be body, map or auto, not '" + values.frame + "'");
     input.dem = io::read_dem(path, to_read_options(values.dem), scaled_progress(progress, 0, 0.3));
+    const auto t1 = clock::now();
+    input.read_seconds = seconds(t0, t1);
     input.mesh = mesh::dem_to_mesh(*input.dem, mesh_options, scaled_progress(progress, 0.3, 1));
+    input.mesh_seconds = seconds(t1, clock::now());
     return input;
 }
 

@@ -23,6 +23,7 @@ void add_input_options(po::options_description& options, InputOptionValues& valu
 struct Input {
     std::optional<Dem> dem;  // set for DEM input
     TriangleMesh mesh;
+    double read_seconds = 0, mesh_seconds = 0;  // wall time of reading and triangulating
 };
 
 // Reads `path` as a mesh file (.off/.ply/.obj) or a DEM and builds the mesh.

@@ -11,6 +11,9 @@ int run_info(int argc, char** argv);
 int run_synth(int argc, char** argv);
 int run_mesh(int argc, char** argv);
 int run_field(int argc, char** argv);
+int run_reeb(int argc, char** argv);
+int run_segment(int argc, char** argv);
+int run_sweep(int argc, char** argv);
 }  // namespace terrain::cli
 
 namespace {
@@ -28,6 +31,12 @@ constexpr Command kCommands[] = {
      terrain::cli::run_mesh},
     {"field", "the scalar field (shape index, SDF, height) on a DEM's grid or a mesh's vertices",
      terrain::cli::run_field},
+    {"reeb", "the Reeb graph of the field, simplified by persistence and area ratio",
+     terrain::cli::run_reeb},
+    {"segment", "the main job: regions from the Reeb graph, as rasters, polygons and graphs",
+     terrain::cli::run_segment},
+    {"sweep", "segmentations at several area ratios from one Reeb graph, with their lineage",
+     terrain::cli::run_sweep},
     {"synth", "generate a synthetic cratered DEM tile (the Vesta sample)", terrain::cli::run_synth},
 };
 

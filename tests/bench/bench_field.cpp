@@ -7,7 +7,7 @@
 #include <cstdio>
 #include <cstdlib>
 
-#include "terrain/core/body.hpp"
+#include "bench_dem.hpp"
 #include "terrain/field/shape_index.hpp"
 #include "terrain/mesh/dem_to_mesh.hpp"
 
@@ -15,17 +15,7 @@ using namespace terrain;
 
 int main(int argc, char** argv) {
     const int n = argc > 1 ? std::atoi(argv[1]) : 1000;
-    Dem dem;
-    dem.width = dem.height = n;
-    dem.crs_wkt = "EPSG:32611";
-    dem.body = body_from_crs(dem.crs_wkt);
-    dem.transform = {400000, 30, 0, 3800000, 0, -30};
-    dem.has_transform = true;
-    dem.values.resize(std::size_t(n) * n);
-    for (int r = 0; r < n; ++r)
-        for (int c = 0; c < n; ++c)
-            dem.values[std::size_t(r) * n + c] =
-                200 * std::sin(c * 0.05) * std::cos(r * 0.037) + 30 * std::sin(c * 0.9 + r * 1.3);
+    const Dem dem = bench::utm_hills(n);
     const auto mesh = mesh::dem_to_mesh(dem);
     std::printf("bench_field: %zu vertices, %d threads\n", mesh.vertex_count(),
                 tbb::info::default_concurrency());

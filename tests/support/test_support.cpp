@@ -30,6 +30,13 @@ std::filesystem::path scratch_dir(const std::string& name) {
     return dir;
 }
 
+std::string file_bytes(const std::filesystem::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
 std::string write_raster(const std::filesystem::path& path, const RasterSpec& spec) {
     GDALAllRegister();
     GDALDriver* driver = GetGDALDriverManager()->GetDriverByName("GTiff");

@@ -20,6 +20,9 @@ std::optional<std::string> shared_data(const std::string& relative);
 // next run, kept for inspection after a failure).
 std::filesystem::path scratch_dir(const std::string& name);
 
+// The whole content of a file, as bytes.
+std::string file_bytes(const std::filesystem::path& path);
+
 struct RasterSpec {
     int width = 4, height = 4;
     std::string type = "Float32";  // a GDAL data type name

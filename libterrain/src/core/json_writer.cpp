@@ -123,6 +123,12 @@ JsonWriter& JsonWriter::value(std::int64_t number_value) {
     return *this;
 }
 
+JsonWriter& JsonWriter::raw(std::string_view json) {
+    before_value();
+    out_ << json;
+    return *this;
+}
+
 JsonWriter& JsonWriter::value(bool flag) {
     before_value();
     out_ << (flag ? "true" : "false");

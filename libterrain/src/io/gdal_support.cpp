@@ -4,6 +4,8 @@
 
 #include <mutex>
 
+#include "terrain/core/error.hpp"
+
 namespace terrain::io {
 
 LonLatTransform make_lonlat_transform(const std::string& crs) {
@@ -35,6 +37,40 @@ void CPL_STDCALL GdalErrorCapture::handler(CPLErr level, CPLErrorNum, const char
     if (level < CE_Failure || !message) return;
     auto* self = static_cast<GdalErrorCapture*>(CPLGetErrorHandlerUserData());
     if (self) self->last_error_ = message;
+}
+
+void check_grid_size(const Dem& grid, std::size_t count) {
+    if (count != grid.size())
+        throw Error("write", "raster of " + std::to_string(count) + " pixels for a " +
+                                 std::to_string(grid.width) + "x" + std::to_string(grid.height) +
+                                 " grid");
+}
+
+std::unique_ptr<GDALDataset> create_grid_tiff(const Dem& grid, bool with_transform,
+                                              const std::string& temp_path, const std::string& path,
+                                              GDALDataType type, const char* const* options,
+                                              const GdalErrorCapture& errors) {
+    GDALDriver* driver = GetGDALDriverManager()->GetDriverByName("GTiff");
+    std::unique_ptr<GDALDataset> ds(driver->Create(temp_path.c_str(), grid.width, grid.height, 1,
+                                                   type, const_cast<char**>(options)));
+    if (!ds) throw Error("write", "cannot create '" + path + "'" + errors.suffix());
+    if (with_transform) {
+        GeoTransform t = grid.transform;
+        ds->SetGeoTransform(t.data());
+    }
+    if (!grid.crs_wkt.empty()) {
+        OGRSpatialReference srs;
+        if (srs.SetFromUserInput(grid.crs_wkt.c_str()) == OGRERR_NONE) ds->SetSpatialRef(&srs);
+    }
+    return ds;
+}
+
+void close_dataset(std::unique_ptr<GDALDataset>& ds, const std::string& path,
+                   const GdalErrorCapture& errors) {
+    CPLErrorReset();
+    ds.reset();  // closes the file, writing what is cached
+    if (CPLGetLastErrorType() >= CE_Failure)
+        throw Error("write", "closing '" + path + "' failed" + errors.suffix());
 }
 
 }  // namespace terrain::io

@@ -4,8 +4,13 @@
 #include <cpl_error.h>
 #include <ogr_spatialref.h>
 
+#include <gdal_priv.h>
+
+#include <cstddef>
 #include <memory>
 #include <string>
+
+#include "terrain/core/dem.hpp"
 
 namespace terrain::io {
 
@@ -37,5 +42,19 @@ class GdalErrorCapture {
     static void CPL_STDCALL handler(CPLErr level, CPLErrorNum number, const char* message);
     std::string last_error_;
 };
+
+// Throws terrain::Error (stage "write") unless `count` is one value per pixel of `grid`.
+void check_grid_size(const Dem& grid, std::size_t count);
+
+// A GeoTIFF of the grid's size with `type` bands, its geotransform (when `with_transform`)
+// and CRS; throws terrain::Error naming `path` when GDAL cannot create it.
+std::unique_ptr<GDALDataset> create_grid_tiff(const Dem& grid, bool with_transform,
+                                              const std::string& temp_path, const std::string& path,
+                                              GDALDataType type, const char* const* options,
+                                              const GdalErrorCapture& errors);
+
+// Closes the dataset (writing what GDAL cached) and throws if that failed.
+void close_dataset(std::unique_ptr<GDALDataset>& ds, const std::string& path,
+                   const GdalErrorCapture& errors);
 
 }  // namespace terrain::io

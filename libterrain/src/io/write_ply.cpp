@@ -24,9 +24,10 @@ void put(std::ofstream& out, T value) {
 void write_ply(const TriangleMesh& mesh, const std::string& path, bool overwrite,
                const std::vector<VertexProperty>& extra) {
     const std::size_t n = mesh.vertex_count();
-    for (const auto& [name, values] : extra)
-        if (!values || values->size() != n)
-            throw Error("write", "property '" + name + "' has the wrong number of values");
+    for (const auto& property : extra)
+        if (property.labels ? property.labels->size() != n
+                            : (!property.values || property.values->size() != n))
+            throw Error("write", "property '" + property.name + "' has the wrong number of values");
     AtomicOutput output(path, overwrite);
     {
         std::ofstream out(output.temp_path(), std::ios::binary);
@@ -43,7 +44,8 @@ void write_ply(const TriangleMesh& mesh, const std::string& path, bool overwrite
         out << "property double x\nproperty double y\nproperty double z\n";
         if (pixels) out << "property int col\nproperty int row\n";
         out << "property float area\n";
-        for (const auto& [name, values] : extra) out << "property float " << name << "\n";
+        for (const auto& property : extra)
+            out << "property " << (property.labels ? "uint " : "float ") << property.name << "\n";
         out << "element face " << mesh.triangle_count() << "\n";
         out << "property list uchar int vertex_indices\nend_header\n";
         for (std::size_t v = 0; v < n; ++v) {
@@ -56,7 +58,12 @@ void write_ply(const TriangleMesh& mesh, const std::string& path, bool overwrite
                 put(out, std::int32_t(mesh.vertex_pixel[v] / mesh.grid_width));
             }
             put(out, mesh.vertex_areas[v]);
-            for (const auto& [name, values] : extra) put(out, (*values)[v]);
+            for (const auto& property : extra) {
+                if (property.labels)
+                    put(out, (*property.labels)[v]);
+                else
+                    put(out, (*property.values)[v]);
+            }
         }
         for (const auto& t : mesh.triangles) {
             put(out, std::uint8_t{3});

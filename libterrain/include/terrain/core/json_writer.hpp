@@ -29,6 +29,7 @@ class JsonWriter {
     JsonWriter& value(std::size_t number) { return value(static_cast<std::int64_t>(number)); }
     JsonWriter& value(bool flag);
     JsonWriter& null();
+    JsonWriter& raw(std::string_view json);  // an already formatted JSON value
 
     template <class T>
     JsonWriter& field(std::string_view name, const T& v) {

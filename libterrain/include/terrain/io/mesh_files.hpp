@@ -1,8 +1,8 @@
 #pragma once
 // Mesh files: .off, .ply, .obj in (CGAL's readers), binary PLY out.
 
+#include <cstdint>
 #include <string>
-#include <utility>
 #include <vector>
 
 #include "terrain/core/progress.hpp"
@@ -26,8 +26,13 @@ TriangleMesh read_mesh(const std::string& path, const ReadMeshOptions& options =
 // True for the extensions read_mesh reads (.off .ply .obj, any case).
 bool is_mesh_file(const std::string& path);
 
-// A per-vertex float property written beside x y z.
-using VertexProperty = std::pair<std::string, const std::vector<float>*>;
+// A per-vertex property written beside x y z: `float name` from `values`, or `uint name`
+// from `labels` when that is set instead.
+struct VertexProperty {
+    std::string name;
+    const std::vector<float>* values = nullptr;
+    const std::vector<std::uint32_t>* labels = nullptr;
+};
 
 // Binary little-endian PLY: double x y z (absolute metres), int col row for DEM meshes,
 // float area, the extra properties, then the faces. Atomic; refuses to overwrite unless asked.

@@ -1,0 +1,41 @@
+#pragma once
+// Topological simplification of a Reeb graph by cancelling critical-node pairs (paper s.3.2,
+// METHOD.md s.4). An arc is a candidate when one end is an extremum, it is not one of several
+// arcs between the same two nodes, and its persistence or its area ratio is below the
+// threshold. Candidates are cancelled from the lowest persistence up (ties by arc id):
+// saddle-extremum (the extremum and the arc are absorbed into the saddle) or
+// extremum-extremum (both become one node at the midpoint value). The vertices' values are
+// rewritten so that the field and the simplified graph agree.
+
+#include <cstddef>
+#include <vector>
+
+#include "terrain/core/progress.hpp"
+#include "terrain/mesh/triangle_mesh.hpp"
+#include "terrain/reeb/reeb_graph.hpp"
+
+namespace terrain::reeb {
+
+struct SimplifyOptions {
+    double persistence = 0;  // cancel arcs with |f(n1) - f(n2)| below this (field units)
+    double area_ratio = 0;   // percent: cancel arcs whose area ratio is below area_ratio/100
+};
+
+struct SimplifyResult {
+    ReebGraph graph;           // the simplified graph, nodes renumbered
+    std::vector<float> field;  // the rewritten field: each vertex takes its node's value
+    std::size_t saddle_extremum = 0, extremum_extremum = 0;  // cancellations done
+};
+
+// Throws terrain::Error for negative or non-finite thresholds, or an area ratio above 100.
+SimplifyResult simplify(const TriangleMesh& mesh, const ReebGraph& graph,
+                        const SimplifyOptions& options, const ProgressFn& progress = {});
+
+// Persistence and area ratio (a fraction, not percent) of each arc of a graph on its mesh.
+struct ArcMetrics {
+    std::vector<float> persistence;
+    std::vector<double> area_ratio;
+};
+ArcMetrics arc_metrics(const TriangleMesh& mesh, const ReebGraph& graph);
+
+}  // namespace terrain::reeb

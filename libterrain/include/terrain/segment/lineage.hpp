@@ -1,0 +1,34 @@
+#pragma once
+// How the regions of one segmentation overlap those of another (a sweep's scale i and i+1).
+
+#include <cstdint>
+#include <vector>
+
+#include "terrain/core/dem.hpp"
+#include "terrain/mesh/triangle_mesh.hpp"
+
+namespace terrain::segment {
+
+struct Overlap {
+    std::uint32_t region = 0;  // a region of the other segmentation
+    double area_m2 = 0;        // the area the two share
+    double fraction = 0;       // area_m2 / the area of the region it is listed under
+};
+
+struct RegionLineage {
+    std::uint32_t region = 0;
+    double area_m2 = 0;
+    std::vector<Overlap> overlaps;  // by region id
+};
+
+// For each region of `from` (ids 1..from_count), the regions of `to` it overlaps. Areas are
+// measured as region_graph measures area_m2: pixel footprints on the body for a DEM mesh
+// (dem != nullptr), vertex areas for a mesh file; so one region's overlaps add up to its
+// area.
+std::vector<RegionLineage> region_lineage(const TriangleMesh& mesh, const Dem* dem,
+                                          const std::vector<std::uint32_t>& from,
+                                          std::uint32_t from_count,
+                                          const std::vector<std::uint32_t>& to,
+                                          std::uint32_t to_count);
+
+}  // namespace terrain::segment

@@ -1,0 +1,50 @@
+#include <gdal_priv.h>
+
+#include <memory>
+
+#include "dataset_files.hpp"
+#include "gdal_support.hpp"
+#include "terrain/core/error.hpp"
+#include "terrain/io/segment_outputs.hpp"
+
+namespace terrain::io {
+
+void write_label_stack(const Dem& dem, const std::vector<std::vector<std::uint32_t>>& bands,
+                       const std::vector<std::string>& descriptions, const std::string& path,
+                       bool overwrite) {
+    const auto n = static_cast<std::size_t>(dem.width) * static_cast<std::size_t>(dem.height);
+    if (bands.empty() || bands.size() != descriptions.size())
+        throw Error("write", "label stack: one description per band is needed");
+    for (const auto& b : bands)
+        if (b.size() != n) throw Error("write", "label stack: a band does not match the DEM grid");
+    ensure_gdal_registered();
+    const GdalErrorCapture errors;
+    AtomicOutput output(path, overwrite);
+    TemporaryFiles temporary(output);
+    GDALDriver* gtiff = GetGDALDriverManager()->GetDriverByName("GTiff");
+    const char* options[] = {"COMPRESS=DEFLATE", "TILED=YES", "INTERLEAVE=BAND", nullptr};
+    std::unique_ptr<GDALDataset> ds(gtiff->Create(output.temp_path().c_str(), dem.width, dem.height,
+                                                  static_cast<int>(bands.size()), GDT_UInt32,
+                                                  const_cast<char**>(options)));
+    if (!ds) throw Error("write", "cannot create '" + path + "'" + errors.suffix());
+    ds->SetGeoTransform(const_cast<double*>(dem.transform.data()));
+    if (!dem.crs_wkt.empty()) ds->SetProjection(dem.crs_wkt.c_str());
+    for (std::size_t i = 0; i < bands.size(); ++i) {
+        GDALRasterBand* band = ds->GetRasterBand(static_cast<int>(i + 1));
+        band->SetNoDataValue(0);
+        band->SetDescription(descriptions[i].c_str());
+        if (band->RasterIO(GF_Write, 0, 0, dem.width, dem.height,
+                           const_cast<std::uint32_t*>(bands[i].data()), dem.width, dem.height,
+                           GDT_UInt32, 0, 0) != CE_None)
+            throw Error("write", "writing '" + path + "' failed" + errors.suffix());
+    }
+    const auto files = dataset_files(ds.get());
+    CPLErrorReset();
+    ds.reset();
+    if (CPLGetLastErrorType() >= CE_Failure)
+        throw Error("write", "closing '" + path + "' failed" + errors.suffix());
+    commit_dataset(output, files, overwrite);
+    temporary.release();
+}
+
+}  // namespace terrain::io

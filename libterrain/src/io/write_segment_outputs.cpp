@@ -1,0 +1,80 @@
+#include <gdal_priv.h>
+
+#include <filesystem>
+
+#include "gdal_support.hpp"
+#include "terrain/core/error.hpp"
+#include "terrain/field/vertex_field.hpp"
+#include "terrain/io/output_file.hpp"
+#include "terrain/io/segment_outputs.hpp"
+
+namespace terrain::io {
+namespace {
+
+// "regions.geojson", or regions.<the driver's extension> ("regions.gpkg").
+std::string polygon_file(const std::string& driver_name) {
+    if (driver_name == "GeoJSON") return "regions.geojson";
+    ensure_gdal_registered();
+    GDALDriver* driver = GetGDALDriverManager()->GetDriverByName(driver_name.c_str());
+    const char* ext = driver ? driver->GetMetadataItem(GDAL_DMD_EXTENSION) : nullptr;
+    if (!ext || !*ext)
+        throw Error("write", "'" + driver_name +
+                                 "' is not an OGR vector driver that creates "
+                                 "files; try GeoJSON or GPKG");
+    return std::string("regions.") + ext;
+}
+
+}  // namespace
+
+std::vector<std::string> write_segment_outputs(const std::string& dir, const TriangleMesh& mesh,
+                                               const std::vector<float>& field,
+                                               const std::vector<std::uint32_t>& labels,
+                                               const segment::RegionGraph& graph, const Dem* dem,
+                                               const SegmentOutputOptions& options,
+                                               const ProgressFn& progress) {
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    if (!fs::is_directory(dir, ec))
+        throw Error("write", "'" + dir + "' is not a directory; create it first");
+    auto in_dir = [&](const std::string& name) { return (fs::path(dir) / name).string(); };
+    std::vector<std::string> names;
+    if (dem)
+        names = {"labels.tif",        polygon_file(options.polygons.driver),
+                 "adjacency.json",    "adjacency.graphml",
+                 "adjacency.geojson", "preview.png"};
+    else
+        names = {"labels.ply", "faces.seg", "adjacency.json", "adjacency.graphml",
+                 "adjacency.geojson"};
+    std::vector<std::string> paths;
+    for (const auto& name : names) paths.push_back(in_dir(name));
+    for (const auto& p : paths) check_output_path(p, options.overwrite);
+    if (dem) check_output_path(paths[0] + ".aux.xml", options.overwrite);
+
+    const bool overwrite = options.overwrite;
+    const double steps = static_cast<double>(paths.size());
+    std::size_t done = 0;
+    auto step = [&] { report_progress(progress, double(++done) / steps, "write"); };
+    if (dem) {
+        const auto pixels = segment::label_pixels(mesh, *dem, labels);
+        write_label_raster(*dem, pixels, graph, paths[0], overwrite);
+        step();
+        write_region_polygons(*dem, pixels, graph, paths[1], overwrite, options.polygons);
+        step();
+        write_preview_png(*dem, field::field_to_pixels(mesh, *dem, field), pixels, paths[5],
+                          overwrite);
+    } else {
+        write_labels_ply(mesh, field, labels, paths[0], overwrite, options.field_name);
+        step();
+        write_faces_seg(mesh, labels, paths[1], overwrite);
+    }
+    step();
+    write_adjacency_json(graph, paths[2], overwrite);
+    step();
+    write_adjacency_graphml(graph, paths[3], overwrite);
+    step();
+    write_adjacency_geojson(graph, paths[4], overwrite);
+    step();
+    return paths;
+}
+
+}  // namespace terrain::io

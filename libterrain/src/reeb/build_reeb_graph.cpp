@@ -1,0 +1,1130 @@
+// Reeb graph construction by a contour-tracking sweep (docs/reeb.md).
+//
+// Vertices are processed in increasing value; adjacent vertices with equal values form one
+// event (one node). Between two events the level set is a set of contours, each a chain of
+// "mixed" triangles (triangles with processed and unprocessed corners); every mixed triangle
+// carries the id of its contour, and each contour knows the arc of the graph it is tracing.
+// At an event P only the triangles around P change:
+//   - regular vertex (one lower and one upper run in its link): the contour passes through,
+//     the new triangles take its id, the node joins its arc; O(degree);
+//   - otherwise the upper triangles around P form segments; segments are joined into new
+//     contours by walking the old contours between their ends, all walks in lockstep, and
+//     stopping as soon as the remaining ends are determined by counting (pairs left on a
+//     closed contour, ends left for the boundary). Only the walked triangles are relabelled;
+//     the contour left unwalked keeps its id (merges use union-find on contour ids).
+// The contours entering P end their arcs at P when P is critical, and each new contour starts
+// an arc at P.
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <numeric>
+#include <string>
+
+#include "terrain/core/error.hpp"
+#include "terrain/reeb/reeb_graph.hpp"
+
+namespace terrain::reeb {
+
+const char* to_string(NodeKind kind) {
+    switch (kind) {
+        case NodeKind::minimum:
+            return "min";
+        case NodeKind::maximum:
+            return "max";
+        case NodeKind::saddle:
+            return "saddle";
+        default:
+            return "regular";
+    }
+}
+
+const char* to_string(LinkClass c) {
+    switch (c) {
+        case LinkClass::morse_minimum:
+            return "morse_minimum";
+        case LinkClass::degenerate_minimum:
+            return "degenerate_minimum";
+        case LinkClass::morse_maximum:
+            return "morse_maximum";
+        case LinkClass::degenerate_maximum:
+            return "degenerate_maximum";
+        case LinkClass::morse_saddle:
+            return "morse_saddle";
+        case LinkClass::degenerate_saddle:
+            return "degenerate_saddle";
+        case LinkClass::asymmetric_saddle:
+            return "asymmetric_saddle";
+        default:
+            return "regular";
+    }
+}
+
+LinkClass classify_link(int lower, int upper) {
+    if (upper == 0) return lower <= 1 ? LinkClass::morse_maximum : LinkClass::degenerate_maximum;
+    if (lower == 0) return upper == 1 ? LinkClass::morse_minimum : LinkClass::degenerate_minimum;
+    if (lower == upper)
+        return lower == 1   ? LinkClass::regular
+               : lower == 2 ? LinkClass::morse_saddle
+                            : LinkClass::degenerate_saddle;
+    return LinkClass::asymmetric_saddle;
+}
+
+std::size_t ReebGraph::memory_bytes() const {
+    auto bytes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
+    return bytes(node_values) + bytes(node_kinds) + bytes(node_lower_links) +
+           bytes(node_upper_links) + bytes(node_vertex_offsets) + bytes(node_vertices) +
+           bytes(vertex_nodes) + bytes(node_arcs) + bytes(arcs) + bytes(arc_offsets) +
+           bytes(arc_nodes);
+}
+
+NodeArcs node_arcs(const ReebGraph& g) {
+    NodeArcs out;
+    out.offsets.assign(g.node_count() + 1, 0);
+    for (const auto& a : g.arcs) {
+        ++out.offsets[static_cast<std::size_t>(a[0]) + 1];
+        ++out.offsets[static_cast<std::size_t>(a[1]) + 1];
+    }
+    std::partial_sum(out.offsets.begin(), out.offsets.end(), out.offsets.begin());
+    out.arcs.resize(static_cast<std::size_t>(out.offsets.back()));
+    std::vector<std::int32_t> fill(out.offsets.begin(), out.offsets.end() - 1);
+    for (std::size_t a = 0; a < g.arcs.size(); ++a)
+        for (int end = 0; end < 2; ++end)
+            out.arcs[static_cast<std::size_t>(fill[static_cast<std::size_t>(g.arcs[a][end])]++)] =
+                static_cast<std::int32_t>(a);
+    return out;
+}
+
+ReebSummary summarize(const ReebGraph& g) {
+    ReebSummary s;
+    s.nodes = g.node_count();
+    s.arcs = g.arc_count();
+    std::vector<std::int32_t> parent(g.node_count());
+    std::iota(parent.begin(), parent.end(), 0);
+    auto find = [&](std::int32_t x) {
+        while (parent[static_cast<std::size_t>(x)] != x)
+            x = parent[static_cast<std::size_t>(x)] =
+                parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(x)])];
+        return x;
+    };
+    for (const auto& a : g.arcs) parent[static_cast<std::size_t>(find(a[0]))] = find(a[1]);
+    for (std::size_t n = 0; n < g.node_count(); ++n) {
+        const NodeKind k = g.node_kinds[n];
+        if (k == NodeKind::regular) continue;
+        ++s.critical;
+        if (k == NodeKind::minimum) ++s.minima;
+        if (k == NodeKind::maximum) ++s.maxima;
+        if (k == NodeKind::saddle) ++s.saddles;
+        if (find(static_cast<std::int32_t>(n)) == static_cast<std::int32_t>(n)) ++s.components;
+        const int lo = g.node_lower_links[n], up = g.node_upper_links[n];
+        s.index_sum += (lo == 0 || up == 0) ? 1.0 : 1.0 - 0.5 * (lo + up);
+    }
+    s.loops = s.arcs + s.components - s.critical;
+    return s;
+}
+
+std::string check_reeb_graph(const ReebGraph& g, const std::vector<float>& field) {
+    const std::size_t n_nodes = g.node_count();
+    if (g.vertex_nodes.size() != field.size()) return "vertex_nodes has the wrong size";
+    std::vector<char> seen(field.size(), 0);
+    for (std::size_t n = 0; n < n_nodes; ++n) {
+        const auto b = g.node_vertex_offsets[n], e = g.node_vertex_offsets[n + 1];
+        if (b >= e) return "node " + std::to_string(n) + " has no vertex";
+        for (auto i = b; i < e; ++i) {
+            const auto v = static_cast<std::size_t>(g.node_vertices[static_cast<std::size_t>(i)]);
+            if (seen[v]++) return "vertex " + std::to_string(v) + " is in two nodes";
+            if (g.vertex_nodes[v] != static_cast<std::int32_t>(n))
+                return "vertex " + std::to_string(v) + " maps to the wrong node";
+            if (field[v] != g.node_values[n])
+                return "vertex " + std::to_string(v) + " differs from its node's value";
+        }
+    }
+    for (std::size_t v = 0; v < seen.size(); ++v)
+        if (!seen[v]) return "vertex " + std::to_string(v) + " is in no node";
+    std::vector<int> down(n_nodes, 0), up(n_nodes, 0);
+    std::vector<char> placed(n_nodes, 0);
+    for (std::size_t a = 0; a < g.arc_count(); ++a) {
+        const auto [lo, hi] = g.arcs[a];
+        if (!g.is_critical(lo) || !g.is_critical(hi))
+            return "arc " + std::to_string(a) + " ends at a regular node";
+        if (lo == hi) return "arc " + std::to_string(a) + " is a self-loop";
+        ++up[static_cast<std::size_t>(lo)];
+        ++down[static_cast<std::size_t>(hi)];
+        float prev = g.node_values[static_cast<std::size_t>(lo)];
+        for (auto i = g.arc_offsets[a]; i < g.arc_offsets[a + 1]; ++i) {
+            const auto r = static_cast<std::size_t>(g.arc_nodes[static_cast<std::size_t>(i)]);
+            if (g.is_critical(static_cast<std::int32_t>(r)) ||
+                g.node_arcs[r] != static_cast<std::int32_t>(a) || placed[r]++)
+                return "arc " + std::to_string(a) + " lists node " + std::to_string(r) + " wrongly";
+            if (g.node_values[r] < prev)
+                return "arc " + std::to_string(a) + " is not sorted by value";
+            prev = g.node_values[r];
+        }
+        if (g.node_values[static_cast<std::size_t>(hi)] < prev)
+            return "arc " + std::to_string(a) + " goes downwards";
+    }
+    for (std::size_t n = 0; n < n_nodes; ++n) {
+        const NodeKind k = g.node_kinds[n];
+        const bool ok = k == NodeKind::regular   ? (placed[n] && !down[n] && !up[n])
+                        : k == NodeKind::minimum ? (down[n] == 0)
+                        : k == NodeKind::maximum
+                            ? (up[n] == 0 && down[n] > 0)
+                            : (down[n] > 0 && up[n] > 0 && down[n] + up[n] >= 3);
+        if (!ok) return "node " + std::to_string(n) + " (" + to_string(k) + ") has wrong arcs";
+    }
+    return {};
+}
+
+namespace {
+
+using i32 = std::int32_t;
+constexpr i32 kNone = -1;
+
+inline std::size_t z(i32 i) {
+    return static_cast<std::size_t>(i);
+}
+
+// Half-edge h = 3*t + k runs from corner k of triangle t to corner (k+1)%3.
+inline i32 next_he(i32 h) {
+    return h % 3 == 2 ? h - 2 : h + 1;
+}
+inline i32 prev_he(i32 h) {
+    return h % 3 == 0 ? h + 2 : h - 1;
+}
+
+struct Topology {
+    std::vector<i32> twin;        // opposite half-edge, kNone on the boundary
+    std::vector<i32> vertex_out;  // a half-edge leaving each vertex; on the boundary, the one
+                                  // with no twin, so that rotating covers the whole fan
+};
+
+Topology build_topology(const TriangleMesh& mesh) {
+    const auto& off = mesh.neighbor_offsets;
+    const auto& nb = mesh.neighbors;
+    auto slot = [&](i32 a, i32 b) -> i32 {
+        const auto first = nb.begin() + off[z(a)], last = nb.begin() + off[z(a) + 1];
+        const auto it = std::lower_bound(first, last, b);
+        return (it != last && *it == b) ? static_cast<i32>(it - nb.begin()) : kNone;
+    };
+    Topology topo;
+    const std::size_t n_he = mesh.triangle_count() * 3;
+    std::vector<i32> at_slot(nb.size(), kNone);
+    topo.twin.assign(n_he, kNone);
+    for (std::size_t h = 0; h < n_he; ++h) {
+        const auto& tri = mesh.triangles[h / 3];
+        const i32 a = tri[h % 3], b = tri[(h + 1) % 3];
+        const i32 s = slot(a, b);
+        if (s == kNone) throw Error("reeb", "the mesh adjacency does not match its triangles");
+        if (at_slot[z(s)] != kNone)
+            throw Error("reeb", "edge " + std::to_string(a) + "-" + std::to_string(b) +
+                                    " is used twice in the same direction (non-manifold or "
+                                    "inconsistently oriented mesh)");
+        at_slot[z(s)] = static_cast<i32>(h);
+    }
+    topo.vertex_out.assign(mesh.vertex_count(), kNone);
+    for (std::size_t h = 0; h < n_he; ++h) {
+        const auto& tri = mesh.triangles[h / 3];
+        const i32 a = tri[h % 3], b = tri[(h + 1) % 3];
+        const i32 t = at_slot[z(slot(b, a))];
+        topo.twin[h] = t;
+        if (t == kNone || topo.vertex_out[z(a)] == kNone)
+            topo.vertex_out[z(a)] = static_cast<i32>(h);
+    }
+    // A boundary vertex must start at its boundary half-edge: prefer it over interior ones.
+    for (std::size_t h = 0; h < n_he; ++h)
+        if (topo.twin[h] == kNone)
+            topo.vertex_out[z(mesh.triangles[h / 3][h % 3])] = static_cast<i32>(h);
+    return topo;
+}
+
+// Sort key of a float: monotonic unsigned bits (-0 taken as +0).
+inline std::uint32_t float_key(float f) {
+    if (f == 0.0f) f = 0.0f;
+    const auto u = std::bit_cast<std::uint32_t>(f);
+    return (u & 0x80000000u) ? ~u : (u | 0x80000000u);
+}
+
+// Sorts the vertices into events (nodes) in increasing value: adjacent vertices with equal
+// values form one event; other ties go by the plateau's lowest vertex, then by vertex. Fills
+// the graph's node_vertex_offsets, node_vertices and vertex_nodes.
+void order_events(const TriangleMesh& mesh, const std::vector<float>& field, ReebGraph& g) {
+    const std::size_t nv = field.size();
+    std::vector<i32> rep(nv);
+    std::iota(rep.begin(), rep.end(), 0);
+    bool any_plateau = false;
+    auto root = [&](i32 x) {
+        while (rep[z(x)] != x) x = rep[z(x)] = rep[z(rep[z(x)])];
+        return x;
+    };
+    for (std::size_t v = 0; v < nv; ++v)
+        for (auto i = mesh.neighbor_offsets[v]; i < mesh.neighbor_offsets[v + 1]; ++i) {
+            const i32 w = mesh.neighbors[z(i)];
+            if (z(w) > v && field[z(w)] == field[v]) {
+                const i32 a = root(static_cast<i32>(v)), b = root(w);
+                if (a != b) rep[z(std::max(a, b))] = std::min(a, b);
+                any_plateau = true;
+            }
+        }
+    if (any_plateau)
+        for (std::size_t v = 0; v < nv; ++v) rep[v] = root(static_cast<i32>(v));
+
+    // Stable LSD radix sort on (value bits, plateau), 16 bits per pass; ties keep vertex order.
+    struct Key {
+        std::uint64_t key;
+        i32 vertex;
+    };
+    std::vector<Key> keys(nv), tmp(nv);
+    for (std::size_t v = 0; v < nv; ++v)
+        keys[v] = {(std::uint64_t{float_key(field[v])} << 32) | static_cast<std::uint32_t>(rep[v]),
+                   static_cast<i32>(v)};
+    std::vector<std::uint32_t> count(65537);
+    for (int shift = 0; shift < 64; shift += 16) {
+        std::fill(count.begin(), count.end(), 0u);
+        for (const Key& k : keys) ++count[((k.key >> shift) & 0xffffu) + 1];
+        if (count[((keys.empty() ? 0 : keys[0].key >> shift) & 0xffffu) + 1] == nv) continue;
+        for (std::size_t i = 1; i < count.size(); ++i) count[i] += count[i - 1];
+        for (const Key& k : keys) tmp[count[(k.key >> shift) & 0xffffu]++] = k;
+        keys.swap(tmp);
+    }
+    g.node_vertices.resize(nv);
+    g.vertex_nodes.resize(nv);
+    g.node_vertex_offsets.clear();
+    g.node_vertex_offsets.reserve(nv + 1);
+    for (std::size_t i = 0; i < nv; ++i) {
+        if (i == 0 || keys[i].key != keys[i - 1].key)
+            g.node_vertex_offsets.push_back(static_cast<i32>(i));
+        g.node_vertices[i] = keys[i].vertex;
+        g.vertex_nodes[z(keys[i].vertex)] = static_cast<i32>(g.node_vertex_offsets.size() - 1);
+    }
+    g.node_vertex_offsets.push_back(static_cast<i32>(nv));
+    g.node_vertex_offsets.shrink_to_fit();
+    const std::size_t n_nodes = g.node_vertex_offsets.size() - 1;
+    g.node_values.resize(n_nodes);
+    for (std::size_t e = 0; e < n_nodes; ++e)
+        g.node_values[e] = field[z(g.node_vertices[z(g.node_vertex_offsets[e])])];
+}
+
+// True when the Reeb graph of any field on the mesh is a tree: every connected component is
+// of genus 0 with at most one boundary loop (a disk or a sphere).
+bool loop_free(const TriangleMesh& mesh) {
+    const std::size_t nv = mesh.vertex_count();
+    std::vector<i32> comp(nv);
+    std::iota(comp.begin(), comp.end(), 0);
+    auto root = [&](std::vector<i32>& p, i32 x) {
+        while (p[z(x)] != x) x = p[z(x)] = p[z(p[z(x)])];
+        return x;
+    };
+    for (const auto& t : mesh.triangles)
+        for (int k = 0; k < 2; ++k) {
+            const i32 a = root(comp, t[z(k)]), b = root(comp, t[z(k + 1)]);
+            if (a != b) comp[z(std::max(a, b))] = std::min(a, b);
+        }
+    // Per component: 2 - chi - b = 2 g must be 0, and b <= 1.
+    const auto& off = mesh.neighbor_offsets;
+    const auto& nb = mesh.neighbors;
+    std::vector<std::uint8_t> uses(nb.size(), 0);
+    for (const auto& t : mesh.triangles)
+        for (int k = 0; k < 3; ++k) {
+            const i32 a = std::min(t[z(k)], t[z((k + 1) % 3)]),
+                      b = std::max(t[z(k)], t[z((k + 1) % 3)]);
+            const auto first = nb.begin() + off[z(a)], last = nb.begin() + off[z(a) + 1];
+            const auto it = std::lower_bound(first, last, b);
+            if (it != last && *it == b && uses[z(static_cast<i32>(it - nb.begin()))] < 2)
+                ++uses[z(static_cast<i32>(it - nb.begin()))];
+        }
+    std::vector<i32> bparent(nv);
+    std::iota(bparent.begin(), bparent.end(), 0);
+    std::vector<std::int64_t> chi(nv, 0);
+    std::vector<char> on_boundary(nv, 0);
+    for (std::size_t v = 0; v < nv; ++v) {
+        const i32 c = root(comp, static_cast<i32>(v));
+        chi[z(c)] += 1;
+        for (i32 i = off[v]; i < off[v + 1]; ++i) {
+            const i32 w = nb[z(i)];
+            if (z(w) <= v) continue;
+            chi[z(c)] -= 1;
+            if (uses[z(i)] == 1) {
+                on_boundary[v] = on_boundary[z(w)] = 1;
+                const i32 a = root(bparent, static_cast<i32>(v)), b = root(bparent, w);
+                if (a != b) bparent[z(std::max(a, b))] = std::min(a, b);
+            }
+        }
+    }
+    for (const auto& t : mesh.triangles) chi[z(root(comp, t[0]))] += 1;
+    std::vector<std::int64_t> loops(nv, 0);
+    for (std::size_t v = 0; v < nv; ++v)
+        if (on_boundary[v] && root(bparent, static_cast<i32>(v)) == static_cast<i32>(v))
+            ++loops[z(root(comp, static_cast<i32>(v)))];
+    for (std::size_t v = 0; v < nv; ++v)
+        if (comp[v] == static_cast<i32>(v) && (loops[v] > 1 || 2 - chi[v] - loops[v] != 0))
+            return false;
+    return true;
+}
+
+// Numbers of connected components of each critical node's lower and upper links (the link
+// graph: the vertices around the node and the star's edges between them).
+void classify_links(const TriangleMesh& mesh, ReebGraph& g) {
+    const std::size_t nv = mesh.vertex_count();
+    std::vector<i32> tri_off(nv + 1, 0), tris(mesh.triangle_count() * 3);
+    for (const auto& t : mesh.triangles)
+        for (const i32 c : t) ++tri_off[z(c) + 1];
+    std::partial_sum(tri_off.begin(), tri_off.end(), tri_off.begin());
+    {
+        std::vector<i32> fill(tri_off.begin(), tri_off.end() - 1);
+        for (std::size_t t = 0; t < mesh.triangle_count(); ++t)
+            for (const i32 c : mesh.triangles[t]) tris[z(fill[z(c)]++)] = static_cast<i32>(t);
+    }
+    std::vector<i32> verts, parent;
+    for (std::size_t n = 0; n < g.node_count(); ++n) {
+        if (g.node_kinds[n] == NodeKind::regular) {
+            g.node_lower_links[n] = g.node_upper_links[n] = 1;
+            continue;
+        }
+        const i32 e = static_cast<i32>(n);
+        verts.clear();
+        for (i32 i = g.node_vertex_offsets[n]; i < g.node_vertex_offsets[n + 1]; ++i) {
+            const i32 v = g.node_vertices[z(i)];
+            for (i32 k = mesh.neighbor_offsets[z(v)]; k < mesh.neighbor_offsets[z(v) + 1]; ++k)
+                if (g.vertex_nodes[z(mesh.neighbors[z(k)])] != e)
+                    verts.push_back(mesh.neighbors[z(k)]);
+        }
+        if (g.node_vertex_offsets[n + 1] - g.node_vertex_offsets[n] > 1) {  // CSR lists are sorted
+            std::sort(verts.begin(), verts.end());
+            verts.erase(std::unique(verts.begin(), verts.end()), verts.end());
+        }
+        parent.resize(verts.size());
+        std::iota(parent.begin(), parent.end(), 0);
+        auto index = [&](i32 v) {
+            if (verts.size() <= 16) {
+                i32 i = 0;
+                while (verts[z(i)] != v) ++i;
+                return i;
+            }
+            return static_cast<i32>(std::lower_bound(verts.begin(), verts.end(), v) -
+                                    verts.begin());
+        };
+        auto find = [&](i32 x) {
+            while (parent[z(x)] != x) x = parent[z(x)] = parent[z(parent[z(x)])];
+            return x;
+        };
+        for (i32 i = g.node_vertex_offsets[n]; i < g.node_vertex_offsets[n + 1]; ++i) {
+            const i32 v = g.node_vertices[z(i)];
+            for (i32 k = tri_off[z(v)]; k < tri_off[z(v) + 1]; ++k) {
+                const auto& t = mesh.triangles[z(tris[z(k)])];
+                // Only the edge opposite v can join two link vertices.
+                const int j = t[0] == v ? 1 : t[1] == v ? 2 : 0;
+                {
+                    const i32 a = t[z(j)], b = t[z((j + 1) % 3)];
+                    const i32 na = g.vertex_nodes[z(a)], nb = g.vertex_nodes[z(b)];
+                    if (na == e || nb == e || (na < e) != (nb < e)) continue;
+                    const i32 ra = find(index(a)), rb = find(index(b));
+                    if (ra != rb) parent[z(ra)] = rb;
+                }
+            }
+        }
+        int lower = 0, upper = 0;
+        for (std::size_t i = 0; i < verts.size(); ++i)
+            if (find(static_cast<i32>(i)) == static_cast<i32>(i))
+                ++(g.vertex_nodes[z(verts[i])] < e ? lower : upper);
+        g.node_lower_links[n] = static_cast<std::uint8_t>(std::min(lower, 255));
+        g.node_upper_links[n] = static_cast<std::uint8_t>(std::min(upper, 255));
+    }
+}
+
+// The contour tree of a loop-free mesh (Carr, Snoeyink & Axen): join and split trees by
+// union-find sweeps over the events, merged leaf by leaf into the augmented contour tree,
+// whose chains of regular nodes become the arcs.
+void contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& progress) {
+    const std::size_t nn = g.node_count();
+    std::vector<i32> uf(nn), head(nn), jp(nn, kNone), sp(nn, kNone), jc(nn, 0), sc(nn, 0),
+        mark(nn, kNone);
+    std::vector<std::uint8_t> rank(nn);
+    auto find = [&](i32 x) {
+        i32 r = x;
+        while (uf[z(r)] != r) r = uf[z(r)];
+        while (uf[z(x)] != r) {
+            const i32 nx = uf[z(x)];
+            uf[z(x)] = r;
+            x = nx;
+        }
+        return r;
+    };
+    // Union by rank; head[root] is the last event added to the component.
+    auto sweep = [&](bool ascending, std::vector<i32>& parent, std::vector<i32>& children) {
+        std::iota(uf.begin(), uf.end(), 0);
+        std::iota(head.begin(), head.end(), 0);
+        std::fill(rank.begin(), rank.end(), 0);
+        std::fill(mark.begin(), mark.end(), kNone);
+        for (std::size_t k = 0; k < nn; ++k) {
+            const i32 e = static_cast<i32>(ascending ? k : nn - 1 - k);
+            i32 cur = e;
+            mark[z(e)] = e;
+            for (i32 i = g.node_vertex_offsets[z(e)]; i < g.node_vertex_offsets[z(e) + 1]; ++i) {
+                const i32 v = g.node_vertices[z(i)];
+                for (i32 j = mesh.neighbor_offsets[z(v)]; j < mesh.neighbor_offsets[z(v) + 1];
+                     ++j) {
+                    const i32 n = g.vertex_nodes[z(mesh.neighbors[z(j)])];
+                    if (ascending ? n >= e : n <= e) continue;
+                    const i32 c = find(n);
+                    if (mark[z(c)] == e) continue;
+                    parent[z(head[z(c)])] = e;
+                    ++children[z(e)];
+                    i32 r = cur, o = c;
+                    if (rank[z(r)] < rank[z(o)]) std::swap(r, o);
+                    if (rank[z(r)] == rank[z(o)]) ++rank[z(r)];
+                    uf[z(o)] = r;
+                    mark[z(r)] = e;
+                    head[z(r)] = e;
+                    cur = r;
+                }
+            }
+        }
+    };
+    sweep(true, jp, jc);
+    report_progress(progress, 0.45, "reeb: join tree");
+    sweep(false, sp, sc);
+    report_progress(progress, 0.6, "reeb: split tree");
+
+    // Merge: remove leaves one by one; each removal is one edge of the augmented tree.
+    std::vector<char> dead(nn, 0);
+    auto next_alive = [&](std::vector<i32>& parent, i32 x) {
+        i32 p = parent[z(x)];
+        while (p != kNone && dead[z(p)]) p = parent[z(p)];
+        for (i32 q = parent[z(x)]; q != p;) {
+            const i32 nx = parent[z(q)];
+            parent[z(q)] = p;
+            q = nx;
+        }
+        parent[z(x)] = p;
+        return p;
+    };
+    auto is_leaf = [&](i32 x) {
+        return (jc[z(x)] == 0 && sc[z(x)] == 1) || (sc[z(x)] == 0 && jc[z(x)] == 1);
+    };
+    std::vector<i32> queue, attach(nn, kNone), up_deg(nn, 0), down_deg(nn, 0);
+    std::vector<char> goes_up(nn, 0);
+    queue.reserve(nn);
+    for (std::size_t n = 0; n < nn; ++n)
+        if (is_leaf(static_cast<i32>(n))) queue.push_back(static_cast<i32>(n));
+    for (std::size_t qi = 0; qi < queue.size(); ++qi) {
+        const i32 x = queue[qi];
+        if (dead[z(x)] || !is_leaf(x)) continue;
+        const bool lower = jc[z(x)] == 0;
+        const i32 y = next_alive(lower ? jp : sp, x);
+        if (y == kNone) throw Error("reeb", "internal error: contour tree leaf without parent");
+        dead[z(x)] = 1;
+        attach[z(x)] = y;
+        goes_up[z(x)] = lower;
+        if (lower) {
+            --jc[z(y)];
+            ++up_deg[z(x)];
+            ++down_deg[z(y)];
+        } else {
+            --sc[z(y)];
+            ++down_deg[z(x)];
+            ++up_deg[z(y)];
+        }
+        if (is_leaf(y)) queue.push_back(y);
+    }
+    report_progress(progress, 0.75, "reeb: contour tree");
+
+    // Up-edges per node (CSR), then arcs from every critical node upwards.
+    std::vector<i32> up_off(nn + 1, 0), up_to(nn);
+    for (std::size_t x = 0; x < nn; ++x)
+        if (attach[x] != kNone) ++up_off[z(goes_up[x] ? static_cast<i32>(x) : attach[x]) + 1];
+    std::partial_sum(up_off.begin(), up_off.end(), up_off.begin());
+    {
+        std::vector<i32> fill(up_off.begin(), up_off.end() - 1);
+        for (std::size_t x = 0; x < nn; ++x) {
+            if (attach[x] == kNone) continue;
+            const i32 lo = goes_up[x] ? static_cast<i32>(x) : attach[x];
+            const i32 hi = goes_up[x] ? attach[x] : static_cast<i32>(x);
+            up_to[z(fill[z(lo)]++)] = hi;
+        }
+    }
+    g.node_kinds.assign(nn, NodeKind::regular);
+    g.node_arcs.assign(nn, kNone);
+    for (std::size_t n = 0; n < nn; ++n) {
+        const int d = down_deg[n], u = up_deg[n];
+        if (d == 1 && u == 1) continue;
+        g.node_kinds[n] = d == 0   ? NodeKind::minimum
+                          : u == 0 ? NodeKind::maximum
+                                   : NodeKind::saddle;
+    }
+    g.arcs.clear();
+    g.arc_offsets.assign(1, 0);
+    g.arc_nodes.clear();
+    g.arc_nodes.reserve(nn);
+    for (std::size_t c = 0; c < nn; ++c) {
+        if (g.node_kinds[c] == NodeKind::regular) continue;
+        for (i32 k = up_off[c]; k < up_off[c + 1]; ++k) {
+            const i32 arc = static_cast<i32>(g.arcs.size());
+            i32 n = up_to[z(k)];
+            while (g.node_kinds[z(n)] == NodeKind::regular) {
+                g.arc_nodes.push_back(n);
+                g.node_arcs[z(n)] = arc;
+                n = up_to[z(up_off[z(n)])];
+            }
+            g.arcs.push_back({static_cast<i32>(c), n});
+            g.arc_offsets.push_back(static_cast<i32>(g.arc_nodes.size()));
+        }
+    }
+    g.node_lower_links.assign(nn, 1);
+    g.node_upper_links.assign(nn, 1);
+    classify_links(mesh, g);
+}
+
+class Sweep {
+  public:
+    Sweep(const TriangleMesh& mesh, const std::vector<float>& field, ReebGraph& g)
+        : mesh_(mesh), field_(field), g_(g) {}
+
+    void run(const ProgressFn& progress);
+
+  private:
+    struct Contour {
+        i32 parent;
+        i32 arc;
+        i32 open;  // boundary ends (0 for a closed contour, 2 for a path)
+    };
+    struct ArcBuild {
+        i32 lower, upper, head, tail, count;
+    };
+    struct End {
+        i32 segment;  // local index of its segment's first triangle (union-find root later)
+        i32 s_he;     // half-edge of the new triangle on the exit edge
+        i32 label;    // old contour across the exit
+        i32 cur;      // walk position: half-edge through which the current triangle was entered
+        i32 partner;  // paired end
+        i32 walk;     // index of its visited-triangle buffer
+        std::int8_t state;  // 0 open, 1 paired, 2 boundary
+        bool complete;      // the piece to its destination was walked to the end
+    };
+
+    void process_event(i32 e, i32 begin, i32 end);
+    bool try_regular(i32 e, i32 v);
+    void general_event(i32 e, i32 begin, i32 end);
+
+    bool processed(i32 v, i32 e) const { return g_.vertex_nodes[z(v)] <= e; }
+    bool in_event(i32 t, i32 e) const {
+        const auto& tri = mesh_.triangles[z(t)];
+        return g_.vertex_nodes[z(tri[0])] == e || g_.vertex_nodes[z(tri[1])] == e ||
+               g_.vertex_nodes[z(tri[2])] == e;
+    }
+    i32 find(i32 c) {
+        while (contours_[z(c)].parent != c) {
+            const i32 p = contours_[z(c)].parent;
+            contours_[z(c)].parent = contours_[z(p)].parent;
+            c = p;
+        }
+        return c;
+    }
+    i32 new_contour(i32 arc, i32 open) {
+        contours_.push_back({static_cast<i32>(contours_.size()), arc, open});
+        return static_cast<i32>(contours_.size() - 1);
+    }
+    i32 new_arc(i32 lower) {
+        arcs_.push_back({lower, kNone, kNone, kNone, 0});
+        return static_cast<i32>(arcs_.size() - 1);
+    }
+    void append_regular(i32 arc, i32 node) {
+        auto& a = arcs_[z(arc)];
+        if (a.tail == kNone)
+            a.head = node;
+        else
+            node_next_[z(a.tail)] = node;
+        a.tail = node;
+        ++a.count;
+        g_.node_arcs[z(node)] = arc;
+    }
+    // One walk step from end i; returns 0 (going on), 1 (arrived at another end), 2 (boundary).
+    int step(i32 i, i32 e);
+    i32 end_at(i32 s_he) const;
+    void deduce(i32 label);
+    void finish_graph();
+
+    const TriangleMesh& mesh_;
+    const std::vector<float>& field_;
+    ReebGraph& g_;
+    Topology topo_;
+    std::vector<i32> tri_label_;
+    std::vector<Contour> contours_;
+    std::vector<ArcBuild> arcs_;
+    std::vector<i32> node_next_;
+
+    // Scratch for general events, reused.
+    std::vector<i32> star_, seg_parent_, seg_bnd_, d_in_;
+    std::vector<End> ends_;
+    std::vector<std::pair<i32, i32>> end_index_;  // (s_he, end) sorted
+    std::vector<std::vector<i32>> walks_;
+    struct LabelCount {
+        i32 label, unresolved, need_boundary;
+    };
+    std::vector<LabelCount> label_counts_;
+    std::vector<i32> link_vertices_, link_parent_;
+};
+
+void Sweep::run(const ProgressFn& progress) {
+    topo_ = build_topology(mesh_);
+    report_progress(progress, 0.1, "reeb: topology");
+    order_events(mesh_, field_, g_);
+    report_progress(progress, 0.3, "reeb: order");
+    const std::size_t n_nodes = g_.node_vertex_offsets.size() - 1;
+    g_.node_kinds.assign(n_nodes, NodeKind::regular);
+    g_.node_lower_links.assign(n_nodes, 0);
+    g_.node_upper_links.assign(n_nodes, 0);
+    g_.node_arcs.assign(n_nodes, kNone);
+    node_next_.assign(n_nodes, kNone);
+    tri_label_.assign(mesh_.triangle_count(), kNone);
+    contours_.reserve(1024);
+    arcs_.reserve(1024);
+    const std::size_t step = std::max<std::size_t>(n_nodes / 50, 1);
+    for (std::size_t e = 0; e < n_nodes; ++e) {
+        const i32 b = g_.node_vertex_offsets[e], en = g_.node_vertex_offsets[e + 1];
+        process_event(static_cast<i32>(e), b, en);
+        if (e % step == 0)
+            report_progress(progress, 0.3 + 0.65 * static_cast<double>(e) / n_nodes, "reeb");
+    }
+    finish_graph();
+    report_progress(progress, 1.0, "reeb");
+}
+
+void Sweep::process_event(i32 e, i32 begin, i32 end) {
+    if (end - begin == 1 && try_regular(e, g_.node_vertices[z(begin)])) return;
+    general_event(e, begin, end);
+}
+
+// The common case: a single vertex whose link has one lower and one upper run.
+bool Sweep::try_regular(i32 e, i32 v) {
+    const i32 h0 = topo_.vertex_out[z(v)];
+    if (h0 == kNone) return false;
+    const bool boundary = topo_.twin[z(h0)] == kNone;
+    // Walk the fan: for each triangle, its corner after v (the link vertex) is `a`.
+    int changes = 0, lower_runs = 0, upper_runs = 0;
+    i32 label_tri = kNone;
+    bool first_lower = false, last_lower = false;
+    i32 h = h0;
+    bool first = true;
+    for (;;) {
+        const i32 t = h / 3;
+        const i32 a = mesh_.triangles[z(t)][z((h + 1) % 3)];
+        const bool lower = g_.vertex_nodes[z(a)] < e;
+        if (first) {
+            first_lower = lower;
+            (lower ? lower_runs : upper_runs) = 1;
+            first = false;
+        } else if (lower != last_lower) {
+            ++changes;
+            ++(lower ? lower_runs : upper_runs);
+        }
+        last_lower = lower;
+        if (label_tri == kNone && lower) label_tri = t;
+        const i32 in = prev_he(h);
+        const i32 tw = topo_.twin[z(in)];
+        if (tw == kNone) {  // boundary: the last link vertex is the far corner of this triangle
+            const i32 b = mesh_.triangles[z(t)][z((h + 2) % 3)];
+            const bool bl = g_.vertex_nodes[z(b)] < e;
+            if (bl != last_lower) {
+                ++changes;
+                ++(bl ? lower_runs : upper_runs);
+            }
+            if (label_tri == kNone && bl) label_tri = t;
+            break;
+        }
+        h = tw;
+        if (h == h0) break;
+        if (changes > 2) return false;
+    }
+    if (!boundary) {
+        if (first_lower != last_lower) ++changes;
+        if (changes != 2) return false;
+    } else if (lower_runs != 1 || upper_runs != 1) {
+        return false;
+    }
+    const i32 c = find(tri_label_[z(label_tri)]);
+    // Relabel the triangles that stay mixed (those with an upper corner).
+    h = h0;
+    for (;;) {
+        const i32 t = h / 3;
+        const auto& tri = mesh_.triangles[z(t)];
+        if (g_.vertex_nodes[z(tri[0])] > e || g_.vertex_nodes[z(tri[1])] > e ||
+            g_.vertex_nodes[z(tri[2])] > e)
+            tri_label_[z(t)] = c;
+        const i32 tw = topo_.twin[z(prev_he(h))];
+        if (tw == kNone || tw == h0) break;
+        h = tw;
+    }
+    g_.node_lower_links[z(e)] = 1;
+    g_.node_upper_links[z(e)] = 1;
+    append_regular(contours_[z(c)].arc, e);
+    return true;
+}
+
+i32 Sweep::end_at(i32 s_he) const {
+    const auto it =
+        std::lower_bound(end_index_.begin(), end_index_.end(), std::make_pair(s_he, kNone));
+    return (it != end_index_.end() && it->first == s_he) ? it->second : kNone;
+}
+
+int Sweep::step(i32 i, i32 e) {
+    End& en = ends_[z(i)];
+    const i32 t = en.cur / 3;
+    const auto& tri = mesh_.triangles[z(t)];
+    walks_[z(en.walk)].push_back(t);
+    i32 out = kNone;
+    for (i32 k = 1; k <= 2; ++k) {
+        const i32 j = (en.cur % 3 + k) % 3;
+        if (processed(tri[z(j)], e) != processed(tri[z((j + 1) % 3)], e)) {
+            out = 3 * t + j;
+            break;
+        }
+    }
+    if (out == kNone) throw Error("reeb", "internal error: a contour walk lost its way");
+    const i32 nxt = topo_.twin[z(out)];
+    if (nxt == kNone) return 2;
+    if (in_event(nxt / 3, e)) {
+        en.partner = end_at(nxt);
+        if (en.partner == kNone) throw Error("reeb", "internal error: a contour walk met no end");
+        return 1;
+    }
+    en.cur = nxt;
+    return 0;
+}
+
+// Ends of one old contour that are still open are settled by counting when possible: as many
+// as the boundary ends still to be met all go to the boundary; two with none to meet pair up.
+void Sweep::deduce(i32 label) {
+    for (auto& lc : label_counts_) {
+        if (lc.label != label) continue;
+        if (lc.unresolved == 0) return;
+        if (lc.unresolved == lc.need_boundary) {
+            for (auto& en : ends_)
+                if (en.label == label && en.state == 0) en.state = 2;
+            lc.need_boundary = lc.unresolved = 0;
+        } else if (lc.need_boundary == 0 && lc.unresolved == 2) {
+            i32 a = kNone;
+            for (std::size_t i = 0; i < ends_.size(); ++i) {
+                auto& en = ends_[i];
+                if (en.label != label || en.state != 0) continue;
+                if (a == kNone) {
+                    a = static_cast<i32>(i);
+                } else {
+                    en.state = ends_[z(a)].state = 1;
+                    en.partner = a;
+                    ends_[z(a)].partner = static_cast<i32>(i);
+                }
+            }
+            lc.unresolved = 0;
+        }
+        return;
+    }
+}
+
+void Sweep::general_event(i32 e, i32 begin, i32 end) {
+    // 1. The star of the event: every triangle with a corner in it, once.
+    star_.clear();
+    for (i32 i = begin; i < end; ++i) {
+        const i32 v = g_.node_vertices[z(i)];
+        const i32 h0 = topo_.vertex_out[z(v)];
+        if (h0 == kNone) continue;
+        i32 h = h0;
+        for (;;) {
+            const i32 t = h / 3;
+            // Keep the triangle only from its lowest-numbered corner in the event.
+            i32 owner = v;
+            for (const i32 c : mesh_.triangles[z(t)])
+                if (g_.vertex_nodes[z(c)] == e) owner = std::min(owner, c);
+            if (owner == v) star_.push_back(t);
+            const i32 tw = topo_.twin[z(prev_he(h))];
+            if (tw == kNone || tw == h0) break;
+            h = tw;
+        }
+    }
+    std::sort(star_.begin(), star_.end());
+    auto star_index = [&](i32 t) {
+        return static_cast<i32>(std::lower_bound(star_.begin(), star_.end(), t) - star_.begin());
+    };
+
+    // 2. Contours entering the event (before it is processed), their boundary ends inside the
+    //    star, and the link components for the node's classification.
+    d_in_.clear();
+    label_counts_.clear();
+    link_vertices_.clear();
+    for (const i32 t : star_) {
+        const auto& tri = mesh_.triangles[z(t)];
+        bool has_lower = false;
+        for (const i32 c : tri) {
+            const i32 n = g_.vertex_nodes[z(c)];
+            if (n != e) link_vertices_.push_back(c);
+            has_lower |= n < e;
+        }
+        if (!has_lower) continue;
+        const i32 c = find(tri_label_[z(t)]);
+        tri_label_[z(t)] = c;
+        if (std::find(d_in_.begin(), d_in_.end(), c) == d_in_.end()) {
+            d_in_.push_back(c);
+            label_counts_.push_back({c, 0, contours_[z(c)].open});
+        }
+        for (i32 j = 0; j < 3; ++j) {
+            if (topo_.twin[z(3 * t + j)] != kNone) continue;
+            const bool pa = g_.vertex_nodes[z(tri[z(j)])] < e;
+            const bool pb = g_.vertex_nodes[z(tri[z((j + 1) % 3)])] < e;
+            if (pa != pb)
+                for (auto& lc : label_counts_)
+                    if (lc.label == c) --lc.need_boundary;
+        }
+    }
+    // Link components: union-find over the link vertices joined by the star's edges.
+    std::sort(link_vertices_.begin(), link_vertices_.end());
+    link_vertices_.erase(std::unique(link_vertices_.begin(), link_vertices_.end()),
+                         link_vertices_.end());
+    link_parent_.resize(link_vertices_.size());
+    std::iota(link_parent_.begin(), link_parent_.end(), 0);
+    auto link_root = [&](i32 x) {
+        while (link_parent_[z(x)] != x)
+            x = link_parent_[z(x)] = link_parent_[z(link_parent_[z(x)])];
+        return x;
+    };
+    auto link_index = [&](i32 v) {
+        return static_cast<i32>(std::lower_bound(link_vertices_.begin(), link_vertices_.end(), v) -
+                                link_vertices_.begin());
+    };
+    for (const i32 t : star_) {
+        const auto& tri = mesh_.triangles[z(t)];
+        for (i32 j = 0; j < 3; ++j) {
+            const i32 a = tri[z(j)], b = tri[z((j + 1) % 3)];
+            const i32 na = g_.vertex_nodes[z(a)], nb = g_.vertex_nodes[z(b)];
+            if (na == e || nb == e || (na < e) != (nb < e)) continue;
+            const i32 ra = link_root(link_index(a)), rb = link_root(link_index(b));
+            if (ra != rb) link_parent_[z(ra)] = rb;
+        }
+    }
+    int lower_links = 0, upper_links = 0;
+    for (std::size_t i = 0; i < link_vertices_.size(); ++i)
+        if (link_root(static_cast<i32>(i)) == static_cast<i32>(i))
+            ++(g_.vertex_nodes[z(link_vertices_[i])] < e ? lower_links : upper_links);
+    g_.node_lower_links[z(e)] = static_cast<std::uint8_t>(std::min(lower_links, 255));
+    g_.node_upper_links[z(e)] = static_cast<std::uint8_t>(std::min(upper_links, 255));
+
+    // 3. The event is processed from here on. Segments: new mixed triangles of the star joined
+    //    across active edges; their exits into the old contours are the ends.
+    const std::size_t ns = star_.size();
+    seg_parent_.assign(ns, kNone);
+    seg_bnd_.assign(ns, 0);
+    auto seg_root = [&](i32 x) {
+        while (seg_parent_[z(x)] != x) x = seg_parent_[z(x)] = seg_parent_[z(seg_parent_[z(x)])];
+        return x;
+    };
+    for (std::size_t i = 0; i < ns; ++i) {
+        const auto& tri = mesh_.triangles[z(star_[i])];
+        if (g_.vertex_nodes[z(tri[0])] > e || g_.vertex_nodes[z(tri[1])] > e ||
+            g_.vertex_nodes[z(tri[2])] > e)
+            seg_parent_[i] = static_cast<i32>(i);
+    }
+    ends_.clear();
+    end_index_.clear();
+    std::size_t n_walks = 0;
+    for (std::size_t i = 0; i < ns; ++i) {
+        if (seg_parent_[i] == kNone) continue;
+        const i32 t = star_[i];
+        const auto& tri = mesh_.triangles[z(t)];
+        for (i32 j = 0; j < 3; ++j) {
+            if (processed(tri[z(j)], e) == processed(tri[z((j + 1) % 3)], e)) continue;
+            const i32 h = 3 * t + j;
+            const i32 tw = topo_.twin[z(h)];
+            if (tw == kNone) {
+                ++seg_bnd_[i];
+            } else if (in_event(tw / 3, e)) {
+                const i32 a = seg_root(static_cast<i32>(i)), b = seg_root(star_index(tw / 3));
+                if (a != b) seg_parent_[z(std::max(a, b))] = std::min(a, b);
+            } else {
+                const i32 label = find(tri_label_[z(tw / 3)]);
+                if (n_walks == walks_.size()) walks_.emplace_back();
+                walks_[n_walks].clear();
+                ends_.push_back({static_cast<i32>(i), h, label, tw, kNone,
+                                 static_cast<i32>(n_walks++), 0, false});
+                end_index_.emplace_back(h, static_cast<i32>(ends_.size() - 1));
+                for (auto& lc : label_counts_)
+                    if (lc.label == label) ++lc.unresolved;
+            }
+        }
+    }
+    std::sort(end_index_.begin(), end_index_.end());
+
+    // 4. Settle every end: walk all open ones in lockstep, deducing what counting allows.
+    for (const auto& lc : label_counts_) deduce(lc.label);
+    for (bool open = true; open;) {
+        open = false;
+        for (std::size_t i = 0; i < ends_.size(); ++i) {
+            if (ends_[i].state != 0) continue;
+            const int r = step(static_cast<i32>(i), e);
+            if (r == 0) {
+                open = true;
+                continue;
+            }
+            End& en = ends_[i];
+            en.complete = true;
+            for (auto& lc : label_counts_) {
+                if (lc.label != en.label) continue;
+                if (r == 1) {
+                    End& other = ends_[z(en.partner)];
+                    if (other.state != 0) throw Error("reeb", "internal error: end met twice");
+                    en.state = other.state = 1;
+                    other.partner = static_cast<i32>(i);
+                    lc.unresolved -= 2;
+                } else {
+                    en.state = 2;
+                    --lc.unresolved;
+                    --lc.need_boundary;
+                }
+            }
+            deduce(en.label);
+            open = true;
+        }
+    }
+
+    // 5. Groups: segments joined through paired ends. Each group is one new contour.
+    for (const auto& en : ends_) {
+        if (en.state != 1) continue;
+        const i32 a = seg_root(en.segment), b = seg_root(ends_[z(en.partner)].segment);
+        if (a != b) seg_parent_[z(std::max(a, b))] = std::min(a, b);
+    }
+    // A piece is walked when one of its ends completed it; a label whose unwalked pieces lie in
+    // several groups has all but one group's pieces walked to the end (lockstep again).
+    auto piece_done = [&](const End& en) {
+        return en.complete || (en.state == 1 && ends_[z(en.partner)].complete);
+    };
+    for (const i32 label : d_in_) {
+        for (;;) {
+            i32 group = kNone;
+            bool several = false;
+            for (const auto& en : ends_)
+                if (en.label == label && !piece_done(en)) {
+                    const i32 gr = seg_root(en.segment);
+                    if (group != kNone && gr != group) several = true;
+                    group = gr;
+                }
+            if (!several) break;
+            for (std::size_t i = 0; i < ends_.size(); ++i) {
+                End& en = ends_[i];
+                if (en.label != label || piece_done(en)) continue;
+                if (en.state == 1 && en.partner < static_cast<i32>(i)) continue;  // once per piece
+                const i32 expect = en.partner;
+                const int r = step(static_cast<i32>(i), e);
+                if (r != 0) {
+                    if ((r == 1) != (en.state == 1) || (r == 1 && en.partner != expect))
+                        throw Error("reeb", "internal error: contour pieces disagree");
+                    en.complete = true;
+                }
+            }
+        }
+    }
+
+    // 6. New contours: a group keeps the ids of the old contours whose unwalked pieces it holds
+    //    (merged by union), or gets a new id; walked pieces and new triangles are relabelled.
+    const bool regular = d_in_.size() == 1 && [&] {
+        i32 only = kNone;
+        for (std::size_t i = 0; i < ns; ++i)
+            if (seg_parent_[i] != kNone) {
+                if (only != kNone && seg_root(static_cast<i32>(i)) != only) return false;
+                only = seg_root(static_cast<i32>(i));
+            }
+        return only != kNone;
+    }();
+    const i32 continuing_arc = regular ? contours_[z(d_in_[0])].arc : kNone;
+    if (!regular)
+        for (const i32 c : d_in_) arcs_[z(contours_[z(c)].arc)].upper = e;
+    int groups = 0;
+    for (std::size_t i = 0; i < ns; ++i) {
+        if (seg_parent_[i] == kNone || seg_root(static_cast<i32>(i)) != static_cast<i32>(i))
+            continue;
+        ++groups;
+        const i32 gr = static_cast<i32>(i);
+        i32 id = kNone;
+        i32 open = 0;
+        for (const auto& en : ends_) {
+            if (seg_root(en.segment) != gr) continue;
+            if (en.state == 2) ++open;
+            if (piece_done(en)) continue;
+            const i32 c = find(en.label);
+            if (id == kNone)
+                id = c;
+            else if (c != id)
+                contours_[z(c)].parent = id;
+        }
+        for (std::size_t k = 0; k < ns; ++k)
+            if (seg_parent_[k] != kNone && seg_root(static_cast<i32>(k)) == gr) open += seg_bnd_[k];
+        const i32 arc = regular ? continuing_arc : new_arc(e);
+        if (id == kNone)
+            id = new_contour(arc, open);
+        else
+            contours_[z(id)].arc = arc, contours_[z(id)].open = open;
+        for (const auto& en : ends_)
+            if (seg_root(en.segment) == gr && en.complete)
+                for (const i32 t : walks_[z(en.walk)]) tri_label_[z(t)] = id;
+        for (std::size_t k = 0; k < ns; ++k)
+            if (seg_parent_[k] != kNone && seg_root(static_cast<i32>(k)) == gr)
+                tri_label_[z(star_[k])] = id;
+    }
+    if (regular) {  // Reeb-regular (a boundary vertex may still have a split link)
+        g_.node_lower_links[z(e)] = g_.node_upper_links[z(e)] = 1;
+        append_regular(continuing_arc, e);
+        return;
+    }
+    const auto d_down = d_in_.size();
+    g_.node_kinds[z(e)] = d_down == 0   ? NodeKind::minimum
+                          : groups == 0 ? NodeKind::maximum
+                                        : NodeKind::saddle;
+}
+
+void Sweep::finish_graph() {
+    const std::size_t na = arcs_.size();
+    g_.arcs.resize(na);
+    g_.arc_offsets.assign(na + 1, 0);
+    for (std::size_t a = 0; a < na; ++a) {
+        if (arcs_[a].upper == kNone) throw Error("reeb", "internal error: an arc was left open");
+        g_.arcs[a] = {arcs_[a].lower, arcs_[a].upper};
+        g_.arc_offsets[a + 1] = g_.arc_offsets[a] + arcs_[a].count;
+    }
+    g_.arc_nodes.resize(static_cast<std::size_t>(g_.arc_offsets[na]));
+    for (std::size_t a = 0; a < na; ++a) {
+        i32 pos = g_.arc_offsets[a];
+        for (i32 n = arcs_[a].head; n != kNone; n = node_next_[z(n)]) g_.arc_nodes[z(pos++)] = n;
+    }
+}
+
+}  // namespace
+
+bool reeb_is_tree(const TriangleMesh& mesh) {
+    return loop_free(mesh);
+}
+
+ReebGraph build_reeb_graph(const TriangleMesh& mesh, const std::vector<float>& field,
+                           const ReebOptions& options, const ProgressFn& progress) {
+    if (field.size() != mesh.vertex_count())
+        throw Error("reeb", "the field has " + std::to_string(field.size()) +
+                                " values for a mesh of " + std::to_string(mesh.vertex_count()) +
+                                " vertices");
+    for (std::size_t v = 0; v < field.size(); ++v)
+        if (std::isnan(field[v]))
+            throw Error("reeb", "the field is NaN at vertex " + std::to_string(v));
+    if (mesh.vertex_count() >= static_cast<std::size_t>(INT32_MAX / 4))
+        throw Error("reeb", "the mesh is too large (more than 500 million vertices)");
+    ReebGraph g;
+    const bool tree = options.algorithm != ReebAlgorithm::sweep && loop_free(mesh);
+    if (options.algorithm == ReebAlgorithm::contour_tree && !tree)
+        throw Error("reeb",
+                    "the contour-tree algorithm needs a mesh whose components are disks "
+                    "or spheres; this one has handles or holes");
+    if (tree) {
+        order_events(mesh, field, g);
+        report_progress(progress, 0.3, "reeb: order");
+        contour_tree(mesh, g, progress);
+        report_progress(progress, 1.0, "reeb");
+    } else {
+        Sweep(mesh, field, g).run(progress);
+    }
+    return g;
+}
+
+}  // namespace terrain::reeb

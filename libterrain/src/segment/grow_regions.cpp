@@ -1,0 +1,223 @@
+// Region growing over Reeb graph nodes (docs/segment.md). Candidates wait in a min-heap of
+// (cost, node, region); a popped candidate whose cost rose since it was pushed (its region's
+// mean moved) is pushed back with the current cost, so the pair taken is the cheapest as far
+// as the heap knows. Costs that fall (a saddle losing its penalty) are pushed anew.
+
+#include "terrain/segment/grow_regions.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <queue>
+
+#include "terrain/core/error.hpp"
+
+namespace terrain::segment {
+
+GrowCost parse_grow_cost(const std::string& name) {
+    if (name == "graph") return GrowCost::graph;
+    if (name == "standard") return GrowCost::standard;
+    throw Error("segment", "unknown cost '" + name + "'; use graph or standard");
+}
+
+const char* to_string(GrowCost cost) {
+    return cost == GrowCost::graph ? "graph" : "standard";
+}
+
+namespace {
+
+using i32 = std::int32_t;
+constexpr i32 kNone = -1;
+inline std::size_t z(i32 i) {
+    return static_cast<std::size_t>(i);
+}
+
+struct Candidate {
+    float cost;
+    i32 node, region;
+    bool operator>(const Candidate& o) const {
+        if (cost != o.cost) return cost > o.cost;
+        if (node != o.node) return node > o.node;
+        return region > o.region;
+    }
+};
+
+class Grower {
+  public:
+    Grower(const TriangleMesh& mesh, const reeb::ReebGraph& g, const GrowOptions& options)
+        : mesh_(mesh), g_(g), options_(options) {
+        const std::size_t nn = g.node_count();
+        node_region_.assign(nn, kNone);
+        node_area_.assign(nn, 0.0);
+        for (std::size_t v = 0; v < g.vertex_nodes.size(); ++v)
+            node_area_[z(g.vertex_nodes[v])] +=
+                mesh.vertex_areas.empty() ? 1.0 : mesh.vertex_areas[v];
+        build_reeb_neighbours();
+        unassigned_branches_.resize(nn);
+        for (std::size_t n = 0; n < nn; ++n) unassigned_branches_[n] = nb_off_[n + 1] - nb_off_[n];
+    }
+
+    Segmentation run(const ProgressFn& progress) {
+        Segmentation out;
+        // Seeds: extremum nodes, numbered by their lowest vertex.
+        std::vector<std::pair<i32, i32>> seeds;  // (lowest vertex, node)
+        for (std::size_t n = 0; n < g_.node_count(); ++n)
+            if (g_.is_extremum(static_cast<i32>(n))) {
+                i32 lowest = INT32_MAX;
+                for (i32 i = g_.node_vertex_offsets[n]; i < g_.node_vertex_offsets[n + 1]; ++i)
+                    lowest = std::min(lowest, g_.node_vertices[z(i)]);
+                seeds.emplace_back(lowest, static_cast<i32>(n));
+            }
+        std::sort(seeds.begin(), seeds.end());
+        region_sum_.assign(seeds.size(), 0.0);
+        region_area_.assign(seeds.size(), 0.0);
+        for (std::size_t r = 0; r < seeds.size(); ++r) out.seeds.push_back(seeds[r].second);
+        for (std::size_t r = 0; r < seeds.size(); ++r) assign(seeds[r].second, static_cast<i32>(r));
+        const std::size_t total = g_.node_count();
+        std::size_t assigned = seeds.size();
+        bool relaxed = false;
+        for (;;) {
+            while (!heap_.empty()) {
+                const Candidate c = heap_.top();
+                heap_.pop();
+                if (node_region_[z(c.node)] != kNone) continue;
+                if (!relaxed && options_.cost == GrowCost::graph && !reeb_eligible(c.node))
+                    continue;
+                const float now = cost(c.node, c.region, relaxed);
+                if (now > c.cost) {
+                    heap_.push({now, c.node, c.region});
+                    continue;
+                }
+                assign(c.node, c.region);
+                if (relaxed) ++out.relaxed_nodes;
+                if ((++assigned & 0xffff) == 0)
+                    report_progress(progress, static_cast<double>(assigned) / total, "grow");
+            }
+            if (assigned == total || relaxed || seeds.empty()) break;
+            // Nodes the graph constraint left out: let them join under the standard cost.
+            relaxed = true;
+            for (std::size_t n = 0; n < total; ++n)
+                if (node_region_[n] != kNone) push_mesh_candidates(static_cast<i32>(n), true);
+        }
+        if (assigned != total)
+            throw Error("segment", "region growing left " + std::to_string(total - assigned) +
+                                       " nodes without a region (no extremum in their component)");
+        out.region_count = static_cast<std::uint32_t>(seeds.size());
+        out.labels.resize(g_.vertex_nodes.size());
+        for (std::size_t v = 0; v < out.labels.size(); ++v)
+            out.labels[v] = static_cast<std::uint32_t>(node_region_[z(g_.vertex_nodes[v])] + 1);
+        report_progress(progress, 1.0, "grow");
+        return out;
+    }
+
+  private:
+    // Reeb-graph neighbours of every node: along its arc for a regular node, the first node
+    // of each incident arc for a critical node. CSR.
+    void build_reeb_neighbours() {
+        const std::size_t nn = g_.node_count();
+        std::vector<std::vector<i32>> tmp;  // only used for critical nodes' lists
+        nb_off_.assign(nn + 1, 0);
+        auto along = [&](std::size_t a, bool from_lower) {
+            const i32 b = g_.arc_offsets[a], e = g_.arc_offsets[a + 1];
+            if (b == e) return from_lower ? g_.arcs[a][1] : g_.arcs[a][0];
+            return from_lower ? g_.arc_nodes[z(b)] : g_.arc_nodes[z(e - 1)];
+        };
+        for (std::size_t n = 0; n < nn; ++n)
+            nb_off_[n + 1] = g_.is_critical(static_cast<i32>(n)) ? 0 : 2;
+        for (const auto& a : g_.arcs) {
+            ++nb_off_[z(a[0]) + 1];
+            ++nb_off_[z(a[1]) + 1];
+        }
+        for (std::size_t n = 0; n < nn; ++n) nb_off_[n + 1] += nb_off_[n];
+        nb_.resize(z(nb_off_[nn]));
+        std::vector<i32> fill(nb_off_.begin(), nb_off_.end() - 1);
+        for (std::size_t a = 0; a < g_.arc_count(); ++a) {
+            nb_[z(fill[z(g_.arcs[a][0])]++)] = along(a, true);
+            nb_[z(fill[z(g_.arcs[a][1])]++)] = along(a, false);
+            const i32 b = g_.arc_offsets[a], e = g_.arc_offsets[a + 1];
+            for (i32 i = b; i < e; ++i) {
+                const i32 r = g_.arc_nodes[z(i)];
+                nb_[z(fill[z(r)]++)] = i == b ? g_.arcs[a][0] : g_.arc_nodes[z(i - 1)];
+                nb_[z(fill[z(r)]++)] = i + 1 == e ? g_.arcs[a][1] : g_.arc_nodes[z(i + 1)];
+            }
+        }
+    }
+
+    bool reeb_eligible(i32 n) const {
+        return unassigned_branches_[z(n)] < nb_off_[z(n) + 1] - nb_off_[z(n)];
+    }
+
+    float cost(i32 n, i32 r, bool relaxed) const {
+        const double mean = region_sum_[z(r)] / std::max(region_area_[z(r)], 1e-300);
+        double c = std::fabs(mean - static_cast<double>(g_.node_values[z(n)]));
+        if (!relaxed && options_.cost == GrowCost::graph && unassigned_branches_[z(n)] > 1)
+            c += options_.saddle_penalty;
+        return static_cast<float>(c);
+    }
+
+    void push(i32 n, i32 r, bool relaxed) { heap_.push({cost(n, r, relaxed), n, r}); }
+
+    // Candidates (u, r) for the unassigned nodes u touching node n (in region r) on the mesh.
+    void push_mesh_candidates(i32 n, bool relaxed) {
+        const i32 r = node_region_[z(n)];
+        i32 last = kNone;
+        for (i32 i = g_.node_vertex_offsets[z(n)]; i < g_.node_vertex_offsets[z(n) + 1]; ++i) {
+            const i32 v = g_.node_vertices[z(i)];
+            for (i32 k = mesh_.neighbor_offsets[z(v)]; k < mesh_.neighbor_offsets[z(v) + 1]; ++k) {
+                const i32 u = g_.vertex_nodes[z(mesh_.neighbors[z(k)])];
+                if (u == last || node_region_[z(u)] != kNone) continue;
+                last = u;
+                if (!relaxed && options_.cost == GrowCost::graph && !reeb_eligible(u)) continue;
+                push(u, r, relaxed);
+            }
+        }
+    }
+
+    // Candidates for node u against every region it touches on the mesh.
+    void push_all_regions(i32 u) {
+        for (i32 i = g_.node_vertex_offsets[z(u)]; i < g_.node_vertex_offsets[z(u) + 1]; ++i) {
+            const i32 v = g_.node_vertices[z(i)];
+            for (i32 k = mesh_.neighbor_offsets[z(v)]; k < mesh_.neighbor_offsets[z(v) + 1]; ++k) {
+                const i32 r = node_region_[z(g_.vertex_nodes[z(mesh_.neighbors[z(k)])])];
+                if (r != kNone) push(u, r, false);
+            }
+        }
+    }
+
+    void assign(i32 n, i32 r) {
+        node_region_[z(n)] = r;
+        region_sum_[z(r)] += node_area_[z(n)] * g_.node_values[z(n)];
+        region_area_[z(r)] += node_area_[z(n)];
+        if (options_.cost == GrowCost::graph) {
+            // Reeb neighbours: one more branch assigned; a node that just became eligible, or
+            // a saddle that just lost its penalty, gets its candidates (again).
+            for (i32 k = nb_off_[z(n)]; k < nb_off_[z(n) + 1]; ++k) {
+                const i32 u = nb_[z(k)];
+                if (node_region_[z(u)] != kNone) continue;
+                const i32 before = unassigned_branches_[z(u)]--;
+                const i32 degree = nb_off_[z(u) + 1] - nb_off_[z(u)];
+                if (before == degree || before == 2) push_all_regions(u);
+            }
+        }
+        push_mesh_candidates(n, false);
+    }
+
+    const TriangleMesh& mesh_;
+    const reeb::ReebGraph& g_;
+    GrowOptions options_;
+    std::vector<i32> node_region_, nb_off_, nb_, unassigned_branches_;
+    std::vector<double> node_area_, region_sum_, region_area_;
+    std::priority_queue<Candidate, std::vector<Candidate>, std::greater<Candidate>> heap_;
+};
+
+}  // namespace
+
+Segmentation grow_regions(const TriangleMesh& mesh, const reeb::ReebGraph& graph,
+                          const GrowOptions& options, const ProgressFn& progress) {
+    if (graph.vertex_nodes.size() != mesh.vertex_count())
+        throw Error("segment", "the Reeb graph was not built on this mesh");
+    if (!std::isfinite(options.saddle_penalty) || options.saddle_penalty < 0)
+        throw Error("segment", "the saddle penalty must be a number >= 0");
+    return Grower(mesh, graph, options).run(progress);
+}
+
+}  // namespace terrain::segment

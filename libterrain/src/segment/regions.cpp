@@ -1,0 +1,266 @@
+#include "terrain/segment/regions.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <unordered_map>
+
+#include "../io/lonlat_frame.hpp"
+#include "pixel_areas.hpp"
+#include "terrain/core/error.hpp"
+#include "terrain/mesh/dem_to_mesh.hpp"
+
+namespace terrain::segment {
+namespace {
+
+using Point = std::array<double, 3>;
+
+Point midpoint(const Point& p, const Point& q) {
+    return {(p[0] + q[0]) / 2, (p[1] + q[1]) / 2, (p[2] + q[2]) / 2};
+}
+
+double distance(const Point& p, const Point& q) {
+    return std::hypot(p[0] - q[0], p[1] - q[1], p[2] - q[2]);
+}
+
+std::uint64_t pair_key(std::uint32_t a, std::uint32_t b) {
+    if (a > b) std::swap(a, b);
+    return (std::uint64_t{a} << 32) | b;
+}
+
+struct EdgeSums {
+    double length = 0;
+    std::size_t mesh_edges = 0;
+};
+
+void check_inputs(const TriangleMesh& mesh, const std::vector<float>& field,
+                  const std::vector<std::uint32_t>& labels, std::uint32_t region_count,
+                  const Dem* dem) {
+    const std::size_t n = mesh.vertex_count();
+    if (field.size() != n || labels.size() != n)
+        throw Error("segment", "the field (" + std::to_string(field.size()) + ") and labels (" +
+                                   std::to_string(labels.size()) +
+                                   ") need one value per mesh vertex (" + std::to_string(n) + ")");
+    for (std::size_t v = 0; v < n; ++v)
+        if (labels[v] == 0 || labels[v] > region_count)
+            throw Error("segment", "vertex " + std::to_string(v) + " has label " +
+                                       std::to_string(labels[v]) + ", outside 1.." +
+                                       std::to_string(region_count));
+    if (dem && (mesh.vertex_pixel.size() != n || dem->width != mesh.grid_width ||
+                dem->height != mesh.grid_height))
+        throw Error("segment", "the mesh was not made from this DEM's grid");
+}
+
+// Vertices on the mesh's boundary: in a 2-manifold, fewer incident triangles than neighbours.
+std::vector<std::uint8_t> mesh_boundary(const TriangleMesh& mesh) {
+    std::vector<std::int32_t> triangles(mesh.vertex_count(), 0);
+    for (const auto& t : mesh.triangles)
+        for (auto v : t) ++triangles[static_cast<std::size_t>(v)];
+    std::vector<std::uint8_t> out(mesh.vertex_count(), 0);
+    for (std::size_t v = 0; v < out.size(); ++v)
+        out[v] = static_cast<std::size_t>(triangles[v]) != mesh.degree(v);
+    return out;
+}
+
+// For each region the vertex with the largest BFS distance (in mesh edges, through the
+// region) from the region's boundary: its cut edges and the mesh boundary. Ties: lowest index.
+std::vector<std::int32_t> representative_vertices(const TriangleMesh& mesh,
+                                                  const std::vector<std::uint32_t>& labels,
+                                                  std::uint32_t region_count) {
+    const std::size_t n = mesh.vertex_count();
+    const auto on_boundary = mesh_boundary(mesh);
+    std::vector<std::int32_t> depth(n, -1), queue;
+    queue.reserve(n);
+    for (std::size_t v = 0; v < n; ++v) {
+        bool source = on_boundary[v];
+        for (auto k = mesh.neighbor_offsets[v]; !source && k < mesh.neighbor_offsets[v + 1]; ++k)
+            source = labels[static_cast<std::size_t>(mesh.neighbors[std::size_t(k)])] != labels[v];
+        if (source) {
+            depth[v] = 0;
+            queue.push_back(static_cast<std::int32_t>(v));
+        }
+    }
+    for (std::size_t head = 0; head < queue.size(); ++head) {
+        const auto v = static_cast<std::size_t>(queue[head]);
+        for (auto k = mesh.neighbor_offsets[v]; k < mesh.neighbor_offsets[v + 1]; ++k) {
+            const auto w = static_cast<std::size_t>(mesh.neighbors[std::size_t(k)]);
+            if (depth[w] >= 0 || labels[w] != labels[v]) continue;
+            depth[w] = depth[v] + 1;
+            queue.push_back(static_cast<std::int32_t>(w));
+        }
+    }
+    std::vector<std::int32_t> best(region_count, -1);
+    for (std::size_t v = 0; v < n; ++v) {
+        auto& b = best[labels[v] - 1];
+        if (b < 0 || depth[v] > depth[static_cast<std::size_t>(b)])
+            b = static_cast<std::int32_t>(v);
+    }
+    return best;
+}
+
+// Boundary length and cut mesh edges per pair of labels (see RegionEdge).
+std::unordered_map<std::uint64_t, EdgeSums> boundary_sums(
+    const TriangleMesh& mesh, const std::vector<std::uint32_t>& labels) {
+    std::unordered_map<std::uint64_t, EdgeSums> sums;
+    for (std::size_t v = 0; v < mesh.vertex_count(); ++v)
+        for (auto k = mesh.neighbor_offsets[v]; k < mesh.neighbor_offsets[v + 1]; ++k) {
+            const auto w = static_cast<std::size_t>(mesh.neighbors[std::size_t(k)]);
+            if (w > v && labels[w] != labels[v]) ++sums[pair_key(labels[v], labels[w])].mesh_edges;
+        }
+    for (const auto& t : mesh.triangles) {
+        const std::uint32_t l[3] = {labels[std::size_t(t[0])], labels[std::size_t(t[1])],
+                                    labels[std::size_t(t[2])]};
+        if (l[0] == l[1] && l[1] == l[2]) continue;
+        const Point p[3] = {mesh.position(std::size_t(t[0])), mesh.position(std::size_t(t[1])),
+                            mesh.position(std::size_t(t[2]))};
+        // Edge k joins corners k and k+1.
+        const Point mid[3] = {midpoint(p[0], p[1]), midpoint(p[1], p[2]), midpoint(p[2], p[0])};
+        if (l[0] != l[1] && l[1] != l[2] && l[2] != l[0]) {
+            const Point centre = {(p[0][0] + p[1][0] + p[2][0]) / 3,
+                                  (p[0][1] + p[1][1] + p[2][1]) / 3,
+                                  (p[0][2] + p[1][2] + p[2][2]) / 3};
+            for (int k = 0; k < 3; ++k)
+                sums[pair_key(l[k], l[(k + 1) % 3])].length += distance(centre, mid[k]);
+            continue;
+        }
+        // Two labels: the corner alone on its side is k; its two edges are k-1 and k.
+        const int k = l[0] == l[1] ? 2 : (l[1] == l[2] ? 0 : 1);
+        sums[pair_key(l[k], l[(k + 1) % 3])].length += distance(mid[(k + 2) % 3], mid[k]);
+    }
+    return sums;
+}
+
+// Position of each region's representative vertex (see Region::point).
+void set_points(RegionGraph& graph, const TriangleMesh& mesh, const Dem* dem) {
+    if (!dem) {
+        graph.point_frame = PointFrame::mesh;
+        for (auto& r : graph.regions) r.point = mesh.position(std::size_t(r.representative_vertex));
+        return;
+    }
+    std::vector<double> x, y;
+    for (auto& r : graph.regions) {
+        const auto pixel = mesh.vertex_pixel[std::size_t(r.representative_vertex)];
+        const int col = pixel % dem->width, row = pixel / dem->width;
+        const auto xy = dem->map_xy(col + 0.5, row + 0.5);
+        x.push_back(xy[0]);
+        y.push_back(xy[1]);
+        r.point[2] = dem->height_at(col, row);
+    }
+    graph.point_frame = PointFrame::map;
+    if (!dem->crs_wkt.empty()) {
+        const io::LonLatFrame frame(*dem, "segment");
+        if (!frame.transform(x.size(), x.data(), y.data()))
+            throw Error("segment", "a region's point has no longitude/latitude on the body");
+        graph.point_frame = PointFrame::lonlat;
+        graph.point_crs_wkt = frame.wkt();
+    }
+    for (std::size_t i = 0; i < graph.regions.size(); ++i) {
+        graph.regions[i].point[0] = x[i];
+        graph.regions[i].point[1] = y[i];
+    }
+}
+
+}  // namespace
+
+Landform landform_of(double shape_index) {
+    // Bin edges at 100 (2k + 1) / 16: 6.25, 18.75, ..., 93.75.
+    if (std::isnan(shape_index)) return Landform::saddle;
+    const double s = std::clamp(shape_index, 0.0, 100.0);
+    const int bin = static_cast<int>(std::floor((s * 16.0 / 100.0 + 1.0) / 2.0));
+    return static_cast<Landform>(std::min(bin, 8));
+}
+
+const char* to_string(Landform landform) {
+    static const char* const names[] = {"cup",          "trough", "rut",  "saddle rut", "saddle",
+                                        "saddle ridge", "ridge",  "dome", "cap"};
+    return names[static_cast<int>(landform)];
+}
+
+std::vector<std::uint32_t> label_pixels(const TriangleMesh& mesh, const Dem& dem,
+                                        const std::vector<std::uint32_t>& labels) {
+    if (mesh.vertex_pixel.size() != mesh.vertex_count() || labels.size() != mesh.vertex_count() ||
+        dem.width != mesh.grid_width || dem.height != mesh.grid_height)
+        throw Error("segment", "labels, mesh and DEM grid do not match");
+    const auto vertex = mesh::pixel_to_vertex(mesh, dem);
+    std::vector<std::uint32_t> out(vertex.size(), 0);
+    for (std::size_t p = 0; p < vertex.size(); ++p)
+        if (vertex[p] >= 0) out[p] = labels[static_cast<std::size_t>(vertex[p])];
+    return out;
+}
+
+RegionGraph region_graph(const TriangleMesh& mesh, const std::vector<float>& field,
+                         const std::vector<std::uint32_t>& labels, std::uint32_t region_count,
+                         const Dem* dem) {
+    check_inputs(mesh, field, labels, region_count, dem);
+    RegionGraph graph;
+    graph.regions.resize(region_count);
+    std::vector<double> weighted(region_count, 0.0), plain(region_count, 0.0);
+    for (std::uint32_t i = 0; i < region_count; ++i) {
+        graph.regions[i].id = i + 1;
+        graph.regions[i].field_min = std::numeric_limits<double>::infinity();
+        graph.regions[i].field_max = -std::numeric_limits<double>::infinity();
+    }
+    for (std::size_t v = 0; v < mesh.vertex_count(); ++v) {
+        auto& r = graph.regions[labels[v] - 1];
+        const double f = field[v], a = mesh.vertex_areas[v];
+        ++r.vertex_count;
+        r.surface_area_m2 += a;
+        weighted[labels[v] - 1] += a * f;
+        plain[labels[v] - 1] += f;
+        r.field_min = std::min(r.field_min, f);
+        r.field_max = std::max(r.field_max, f);
+    }
+    for (std::uint32_t i = 0; i < region_count; ++i) {
+        auto& r = graph.regions[i];
+        if (r.vertex_count == 0)
+            throw Error("segment", "region " + std::to_string(r.id) +
+                                       " has no vertex; number the regions 1..N without gaps");
+        r.field_mean = r.surface_area_m2 > 0 ? weighted[i] / r.surface_area_m2
+                                             : plain[i] / double(r.vertex_count);
+        r.landform = landform_of(r.field_mean);
+        r.area_m2 = r.surface_area_m2;
+    }
+
+    if (dem) {
+        const auto pixels = label_pixels(mesh, *dem, labels);
+        const PixelAreas pixel_area(*dem);
+        for (auto& r : graph.regions) r.area_m2 = 0;
+        for (int row = 0; row < dem->height; ++row)
+            for (int col = 0; col < dem->width; ++col) {
+                const auto l = pixels[dem->index(col, row)];
+                if (l == 0) continue;
+                auto& r = graph.regions[l - 1];
+                ++r.pixel_count;
+                r.area_m2 += pixel_area(col, row);
+            }
+    }
+
+    const auto best = representative_vertices(mesh, labels, region_count);
+    for (std::uint32_t i = 0; i < region_count; ++i)
+        graph.regions[i].representative_vertex = best[i];
+    set_points(graph, mesh, dem);
+
+    const auto sums = boundary_sums(mesh, labels);
+    graph.edges.reserve(sums.size());
+    for (const auto& [key, s] : sums) {
+        RegionEdge e;
+        e.a = static_cast<std::uint32_t>(key >> 32);
+        e.b = static_cast<std::uint32_t>(key & 0xffffffffu);
+        e.boundary_length_m = s.length;
+        e.mesh_edges = s.mesh_edges;
+        e.contrast =
+            std::abs(graph.regions[e.a - 1].field_mean - graph.regions[e.b - 1].field_mean);
+        graph.edges.push_back(e);
+    }
+    std::sort(graph.edges.begin(), graph.edges.end(), [](const RegionEdge& p, const RegionEdge& q) {
+        return p.a != q.a ? p.a < q.a : p.b < q.b;
+    });
+    for (const auto& e : graph.edges) {
+        ++graph.regions[e.a - 1].neighbor_count;
+        ++graph.regions[e.b - 1].neighbor_count;
+    }
+    return graph;
+}
+
+}  // namespace terrain::segment

@@ -1,0 +1,84 @@
+// Benchmark: Reeb graph construction and simplification (single thread, as both are) on the
+// shape index field of a synthetic 1000x1000 Vesta tile (craters plus roughness: a noisy
+// field where a large share of vertices are critical).
+//   build/tests/bench/bench_reeb [size]
+#include <time.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+
+#include "terrain/field/shape_index.hpp"
+#include "terrain/mesh/dem_to_mesh.hpp"
+#include "terrain/reeb/reeb_graph.hpp"
+#include "terrain/reeb/simplify.hpp"
+#include "terrain/synth/crater_field.hpp"
+
+using namespace terrain;
+
+namespace {
+
+double thread_cpu_seconds() {
+    timespec ts{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
+// Best wall time of a few runs, and the CPU time of that run (on a busy machine the CPU time
+// is the better measure of a single-threaded step).
+template <class F>
+double best_of(int runs, F&& f, double* cpu) {
+    double best = 1e300;
+    for (int i = 0; i < runs; ++i) {
+        const auto t0 = std::chrono::steady_clock::now();
+        const double c0 = thread_cpu_seconds();
+        f();
+        const double wall =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        if (wall < best) {
+            best = wall;
+            *cpu = thread_cpu_seconds() - c0;
+        }
+    }
+    return best;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    synth::VestaTileOptions options;
+    options.width = options.height = argc > 1 ? std::atoi(argv[1]) : 1000;
+    const Dem dem = synth::generate_vesta_tile(options);
+    const auto mesh = mesh::dem_to_mesh(dem);
+    const auto field = field::shape_index_field(mesh);
+    const double nv = static_cast<double>(mesh.vertex_count());
+
+    reeb::ReebGraph graph;
+    double c_build = 0;
+    const double t_build = best_of(
+        3, [&] { graph = reeb::build_reeb_graph(mesh, field); }, &c_build);
+    const auto s = reeb::summarize(graph);
+    std::printf(
+        "bench_reeb: %zu vertices, shape index field, %zu critical nodes (%.1f%%), %zu arcs\n",
+        mesh.vertex_count(), s.critical, 100.0 * s.critical / nv, s.arcs);
+    std::printf(
+        "construction           %.3f s  %.2f M vertices/s (cpu %.3f s, %.2f M/s)  %.1f "
+        "bytes/vertex\n",
+        t_build, nv / t_build / 1e6, c_build, nv / c_build / 1e6, graph.memory_bytes() / nv);
+    for (const double ratio : {0.1, 0.5}) {
+        reeb::SimplifyOptions so;
+        so.persistence = 10;
+        so.area_ratio = ratio;
+        reeb::SimplifyResult result;
+        double c = 0;
+        const double t = best_of(
+            3, [&] { result = reeb::simplify(mesh, graph, so); }, &c);
+        const auto r = reeb::summarize(result.graph);
+        std::printf(
+            "simplify P=10 A=%.1f%%  %.3f s  %.2f M vertices/s  %zu -> %zu critical nodes, "
+            "%.1f bytes/vertex\n",
+            ratio, t, nv / t / 1e6, s.critical, r.critical, result.graph.memory_bytes() / nv);
+    }
+    return 0;
+}

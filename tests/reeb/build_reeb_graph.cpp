@@ -1,0 +1,281 @@
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <numeric>
+#include <random>
+#include <set>
+
+#include "support/test_meshes.hpp"
+#include "support/test_support.hpp"
+#include "terrain/core/error.hpp"
+#include "terrain/field/vertex_field.hpp"
+#include "terrain/io/read_dem.hpp"
+#include "terrain/mesh/dem_to_mesh.hpp"
+#include "terrain/reeb/reeb_graph.hpp"
+
+using namespace terrain;
+using terrain::reeb::NodeKind;
+
+namespace {
+
+std::vector<float> coordinate_field(const TriangleMesh& mesh, std::array<double, 3> w) {
+    std::vector<float> f(mesh.vertex_count());
+    for (std::size_t v = 0; v < f.size(); ++v) {
+        const auto p = mesh.position(v);
+        f[v] = static_cast<float>(w[0] * p[0] + w[1] * p[1] + w[2] * p[2]);
+    }
+    return f;
+}
+
+reeb::ReebSummary checked(const TriangleMesh& mesh, const std::vector<float>& field) {
+    const auto g = reeb::build_reeb_graph(mesh, field);
+    INFO(reeb::check_reeb_graph(g, field));
+    REQUIRE(reeb::check_reeb_graph(g, field).empty());
+    return reeb::summarize(g);
+}
+
+// Sum over critical nodes of (2 - degree): 2 (1 - loops) per connected component.
+long degree_sum(const reeb::ReebGraph& g) {
+    const auto inc = reeb::node_arcs(g);
+    long s = 0;
+    for (std::size_t n = 0; n < g.node_count(); ++n)
+        if (g.is_critical(static_cast<std::int32_t>(n)))
+            s += 2 - static_cast<long>(inc.degree(static_cast<std::int32_t>(n)));
+    return s;
+}
+
+}  // namespace
+
+TEST_CASE("A torus standing on its rim has one loop: min, two saddles, max", "[reeb]") {
+    const auto mesh = test::torus_mesh(3, 1, 48, 24, true);
+    auto f = coordinate_field(mesh, {1e-3, 2e-4, 1});
+    const auto s = checked(mesh, f);
+    CHECK(s.minima == 1);
+    CHECK(s.maxima == 1);
+    CHECK(s.saddles == 2);
+    CHECK(s.arcs == 4);
+    CHECK(s.loops == 1);
+    CHECK(s.index_sum == Approx(0));  // Euler characteristic of the torus
+}
+
+TEST_CASE("A lying torus: level rings give two degenerate extrema and two parallel arcs",
+          "[reeb]") {
+    const auto mesh = test::torus_mesh(3, 1, 40, 16, false);
+    const auto f = coordinate_field(mesh, {0, 0, 1});
+    const auto g = reeb::build_reeb_graph(mesh, f);
+    REQUIRE(reeb::check_reeb_graph(g, f).empty());
+    const auto s = reeb::summarize(g);
+    CHECK(s.minima == 1);
+    CHECK(s.maxima == 1);
+    CHECK(s.saddles == 0);
+    REQUIRE(s.arcs == 2);
+    CHECK(s.loops == 1);
+    CHECK(g.arcs[0] == g.arcs[1]);
+    // The lowest ring (40 vertices of equal z) is one node.
+    const auto lo = g.arcs[0][0];
+    CHECK(g.node_vertex_offsets[lo + 1] - g.node_vertex_offsets[lo] == 40);
+    CHECK(g.node_upper_links[lo] == 2);
+}
+
+TEST_CASE("Closed surfaces of genus g have g loops, also under a noisy field", "[reeb]") {
+    for (int genus : {0, 1, 2, 3}) {
+        const auto mesh = test::plate_mesh(24, 8, genus);
+        const auto topo = mesh_topology(mesh);
+        REQUIRE(topo.boundary_edges == 0);
+        REQUIRE(topo.euler_characteristic == 2 - 2 * genus);
+        const auto height = checked(mesh, coordinate_field(mesh, {1, 0.0137, 0.00071}));
+        CHECK(height.loops == static_cast<std::size_t>(genus));
+        CHECK(height.index_sum == Approx(2 - 2 * genus));
+        for (unsigned seed : {1u, 2u, 3u}) {
+            const auto noise = test::noise_field(mesh.vertex_count(), seed + 10 * genus);
+            const auto g = reeb::build_reeb_graph(mesh, noise);
+            REQUIRE(reeb::check_reeb_graph(g, noise).empty());
+            const auto s = reeb::summarize(g);
+            CHECK(s.loops == static_cast<std::size_t>(genus));
+            CHECK(s.index_sum == Approx(2 - 2 * genus));
+            CHECK(degree_sum(g) == 2 - 2 * genus);
+        }
+    }
+    const auto torus = test::torus_mesh(3, 1, 30, 12, true);
+    for (unsigned seed : {4u, 5u}) {
+        const auto s = checked(torus, test::noise_field(torus.vertex_count(), seed));
+        CHECK(s.loops == 1);
+        CHECK(s.index_sum == Approx(0));
+    }
+}
+
+TEST_CASE("Disk-like DEMs give a tree; a hole in the DEM can give a loop", "[reeb]") {
+    const auto dem = test::grid_dem(40, 30, [](int c, int r) { return 0.3 * c + 0.01 * r; });
+    const auto mesh = mesh::dem_to_mesh(dem);
+    CHECK(checked(mesh, field::height_field(mesh, &dem)).loops == 0);
+    CHECK(checked(mesh, test::noise_field(mesh.vertex_count(), 7)).loops == 0);
+    // A plane tilted along x around a NoData hole: contours pass on both sides of the hole.
+    const auto holed = test::grid_dem(40, 30, [](int c, int r) {
+        return (c >= 15 && c < 25 && r >= 10 && r < 20) ? std::nan("") : 0.3 * c + 0.01 * r;
+    });
+    const auto holed_mesh = mesh::dem_to_mesh(holed);
+    REQUIRE(mesh_topology(holed_mesh).boundary_loops == 2);
+    const auto s = checked(holed_mesh, field::height_field(holed_mesh, &holed));
+    CHECK(s.loops == 1);
+    CHECK(s.minima == 1);
+    CHECK(s.maxima == 1);
+    // Noise on the holed disk: at most one loop.
+    for (unsigned seed : {8u, 9u, 10u})
+        CHECK(checked(holed_mesh, test::noise_field(holed_mesh.vertex_count(), seed)).loops <= 1);
+}
+
+TEST_CASE("Real tiles: trees with consistent nodes and arcs", "[reeb]") {
+    for (const char* name : {"vesta_hamo_tile.lbl", "mars_hirise_crop.tif"}) {
+        const auto dem = io::read_dem(test::sample(name));
+        const auto mesh = mesh::dem_to_mesh(dem);
+        for (auto kind : {field::FieldKind::shape_index, field::FieldKind::height}) {
+            field::FieldOptions options;
+            options.kind = kind;
+            const auto f = field::vertex_field(mesh, &dem, options);
+            const auto g = reeb::build_reeb_graph(mesh, f);
+            INFO(name << " " << field::to_string(kind));
+            REQUIRE(reeb::check_reeb_graph(g, f).empty());
+            const auto s = reeb::summarize(g);
+            CHECK(s.loops == 0);
+            CHECK(s.components == 1);
+            CHECK(s.minima + s.maxima > 1);
+            CHECK(g.memory_bytes() < 150 * mesh.vertex_count());
+        }
+    }
+}
+
+TEST_CASE("The closed Moon is a tree with index sum 2", "[reeb]") {
+    const auto dem = io::read_dem(test::sample("moon_ldem1_global.tif"));
+    const auto mesh = mesh::dem_to_mesh(dem);
+    REQUIRE(mesh_topology(mesh).boundary_edges == 0);
+    for (auto kind : {field::FieldKind::shape_index, field::FieldKind::height}) {
+        field::FieldOptions options;
+        options.kind = kind;
+        const auto f = field::vertex_field(mesh, &dem, options);
+        const auto g = reeb::build_reeb_graph(mesh, f);
+        REQUIRE(reeb::check_reeb_graph(g, f).empty());
+        const auto s = reeb::summarize(g);
+        CHECK(s.loops == 0);
+        CHECK(degree_sum(g) == 2);
+    }
+    if (const auto ldem = test::shared_data("moon_lola_ldem4/LDEM_4.LBL")) {
+        const auto big = io::read_dem(*ldem);
+        const auto m = mesh::dem_to_mesh(big);
+        const auto f = field::height_field(m, &big);
+        const auto g = reeb::build_reeb_graph(m, f);
+        REQUIRE(reeb::check_reeb_graph(g, f).empty());
+        CHECK(reeb::summarize(g).loops == 0);
+        CHECK(degree_sum(g) == 2);
+    }
+}
+
+TEST_CASE("Plateaus are single nodes: a mesa's flat top is one maximum", "[reeb]") {
+    const auto dem = test::grid_dem(30, 30, [](int c, int r) {
+        const double d = std::hypot(c - 14.5, r - 14.5);
+        return d < 6 ? 100.0 : 100.0 - (d - 6) * 3 + 0.001 * c;
+    });
+    const auto mesh = mesh::dem_to_mesh(dem);
+    const auto f = field::height_field(mesh, &dem);
+    const auto g = reeb::build_reeb_graph(mesh, f);
+    REQUIRE(reeb::check_reeb_graph(g, f).empty());
+    std::size_t top = 0;
+    for (std::size_t v = 0; v < f.size(); ++v) top += f[v] == 100.0f;
+    const auto n =
+        g.vertex_nodes[static_cast<std::size_t>(std::find(f.begin(), f.end(), 100.0f) - f.begin())];
+    CHECK(g.node_kinds[n] == NodeKind::maximum);
+    CHECK(static_cast<std::size_t>(g.node_vertex_offsets[n + 1] - g.node_vertex_offsets[n]) == top);
+    CHECK(reeb::summarize(g).maxima == 1);
+}
+
+TEST_CASE("The graph does not depend on the vertex order", "[reeb]") {
+    const auto mesh = test::plate_mesh(16, 6, 2);
+    const auto f = test::noise_field(mesh.vertex_count(), 42);
+    std::vector<std::int32_t> perm(mesh.vertex_count());
+    std::iota(perm.begin(), perm.end(), 0);
+    std::mt19937 rng(3);
+    std::shuffle(perm.begin(), perm.end(), rng);
+    const auto pmesh = test::permute_mesh(mesh, perm);
+    const auto pf = test::permute_field(f, perm);
+    const auto a = reeb::build_reeb_graph(mesh, f);
+    const auto b = reeb::build_reeb_graph(pmesh, pf);
+    REQUIRE(reeb::check_reeb_graph(b, pf).empty());
+    // Critical nodes by (kind, original vertex); arcs by their end vertices and regular count.
+    auto describe = [](const reeb::ReebGraph& g, const std::vector<std::int32_t>* back) {
+        auto vertex = [&](std::int32_t n) {
+            const auto v = g.node_vertices[static_cast<std::size_t>(g.node_vertex_offsets[n])];
+            return back ? (*back)[static_cast<std::size_t>(v)] : v;
+        };
+        std::multiset<std::tuple<int, int, int>> arcs;
+        for (std::size_t k = 0; k < g.arc_count(); ++k)
+            arcs.insert({vertex(g.arcs[k][0]), vertex(g.arcs[k][1]),
+                         g.arc_offsets[k + 1] - g.arc_offsets[k]});
+        std::set<std::pair<int, int>> nodes;
+        for (std::size_t n = 0; n < g.node_count(); ++n)
+            if (g.is_critical(static_cast<std::int32_t>(n)))
+                nodes.insert({int(g.node_kinds[n]), vertex(static_cast<std::int32_t>(n))});
+        return std::make_pair(nodes, arcs);
+    };
+    std::vector<std::int32_t> inverse(perm.size());
+    for (std::size_t v = 0; v < perm.size(); ++v)
+        inverse[static_cast<std::size_t>(perm[v])] = static_cast<std::int32_t>(v);
+    CHECK(describe(a, nullptr) == describe(b, &inverse));
+}
+
+TEST_CASE("Reeb graph input errors", "[reeb]") {
+    const auto mesh = test::plate_mesh(6, 4, 0);
+    auto f = test::noise_field(mesh.vertex_count(), 1);
+    CHECK_THROWS_AS(reeb::build_reeb_graph(mesh, std::vector<float>(3, 0.f)), Error);
+    f[5] = std::nanf("");
+    CHECK_THROWS_WITH(reeb::build_reeb_graph(mesh, f), Catch::Contains("NaN at vertex 5"));
+    // A constant field: one node, no arcs.
+    const std::vector<float> flat(mesh.vertex_count(), 50.f);
+    const auto g = reeb::build_reeb_graph(mesh, flat);
+    CHECK(reeb::check_reeb_graph(g, flat).empty());
+    CHECK(g.node_count() == 1);
+    CHECK(g.arc_count() == 0);
+}
+
+TEST_CASE("The contour tree and the sweep give the same graph on disks and spheres", "[reeb]") {
+    const auto dem = io::read_dem(test::sample("vesta_hamo_tile.lbl"));
+    const auto disk = mesh::dem_to_mesh(dem);
+    const auto globe_dem = io::read_dem(test::sample("moon_ldem1_global.tif"));
+    const auto sphere = mesh::dem_to_mesh(globe_dem);
+    const auto holed = mesh::dem_to_mesh(test::grid_dem(20, 20, [](int c, int r) {
+        return (c > 8 && c < 12 && r > 8 && r < 12) ? std::nan("") : double(c + r);
+    }));
+    CHECK(reeb::reeb_is_tree(disk));
+    CHECK(reeb::reeb_is_tree(sphere));
+    CHECK_FALSE(reeb::reeb_is_tree(holed));
+    CHECK_FALSE(reeb::reeb_is_tree(test::torus_mesh(3, 1, 12, 8, true)));
+    CHECK_THROWS_WITH(reeb::build_reeb_graph(holed, test::noise_field(holed.vertex_count(), 1),
+                                             {reeb::ReebAlgorithm::contour_tree}),
+                      Catch::Contains("disks or spheres"));
+    const std::vector<std::pair<const TriangleMesh*, std::vector<float>>> cases = {
+        {&disk, field::shape_index_field(disk)},
+        {&disk, field::height_field(disk, &dem)},
+        {&sphere, field::shape_index_field(sphere)},
+        {&sphere, test::noise_field(sphere.vertex_count(), 5)},
+    };
+    for (const auto& [mesh, f] : cases) {
+        const auto a = reeb::build_reeb_graph(*mesh, f, {reeb::ReebAlgorithm::sweep});
+        const auto b = reeb::build_reeb_graph(*mesh, f, {reeb::ReebAlgorithm::contour_tree});
+        REQUIRE(reeb::check_reeb_graph(b, f).empty());
+        CHECK(a.node_vertices == b.node_vertices);
+        CHECK(a.node_kinds == b.node_kinds);
+        CHECK(a.node_lower_links == b.node_lower_links);
+        CHECK(a.node_upper_links == b.node_upper_links);
+        auto arcs = [](const reeb::ReebGraph& g) {
+            std::set<std::vector<std::int32_t>> out;
+            for (std::size_t k = 0; k < g.arc_count(); ++k) {
+                std::vector<std::int32_t> arc{g.arcs[k][0], g.arcs[k][1]};
+                arc.insert(arc.end(), g.arc_nodes.begin() + g.arc_offsets[k],
+                           g.arc_nodes.begin() + g.arc_offsets[k + 1]);
+                out.insert(arc);
+            }
+            return out;
+        };
+        CHECK(arcs(a) == arcs(b));
+    }
+}

@@ -1,0 +1,176 @@
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <map>
+#include <set>
+
+#include "support/test_meshes.hpp"
+#include "support/test_support.hpp"
+#include "terrain/core/error.hpp"
+#include "terrain/field/vertex_field.hpp"
+#include "terrain/io/read_dem.hpp"
+#include "terrain/mesh/dem_to_mesh.hpp"
+#include "terrain/reeb/simplify.hpp"
+
+using namespace terrain;
+
+namespace {
+
+// Critical nodes as (kind, sorted vertex set): comparable between graphs of one mesh.
+std::set<std::pair<int, std::vector<std::int32_t>>> critical_nodes(const reeb::ReebGraph& g) {
+    std::set<std::pair<int, std::vector<std::int32_t>>> out;
+    for (std::size_t n = 0; n < g.node_count(); ++n) {
+        if (!g.is_critical(static_cast<std::int32_t>(n))) continue;
+        std::vector<std::int32_t> vs(g.node_vertices.begin() + g.node_vertex_offsets[n],
+                                     g.node_vertices.begin() + g.node_vertex_offsets[n + 1]);
+        std::sort(vs.begin(), vs.end());
+        out.insert({static_cast<int>(g.node_kinds[n]), vs});
+    }
+    return out;
+}
+
+reeb::SimplifyResult simplified(const TriangleMesh& mesh, const std::vector<float>& f, double p,
+                                double a) {
+    const auto g = reeb::build_reeb_graph(mesh, f);
+    reeb::SimplifyOptions o;
+    o.persistence = p;
+    o.area_ratio = a;
+    auto r = reeb::simplify(mesh, g, o);
+    INFO(reeb::check_reeb_graph(r.graph, r.field));
+    REQUIRE(reeb::check_reeb_graph(r.graph, r.field).empty());
+    return r;
+}
+
+struct Sample {
+    Dem dem;
+    TriangleMesh mesh;
+    std::vector<float> si;
+};
+const Sample& vesta() {
+    static const Sample s = [] {
+        Sample x;
+        x.dem = io::read_dem(test::sample("vesta_hamo_tile.lbl"));
+        x.mesh = mesh::dem_to_mesh(x.dem);
+        x.si = field::shape_index_field(x.mesh);
+        return x;
+    }();
+    return s;
+}
+
+}  // namespace
+
+TEST_CASE("Two hills: persistence above the smaller hill cuts it down, keeps the high one",
+          "[simplify]") {
+    // Hills 10 and 4 high over a plane tilted by 0.001 per pixel; the saddle between them is
+    // near the plane.
+    const auto dem = test::grid_dem(40, 20, [](int c, int r) {
+        const double a = std::hypot(c - 10, r - 10), b = std::hypot(c - 30, r - 10);
+        return 10 * std::exp(-a * a / 20) + 4 * std::exp(-b * b / 20) + 0.001 * (c + 2 * r);
+    });
+    const auto mesh = mesh::dem_to_mesh(dem);
+    const auto f = field::height_field(mesh, &dem);
+    const auto before = reeb::summarize(reeb::build_reeb_graph(mesh, f));
+    REQUIRE(before.maxima == 2);
+    const auto r = simplified(mesh, f, 5, 0);
+    const auto after = reeb::summarize(r.graph);
+    CHECK(after.maxima == 1);
+    CHECK(after.saddles < before.saddles);
+    CHECK(r.saddle_extremum >= 1);
+    // The kept maximum is the high hill's top, with its value unchanged.
+    float top = 0;
+    for (std::size_t n = 0; n < r.graph.node_count(); ++n)
+        if (r.graph.node_kinds[n] == reeb::NodeKind::maximum) top = r.graph.node_values[n];
+    CHECK(top == Approx(10.03).margin(0.05));
+    // The small hill is cut down (to its saddle, or to the midpoint with a minimum).
+    const auto p2v = mesh::pixel_to_vertex(mesh, dem);
+    const auto small_top = static_cast<std::size_t>(p2v[dem.index(30, 10)]);
+    CHECK(r.field[small_top] < f[small_top] - 1.5f);
+    // With a threshold above both hills, only extremum-extremum pairs can go; a disk keeps
+    // at least one node.
+    const auto all = simplified(mesh, f, 1000, 0);
+    CHECK(reeb::summarize(all.graph).critical >= 1);
+}
+
+TEST_CASE("The rewritten field rebuilds into the same critical nodes", "[simplify]") {
+    const auto& s = vesta();
+    for (const auto& [p, a] :
+         std::vector<std::pair<double, double>>{{10, 0.5}, {10, 0.1}, {5, 0}}) {
+        const auto r = simplified(s.mesh, s.si, p, a);
+        const auto rebuilt = reeb::build_reeb_graph(s.mesh, r.field);
+        INFO("persistence " << p << " area ratio " << a);
+        CHECK(critical_nodes(rebuilt) == critical_nodes(r.graph));
+        CHECK(reeb::summarize(rebuilt).arcs == reeb::summarize(r.graph).arcs);
+    }
+    const auto torus = test::plate_mesh(20, 8, 2);
+    const auto noise = test::noise_field(torus.vertex_count(), 11);
+    const auto r = simplified(torus, noise, 30, 5);
+    CHECK(critical_nodes(reeb::build_reeb_graph(torus, r.field)) == critical_nodes(r.graph));
+}
+
+TEST_CASE("Loops survive any thresholds", "[simplify]") {
+    const auto plate = test::plate_mesh(20, 8, 2);
+    const auto noise = test::noise_field(plate.vertex_count(), 3);
+    const auto r = simplified(plate, noise, 1e9, 100);
+    CHECK(reeb::summarize(r.graph).loops == 2);
+    const auto torus = test::torus_mesh(3, 1, 32, 16, true);
+    std::vector<float> z(torus.vertex_count());
+    for (std::size_t v = 0; v < z.size(); ++v) z[v] = static_cast<float>(torus.position(v)[2]);
+    CHECK(reeb::summarize(simplified(torus, z, 1e9, 100).graph).loops == 1);
+}
+
+TEST_CASE("Raising a threshold never adds nodes (Vesta sample)", "[simplify]") {
+    const auto& s = vesta();
+    const auto g = reeb::build_reeb_graph(s.mesh, s.si);
+    std::size_t last = reeb::summarize(g).critical;
+    for (double a : {0.0, 0.1, 0.25, 0.5, 1.0, 2.0, 6.0}) {
+        reeb::SimplifyOptions o;
+        o.persistence = 10;
+        o.area_ratio = a;
+        const auto n = reeb::summarize(reeb::simplify(s.mesh, g, o).graph).critical;
+        INFO("area ratio " << a);
+        CHECK(n <= last);
+        last = n;
+    }
+    last = reeb::summarize(g).critical;
+    for (double p : {0.0, 1.0, 5.0, 10.0, 20.0, 50.0}) {
+        reeb::SimplifyOptions o;
+        o.persistence = p;
+        const auto n = reeb::summarize(reeb::simplify(s.mesh, g, o).graph).critical;
+        INFO("persistence " << p);
+        CHECK(n <= last);
+        last = n;
+    }
+}
+
+TEST_CASE("Simplification is deterministic and leaves no candidate", "[simplify]") {
+    const auto& s = vesta();
+    const auto a = simplified(s.mesh, s.si, 10, 0.5);
+    const auto b = simplified(s.mesh, s.si, 10, 0.5);
+    CHECK(a.field == b.field);
+    CHECK(a.graph.arcs == b.graph.arcs);
+    // No arc with an extremum end (and no parallel twin) is left below the thresholds.
+    const auto m = reeb::arc_metrics(s.mesh, a.graph);
+    const auto inc = reeb::node_arcs(a.graph);
+    for (std::size_t k = 0; k < a.graph.arc_count(); ++k) {
+        const auto [lo, hi] = a.graph.arcs[k];
+        if (!a.graph.is_extremum(lo) && !a.graph.is_extremum(hi)) continue;
+        std::size_t twins = 0;
+        for (auto i = inc.offsets[lo]; i < inc.offsets[lo + 1]; ++i)
+            twins += a.graph.arcs[inc.arcs[i]] == a.graph.arcs[k];
+        if (twins > 1) continue;
+        CHECK((m.persistence[k] >= 10 && m.area_ratio[k] >= 0.005));
+    }
+}
+
+TEST_CASE("Simplification thresholds are checked", "[simplify]") {
+    const auto mesh = test::plate_mesh(6, 4, 0);
+    const auto g = reeb::build_reeb_graph(mesh, test::noise_field(mesh.vertex_count(), 1));
+    reeb::SimplifyOptions o;
+    o.persistence = -1;
+    CHECK_THROWS_WITH(reeb::simplify(mesh, g, o), Catch::Contains("persistence"));
+    o.persistence = 0;
+    o.area_ratio = 150;
+    CHECK_THROWS_WITH(reeb::simplify(mesh, g, o), Catch::Contains("percentage"));
+    o.area_ratio = std::nan("");
+    CHECK_THROWS_AS(reeb::simplify(mesh, g, o), Error);
+}

@@ -1,0 +1,120 @@
+#include <tbb/global_control.h>
+#include <catch2/catch.hpp>
+
+#include <queue>
+
+#include "support/test_meshes.hpp"
+#include "support/test_support.hpp"
+#include "terrain/core/error.hpp"
+#include "terrain/field/vertex_field.hpp"
+#include "terrain/io/read_dem.hpp"
+#include "terrain/mesh/dem_to_mesh.hpp"
+#include "terrain/reeb/simplify.hpp"
+#include "terrain/segment/grow_regions.hpp"
+
+using namespace terrain;
+
+namespace {
+
+// Number of mesh-connected pieces of each region (index label-1).
+std::vector<int> pieces(const TriangleMesh& mesh, const segment::Segmentation& s) {
+    std::vector<int> count(s.region_count, 0);
+    std::vector<char> seen(mesh.vertex_count(), 0);
+    for (std::size_t v0 = 0; v0 < mesh.vertex_count(); ++v0) {
+        if (seen[v0]) continue;
+        ++count[s.labels[v0] - 1];
+        std::queue<std::size_t> q;
+        q.push(v0);
+        seen[v0] = 1;
+        while (!q.empty()) {
+            const auto v = q.front();
+            q.pop();
+            for (auto i = mesh.neighbor_offsets[v]; i < mesh.neighbor_offsets[v + 1]; ++i) {
+                const auto w =
+                    static_cast<std::size_t>(mesh.neighbors[static_cast<std::size_t>(i)]);
+                if (!seen[w] && s.labels[w] == s.labels[v]) {
+                    seen[w] = 1;
+                    q.push(w);
+                }
+            }
+        }
+    }
+    return count;
+}
+
+struct Case {
+    TriangleMesh mesh;
+    reeb::ReebGraph graph;
+};
+
+Case vesta_case(double area_ratio) {
+    const auto dem = io::read_dem(test::sample("vesta_hamo_tile.lbl"));
+    Case c;
+    c.mesh = mesh::dem_to_mesh(dem);
+    const auto f = field::shape_index_field(c.mesh);
+    reeb::SimplifyOptions o;
+    o.persistence = 10;
+    o.area_ratio = area_ratio;
+    c.graph = reeb::simplify(c.mesh, reeb::build_reeb_graph(c.mesh, f), o).graph;
+    return c;
+}
+
+}  // namespace
+
+TEST_CASE("Regions: one per extremum, every vertex labelled, every region connected", "[segment]") {
+    const auto c = vesta_case(0.5);
+    const auto summary = reeb::summarize(c.graph);
+    for (auto cost : {segment::GrowCost::graph, segment::GrowCost::standard}) {
+        segment::GrowOptions o;
+        o.cost = cost;
+        const auto s = segment::grow_regions(c.mesh, c.graph, o);
+        INFO(segment::to_string(cost));
+        CHECK(s.region_count == summary.minima + summary.maxima);
+        REQUIRE(s.labels.size() == c.mesh.vertex_count());
+        CHECK(std::all_of(s.labels.begin(), s.labels.end(),
+                          [&](std::uint32_t l) { return l >= 1 && l <= s.region_count; }));
+        const auto p = pieces(c.mesh, s);
+        CHECK(std::count(p.begin(), p.end(), 1) == static_cast<long>(s.region_count));
+        CHECK(s.relaxed_nodes == 0);
+        // Seeds are in their own regions, numbered by their lowest vertex.
+        for (std::uint32_t r = 0; r < s.region_count; ++r) {
+            const auto seed = s.seeds[r];
+            const auto v =
+                c.graph.node_vertices[static_cast<std::size_t>(c.graph.node_vertex_offsets[seed])];
+            CHECK(s.labels[static_cast<std::size_t>(v)] == r + 1);
+        }
+    }
+}
+
+TEST_CASE("Region growing is deterministic across runs and thread counts", "[segment]") {
+    const auto a = [] {
+        tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
+        const auto c = vesta_case(0.1);
+        return segment::grow_regions(c.mesh, c.graph).labels;
+    }();
+    const auto c = vesta_case(0.1);
+    CHECK(segment::grow_regions(c.mesh, c.graph).labels == a);
+}
+
+TEST_CASE("A constant field is one region; a genus-2 plate keeps regions connected", "[segment]") {
+    const auto plate = test::plate_mesh(20, 8, 2);
+    const std::vector<float> flat(plate.vertex_count(), 50.f);
+    const auto g = reeb::build_reeb_graph(plate, flat);
+    const auto s = segment::grow_regions(plate, g);
+    CHECK(s.region_count == 1);
+    const auto noise = test::noise_field(plate.vertex_count(), 4);
+    reeb::SimplifyOptions o;
+    o.persistence = 20;
+    const auto simple = reeb::simplify(plate, reeb::build_reeb_graph(plate, noise), o);
+    for (auto cost : {segment::GrowCost::graph, segment::GrowCost::standard}) {
+        segment::GrowOptions go;
+        go.cost = cost;
+        const auto r = segment::grow_regions(plate, simple.graph, go);
+        const auto p = pieces(plate, r);
+        CHECK(std::count(p.begin(), p.end(), 1) == static_cast<long>(r.region_count));
+    }
+    segment::GrowOptions bad;
+    bad.saddle_penalty = -1;
+    CHECK_THROWS_AS(segment::grow_regions(plate, g, bad), Error);
+    CHECK_THROWS_AS(segment::parse_grow_cost("cheap"), Error);
+}

@@ -1,0 +1,111 @@
+// terrain reeb INPUT [field options] [--persistence P] [--area-ratio A] -o GRAPH.json|.dot
+//                    [--write-field OUT]: the (simplified) Reeb graph of the field.
+#include <cstdio>
+#include <filesystem>
+
+#include "cli.hpp"
+#include "field_options.hpp"
+#include "input.hpp"
+#include "terrain/core/json_writer.hpp"
+#include "terrain/io/mesh_files.hpp"
+#include "terrain/io/output_file.hpp"
+#include "terrain/io/write_raster.hpp"
+#include "terrain/reeb/reeb_io.hpp"
+#include "terrain/reeb/simplify.hpp"
+
+namespace terrain::cli {
+
+int run_reeb(int argc, char** argv) {
+    return guarded("reeb", [&] {
+        std::string input_path, output, field_output, algorithm = "auto";
+        bool quiet = false, overwrite = false;
+        InputOptionValues input_values;
+        FieldOptionValues field_values;
+        reeb::SimplifyOptions simplify_options;
+        po::options_description options("terrain reeb options");
+        options.add_options()("input", po::value(&input_path)->required(),
+                              "a DEM or a mesh (.off, .ply, .obj)")(
+            "output,o", po::value(&output)->required(), "GRAPH.json (or GRAPH.dot for GraphViz)")(
+            "persistence", po::value(&simplify_options.persistence)->default_value(0.0),
+            "cancel arcs whose persistence is below P (field units)")(
+            "area-ratio", po::value(&simplify_options.area_ratio)->default_value(0.0),
+            "cancel arcs whose area ratio is below A percent of the surface")(
+            "write-field", po::value(&field_output),
+            "also write the simplified field (OUT.tif for a DEM, OUT.ply)")(
+            "algorithm", po::value(&algorithm)->default_value("auto"),
+            "auto, sweep or contour-tree (disks and spheres only)")(
+            "overwrite", po::bool_switch(&overwrite), "replace existing outputs")(
+            "quiet,q", po::bool_switch(&quiet), "no progress output");
+        add_field_options(options, field_values);
+        add_input_options(options, input_values);
+        po::positional_options_description positional;
+        positional.add("input", 1);
+        po::variables_map vm;
+        if (!parse(argc, argv,
+                   "terrain reeb INPUT [--field F] [--persistence P] [--area-ratio A] -o "
+                   "GRAPH.json [--write-field OUT]",
+                   options, positional, vm))
+            return 0;
+        const auto field_options = to_field_options(field_values, vm);
+        reeb::ReebOptions reeb_options;
+        if (algorithm == "sweep")
+            reeb_options.algorithm = reeb::ReebAlgorithm::sweep;
+        else if (algorithm == "contour-tree")
+            reeb_options.algorithm = reeb::ReebAlgorithm::contour_tree;
+        else if (algorithm != "auto")
+            throw UsageError("--algorithm must be auto, sweep or contour-tree");
+        const std::string ext = std::filesystem::path(output).extension().string();
+        if (ext != ".json" && ext != ".dot")
+            throw UsageError("the output must end in .json or .dot");
+        io::check_output_path(output, overwrite);
+        if (!field_output.empty()) io::check_output_path(field_output, overwrite);
+
+        const auto progress = terminal_progress(quiet);
+        const Input input = load_input(input_path, input_values, scaled_progress(progress, 0, 0.3));
+        const Dem* dem = input.dem ? &*input.dem : nullptr;
+        // Thresholds are checked before the long steps.
+        reeb::simplify(TriangleMesh{}, reeb::ReebGraph{}, simplify_options);
+        const auto values = field::vertex_field(input.mesh, dem, field_options,
+                                                scaled_progress(progress, 0.3, 0.7));
+        auto graph = reeb::build_reeb_graph(input.mesh, values, reeb_options,
+                                            scaled_progress(progress, 0.7, 0.85));
+        const auto before = reeb::summarize(graph);
+        std::vector<float> simplified = values;
+        if (simplify_options.persistence > 0 || simplify_options.area_ratio > 0) {
+            auto result = reeb::simplify(input.mesh, graph, simplify_options,
+                                         scaled_progress(progress, 0.85, 0.95));
+            graph = std::move(result.graph);
+            simplified = std::move(result.field);
+        }
+        if (ext == ".dot") {
+            reeb::write_reeb_dot(graph, output, overwrite);
+        } else {
+            reeb::write_reeb_json(
+                graph, input.mesh, output, overwrite,
+                {{"input", JsonWriter::escape(input_path)},
+                 {"field", JsonWriter::escape(field_values.name)},
+                 {"persistence", JsonWriter::number(simplify_options.persistence)},
+                 {"area_ratio_percent", JsonWriter::number(simplify_options.area_ratio)},
+                 {"critical_nodes_before_simplification", std::to_string(before.critical)}});
+        }
+        if (!field_output.empty()) {
+            if (io::is_mesh_file(field_output)) {
+                io::write_ply(input.mesh, field_output, overwrite, {{"field", &simplified}});
+            } else {
+                if (!dem) throw UsageError("a mesh input gives a .ply field, not a raster");
+                io::write_float_raster(*dem, field::field_to_pixels(input.mesh, *dem, simplified),
+                                       field_output, overwrite, "simplified " + field_values.name);
+            }
+        }
+        report_progress(progress, 1.0);
+        const auto s = reeb::summarize(graph);
+        std::printf(
+            "%s: %zu critical nodes (%zu minima, %zu maxima, %zu saddles), %zu arcs, %zu loops; "
+            "%zu critical nodes before simplification\n",
+            output.c_str(), s.critical, s.minima, s.maxima, s.saddles, s.arcs, s.loops,
+            before.critical);
+        return 0;
+    });
+}
+
+}  // namespace terrain::cli

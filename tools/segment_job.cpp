@@ -1,0 +1,222 @@
+#include "segment_job.hpp"
+
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include "terrain/core/error.hpp"
+#include "terrain/core/json_writer.hpp"
+#include "terrain/core/version.hpp"
+#include "terrain/io/segment_outputs.hpp"
+
+namespace terrain::cli {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+using clock = std::chrono::steady_clock;
+double since(clock::time_point t0) {
+    return std::chrono::duration<double>(clock::now() - t0).count();
+}
+
+}  // namespace
+
+void SegmentJob::add_time(const std::string& name, double seconds) {
+    for (auto& t : timings)
+        if (t.name == name) {
+            t.seconds += seconds;
+            return;
+        }
+    timings.push_back({name, seconds});
+}
+
+void add_segment_options(po::options_description& options, SegmentOptionValues& values) {
+    options.add_options()("persistence",
+                          po::value(&values.simplify.persistence)->default_value(10.0),
+                          "cancel arcs whose persistence is below P (field units)")(
+        "area-ratio", po::value(&values.simplify.area_ratio)->default_value(0.5),
+        "cancel arcs whose area ratio is below A percent of the surface")(
+        "cost", po::value(&values.cost)->default_value("auto"),
+        "graph (Reeb-graph constrained), standard, or auto: graph for DEMs, standard for meshes")(
+        "saddle-penalty", po::value(&values.grow.saddle_penalty)->default_value(20.0),
+        "graph cost: penalty for joining a saddle with several unassigned branches")(
+        "format", po::value(&values.format)->default_value("GeoJSON"),
+        "OGR driver of the region polygons (GeoJSON, GPKG, ...)")(
+        "timings", po::bool_switch(&values.timings), "print the time of each stage");
+}
+
+void check_segment_options(const SegmentOptionValues& v) {
+    if (!std::isfinite(v.simplify.persistence) || v.simplify.persistence < 0)
+        throw Error("segment", "--persistence must be a number >= 0");
+    if (!std::isfinite(v.simplify.area_ratio) || v.simplify.area_ratio < 0 ||
+        v.simplify.area_ratio > 100)
+        throw Error("segment", "--area-ratio is a percentage of the surface: between 0 and 100");
+    if (!std::isfinite(v.grow.saddle_penalty) || v.grow.saddle_penalty < 0)
+        throw Error("segment", "--saddle-penalty must be a number >= 0");
+    if (v.cost != "auto") segment::parse_grow_cost(v.cost);
+}
+
+void compute_field(SegmentJob& job, const field::FieldOptions& options,
+                   const ProgressFn& progress) {
+    const auto t0 = clock::now();
+    job.field = field::vertex_field(job.input.mesh, job.dem(), options, progress);
+    job.add_time("field", since(t0));
+}
+
+void compute_reeb(SegmentJob& job, const ProgressFn& progress) {
+    const auto t0 = clock::now();
+    job.graph = reeb::build_reeb_graph(job.input.mesh, job.field, {}, progress);
+    job.critical_before = reeb::summarize(job.graph).critical;
+    job.add_time("reeb", since(t0));
+}
+
+void segment_once(SegmentJob& job, const SegmentOptionValues& values, const ProgressFn& progress) {
+    auto t0 = clock::now();
+    job.simplified = reeb::simplify(job.input.mesh, job.graph, values.simplify,
+                                    scaled_progress(progress, 0, 0.3));
+    job.add_time("simplify", since(t0));
+    t0 = clock::now();
+    segment::GrowOptions grow = values.grow;
+    grow.cost = values.cost == "auto"
+                    ? (job.input.dem ? segment::GrowCost::graph : segment::GrowCost::standard)
+                    : segment::parse_grow_cost(values.cost);
+    job.segmentation = segment::grow_regions(job.input.mesh, job.simplified.graph, grow,
+                                             scaled_progress(progress, 0.3, 1));
+    job.add_time("grow", since(t0));
+}
+
+std::vector<std::string> write_segmentation(SegmentJob& job, const SegmentOptionValues& values,
+                                            const std::string& dir, const ProgressFn& progress) {
+    const auto t0 = clock::now();
+    job.regions = segment::region_graph(job.input.mesh, job.field, job.segmentation.labels,
+                                        job.segmentation.region_count, job.dem());
+    io::SegmentOutputOptions options;
+    options.polygons.driver = values.format;
+    auto paths = io::write_segment_outputs(dir, job.input.mesh, job.field, job.segmentation.labels,
+                                           job.regions, job.dem(), options, progress);
+    job.add_time("write", since(t0));
+    std::vector<std::string> names;
+    for (const auto& p : paths) names.push_back(fs::path(p).filename().string());
+    return names;
+}
+
+void write_run_json(const SegmentJob& job, const std::string& input_path,
+                    const FieldOptionValues& field, const SegmentOptionValues& values,
+                    const std::vector<std::string>& files, const std::string& path,
+                    const std::vector<std::pair<std::string, std::string>>& extra) {
+    std::ofstream os(path, std::ios::binary);
+    if (!os) throw Error("write", "cannot write " + path);
+    JsonWriter j(os);
+    const auto topo = mesh_topology(job.input.mesh);
+    const auto after = reeb::summarize(job.simplified.graph);
+    j.begin_object();
+    j.field("input", fs::absolute(input_path).lexically_normal().string());
+    j.key("parameters")
+        .begin_object()
+        .field("field", field.name)
+        .field("rings", field.options.shape_index.rings)
+        .field("radius", field.options.shape_index.radius)
+        .field("persistence", values.simplify.persistence)
+        .field("area_ratio_percent", values.simplify.area_ratio)
+        .field("cost",
+               values.cost == "auto" ? (job.input.dem ? "graph" : "standard") : values.cost.c_str())
+        .field("saddle_penalty", values.grow.saddle_penalty)
+        .field("format", values.format)
+        .field("frame", to_string(job.input.mesh.frame))
+        .end_object();
+    j.key("counts")
+        .begin_object()
+        .field("vertices", topo.vertices)
+        .field("faces", topo.faces)
+        .field("boundary_edges", topo.boundary_edges)
+        .field("euler_characteristic", topo.euler_characteristic)
+        .field("critical_nodes_before", job.critical_before)
+        .field("critical_nodes_after", after.critical)
+        .field("loops", after.loops)
+        .field("regions", static_cast<std::size_t>(job.segmentation.region_count))
+        .field("relaxed_nodes", job.segmentation.relaxed_nodes)
+        .end_object();
+    j.key("timings_seconds").begin_object();
+    double total = 0;
+    for (const auto& t : job.timings) {
+        j.field(t.name, t.seconds);
+        total += t.seconds;
+    }
+    j.field("total", total).end_object();
+    j.key("outputs").begin_array();
+    for (const auto& f : files) j.value(f);
+    j.end_array();
+    for (const auto& [k, v] : extra) j.key(k).raw(v);
+    j.key("versions").begin_object().field("terrain", version());
+    for (const auto& [name, v] : dependency_versions()) j.field(name, v);
+    j.end_object();
+    j.end_object();
+    os.flush();
+    if (!os) throw Error("write", "writing " + path + " failed (disk full?)");
+}
+
+void print_summary(const SegmentJob& job, const std::string& output, bool timings) {
+    std::printf("%s: %u regions on %zu vertices (critical nodes %zu -> %zu)\n", output.c_str(),
+                job.segmentation.region_count, job.input.mesh.vertex_count(), job.critical_before,
+                reeb::summarize(job.simplified.graph).critical);
+    if (!timings) return;
+    double total = 0;
+    std::printf("%-10s %10s\n", "stage", "seconds");
+    for (const auto& t : job.timings) {
+        std::printf("%-10s %10.3f\n", t.name.c_str(), t.seconds);
+        total += t.seconds;
+    }
+    std::printf("%-10s %10.3f\n", "total", total);
+}
+
+OutputDirectory::OutputDirectory(std::string path, bool overwrite) : path_(std::move(path)) {
+    std::error_code ec;
+    const fs::path p = fs::path(path_).lexically_normal();
+    if (p.filename().empty()) throw Error("write", "'" + path_ + "' is not a directory name");
+    if (fs::exists(p, ec)) {
+        if (!fs::is_directory(p, ec))
+            throw Error("write", "'" + path_ + "' exists and is not a directory");
+        if (!overwrite && !fs::is_empty(p, ec))
+            throw Error("write", "'" + path_ + "' already exists; pass --overwrite to replace it");
+    }
+    const fs::path parent = p.has_parent_path() ? p.parent_path() : fs::path(".");
+    if (!fs::is_directory(parent, ec))
+        throw Error("write", "cannot write '" + path_ + "': '" + parent.string() +
+                                 "' does not exist; create it first");
+    if (::access(parent.c_str(), W_OK) != 0)
+        throw Error("write",
+                    "cannot create '" + path_ + "': '" + parent.string() + "' is not writable");
+    temp_ = (parent / ("." + p.filename().string() + ".tmp" + std::to_string(::getpid()))).string();
+    fs::remove_all(temp_, ec);
+    if (!fs::create_directory(temp_, ec))
+        throw Error("write", "cannot create a directory beside '" + path_ + "': " + ec.message());
+}
+
+OutputDirectory::~OutputDirectory() {
+    if (committed_) return;
+    std::error_code ec;
+    fs::remove_all(temp_, ec);
+}
+
+void OutputDirectory::commit() {
+    std::error_code ec;
+    const std::string old = temp_ + ".old";
+    const bool existed = fs::exists(path_, ec);
+    if (existed) fs::rename(path_, old, ec);
+    if (ec) throw Error("write", "cannot replace '" + path_ + "': " + ec.message());
+    fs::rename(temp_, path_, ec);
+    if (ec) {
+        std::error_code ignored;
+        if (existed) fs::rename(old, path_, ignored);
+        throw Error("write", "cannot move the outputs into '" + path_ + "': " + ec.message());
+    }
+    committed_ = true;
+    if (existed) fs::remove_all(old, ec);
+}
+
+}  // namespace terrain::cli

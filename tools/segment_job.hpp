@@ -1,0 +1,80 @@
+#pragma once
+// The steps `segment` and `sweep` share: options, the field and Reeb graph computed once,
+// one segmentation per area ratio, the output files, run.json, and the atomic output
+// directory.
+
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "cli.hpp"
+#include "field_options.hpp"
+#include "input.hpp"
+#include "terrain/reeb/simplify.hpp"
+#include "terrain/segment/grow_regions.hpp"
+#include "terrain/segment/regions.hpp"
+
+namespace terrain::cli {
+
+struct SegmentOptionValues {
+    reeb::SimplifyOptions simplify;
+    segment::GrowOptions grow;
+    std::string cost = "auto";
+    std::string format = "GeoJSON";
+    bool timings = false;
+};
+
+// --persistence, --area-ratio, --cost, --saddle-penalty, --format, --timings.
+void add_segment_options(po::options_description& options, SegmentOptionValues& values);
+// Thresholds and names checked before any long work (terrain::Error, exit status 1).
+void check_segment_options(const SegmentOptionValues& values);
+
+struct StageTime {
+    std::string name;
+    double seconds = 0;
+};
+
+struct SegmentJob {
+    Input input;
+    std::vector<float> field;  // as computed
+    reeb::ReebGraph graph;     // before simplification
+    std::size_t critical_before = 0;
+    reeb::SimplifyResult simplified;  // of the last segment_once
+    segment::Segmentation segmentation;
+    segment::RegionGraph regions;
+    std::vector<StageTime> timings;
+    const Dem* dem() const { return input.dem ? &*input.dem : nullptr; }
+    void add_time(const std::string& name, double seconds);
+};
+
+void compute_field(SegmentJob& job, const field::FieldOptions& options, const ProgressFn& progress);
+void compute_reeb(SegmentJob& job, const ProgressFn& progress);
+// Simplifies job.graph with values.simplify and grows the regions (cost auto: graph for DEMs,
+// standard for meshes); fills job.simplified, job.segmentation and job.regions.
+void segment_once(SegmentJob& job, const SegmentOptionValues& values, const ProgressFn& progress);
+// Every output of one segmentation into `dir`; returns the file names written.
+std::vector<std::string> write_segmentation(SegmentJob& job, const SegmentOptionValues& values,
+                                            const std::string& dir, const ProgressFn& progress);
+void write_run_json(const SegmentJob& job, const std::string& input_path,
+                    const FieldOptionValues& field, const SegmentOptionValues& values,
+                    const std::vector<std::string>& files, const std::string& path,
+                    const std::vector<std::pair<std::string, std::string>>& extra = {});
+void print_summary(const SegmentJob& job, const std::string& output, bool timings);
+
+// A directory written in full beside its final place, then moved there: OUTDIR appears
+// complete or not at all. An existing non-empty OUTDIR is refused unless overwrite.
+class OutputDirectory {
+  public:
+    OutputDirectory(std::string path, bool overwrite);
+    ~OutputDirectory();
+    OutputDirectory(const OutputDirectory&) = delete;
+    OutputDirectory& operator=(const OutputDirectory&) = delete;
+    const std::string& temp_path() const { return temp_; }
+    void commit();
+
+  private:
+    std::string path_, temp_;
+    bool committed_ = false;
+};
+
+}  // namespace terrain::cli
