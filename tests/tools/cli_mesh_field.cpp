@@ -227,6 +227,11 @@ TEST_CASE("terrain field --field sdf: a mesh file round trip, open DEM tiles ref
     CHECK(
         run_cli({"field", mesh, "--field", "sdf", "--cone-angle", "180", "-o", ply, "--overwrite"})
             .status == 1);
+    // The same field options drive the Reeb graph (the paper's part-based case).
+    const auto reeb = run_cli(
+        {"reeb", mesh, "--field", "sdf", "--rays", "9", "-o", (dir / "box.json").string(), "-q"});
+    INFO(reeb.err);
+    CHECK(reeb.status == 0);
 
     // A DEM tile is open: one line saying so. A global DEM closes: its SDF is a raster.
     terrain::test::RasterSpec tile;
