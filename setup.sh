@@ -2,7 +2,8 @@
 # terrain's set-up, in one command each (see README.md):
 #   ./setup.sh          install missing Debian packages, build, run the main job on the sample
 #   ./setup.sh test     install missing Debian packages, build, run the whole test suite
-# Both are idempotent: installed packages are skipped and the build directory is reused.
+#   ./setup.sh bench    also install the bench-only packages, build, run the benchmarks
+# All are idempotent: installed packages are skipped and the build directory is reused.
 # Environment: BUILD_DIR (default build), OUT_DIR (default out), JOBS (default nproc).
 set -euo pipefail
 
@@ -26,10 +27,16 @@ packages=(
   catch2
   time
 )
+# Only for `./setup.sh bench`: libcgal-demo ships CGAL's sample meshes (data.tar.gz), on
+# which bench_sdf compares our Shape Diameter Function with CGAL's.
+bench_packages=(libcgal-demo)
+# Closed meshes from that archive (cactus is CGAL's own SDF example).
+bench_meshes=(cactus hand elephant cow dino homer bull camel man armadillo)
 
+# install_packages PACKAGE...: installs those not installed yet.
 install_packages() {
   local missing=()
-  for p in "${packages[@]}"; do
+  for p in "$@"; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
   done
   [ ${#missing[@]} -eq 0 ] && return 0
@@ -54,7 +61,7 @@ build() {
 
 case "$mode" in
   run)
-    install_packages
+    install_packages "${packages[@]}"
     build
     # The main job: the synthetic Vesta HAMO tile segmented with the paper's terrain
     # parameters (shape index x100, persistence 10, area ratio 0.5 %, graph cost, lambda 20).
@@ -66,12 +73,32 @@ case "$mode" in
     echo "setup: outputs in $out_dir/vesta_hamo_tile/ (labels.tif, regions.geojson, adjacency.*, preview.png, run.json)"
     ;;
   test)
-    install_packages
+    install_packages "${packages[@]}"
     build
     ctest --test-dir "$build_dir" --output-on-failure -j "$jobs"
     ;;
+  bench)
+    install_packages "${packages[@]}" "${bench_packages[@]}"
+    build
+    archive="$(dpkg -L libcgal-demo | grep '/data\.tar\.gz$' | head -n 1)"
+    mesh_dir="$build_dir/cgal-meshes"
+    mkdir -p "$mesh_dir"
+    meshes=() missing=()
+    for m in "${bench_meshes[@]}"; do
+      meshes+=("$mesh_dir/$m.off")
+      [ -f "$mesh_dir/$m.off" ] || missing+=("data/meshes/$m.off")
+    done
+    [ ${#missing[@]} -eq 0 ] ||
+      tar -xzf "$archive" -C "$mesh_dir" --strip-components=2 "${missing[@]}"
+    "$build_dir/tests/bench/bench_mesh"
+    "$build_dir/tests/bench/bench_field"
+    "$build_dir/tests/bench/bench_sdf" "${meshes[@]}"
+    "$build_dir/tests/bench/bench_reeb"
+    "$build_dir/tests/bench/bench_outputs"
+    tests/bench/bench_segment.sh "$build_dir"
+    ;;
   *)
-    echo "usage: ./setup.sh [run|test]" >&2
+    echo "usage: ./setup.sh [run|test|bench]" >&2
     exit 2
     ;;
 esac

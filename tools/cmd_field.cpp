@@ -1,11 +1,16 @@
-// terrain field INPUT --field shape-index|height -o OUT.tif|OUT.ply: the scalar field, as a
-// Float32 raster on the DEM's grid or as a per-vertex PLY property.
+// terrain field INPUT --field shape-index|sdf|height -o OUT.tif|OUT.ply: the scalar field, as
+// a Float32 raster on the DEM's grid or as a per-vertex PLY property.
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
 
 #include "cli.hpp"
+#include "field_options.hpp"
 #include "input.hpp"
+#include "terrain/core/error.hpp"
 #include "terrain/field/vertex_field.hpp"
 #include "terrain/io/mesh_files.hpp"
 #include "terrain/io/output_file.hpp"
@@ -13,22 +18,31 @@
 
 namespace terrain::cli {
 
-void add_field_options(po::options_description& options, std::string& field_name,
-                       field::ShapeIndexOptions& shape_index) {
-    options.add_options()("field", po::value(&field_name)->default_value("shape-index"),
-                          "shape-index (x100, in [0,100]) or height (metres above the reference)")(
-        "rings", po::value(&shape_index.rings)->default_value(2),
-        "shape index: fit over the vertices within N mesh edges")(
-        "radius", po::value(&shape_index.radius)->default_value(0.0),
-        "shape index: fit over the vertices within M metres instead of rings");
+// What the SDF met, for the summary: degenerate faces, faces without a value, orientation.
+void print_sdf_notes(const field::SdfResult& sdf) {
+    std::printf("sdf: vertex diameters %.6g .. %.6g mapped to 0 .. 100", sdf.min_diameter,
+                sdf.max_diameter);
+    if (sdf.degenerate_faces > 0)
+        std::printf(
+            "; %zu degenerate (zero-area) faces got no rays and took their neighbours' "
+            "value",
+            sdf.degenerate_faces);
+    if (sdf.faces_without_value > 0)
+        std::printf("; %zu faces whose rays met no inner surface took their neighbours' value",
+                    sdf.faces_without_value);
+    if (sdf.reoriented) std::printf("; the faces point inwards, rays were cast the other way");
+    if (sdf.boundary_edges + sdf.nonmanifold_edges > 0)
+        std::printf("; open mesh (%zu boundary, %zu non-manifold edges): rays through holes lost",
+                    sdf.boundary_edges, sdf.nonmanifold_edges);
+    std::printf("\n");
 }
 
 int run_field(int argc, char** argv) {
     return guarded("field", [&] {
-        std::string input_path, output, field_name;
+        std::string input_path, output;
         bool quiet = false, overwrite = false;
         InputOptionValues input_values;
-        field::FieldOptions field_options;
+        FieldOptionValues field_values;
         po::options_description options("terrain field options");
         options.add_options()("input", po::value(&input_path)->required(),
                               "a DEM or a mesh (.off, .ply, .obj)")(
@@ -36,34 +50,49 @@ int run_field(int argc, char** argv) {
             "OUT.tif (DEM input: Float32 on the DEM's grid) or OUT.ply (per-vertex property)")(
             "overwrite", po::bool_switch(&overwrite), "replace an existing output")(
             "quiet,q", po::bool_switch(&quiet), "no progress output");
-        add_field_options(options, field_name, field_options.shape_index);
+        add_field_options(options, field_values);
         add_input_options(options, input_values);
         po::positional_options_description positional;
         positional.add("input", 1);
         po::variables_map vm;
-        if (!parse(argc, argv, "terrain field INPUT --field shape-index|height -o OUT.tif|OUT.ply",
-                   options, positional, vm))
+        if (!parse(argc, argv,
+                   "terrain field INPUT --field shape-index|sdf|height -o OUT.tif|OUT.ply", options,
+                   positional, vm))
             return 0;
-        if (field_name == "sdf")
-            throw UsageError("--field sdf is not available yet; use shape-index or height");
-        field_options.kind = field::parse_field_kind(field_name);
-        if (vm["rings"].defaulted() == false && field_options.shape_index.radius > 0)
-            throw UsageError("give --rings or --radius, not both");
+        const field::FieldOptions field_options = to_field_options(field_values, vm);
         const bool to_ply = io::is_mesh_file(output);
         const std::string ext = std::filesystem::path(output).extension().string();
         if (!to_ply && ext != ".tif" && ext != ".tiff")
             throw UsageError("the output must end in .tif or .ply");
+        if (!to_ply && io::is_mesh_file(input_path))
+            throw UsageError("a mesh input gives a .ply output, not a raster");
         io::check_output_path(output, overwrite);
 
         const auto progress = terminal_progress(quiet);
         const Input input = load_input(input_path, input_values, scaled_progress(progress, 0, 0.4));
-        const auto values = field::vertex_field(input.mesh, input.dem ? &*input.dem : nullptr,
-                                                field_options, scaled_progress(progress, 0.4, 1));
-        const std::string name = field_name == "height" ? "height" : "shape_index";
+        const auto field_progress = scaled_progress(progress, 0.4, 1);
+        std::vector<float> values;
+        std::optional<field::SdfResult> sdf;
+        if (field_options.kind == field::FieldKind::sdf) {
+            const std::size_t open = input.dem && !field_options.sdf.allow_open
+                                         ? mesh_topology(input.mesh).boundary_edges
+                                         : 0;
+            if (open > 0)
+                throw Error("sdf", "a DEM tile is an open surface (" + std::to_string(open) +
+                                       " boundary edges; only a global DEM closes) and the SDF "
+                                       "needs a closed one; use --field shape-index, or "
+                                       "--allow-open to compute it anyway");
+            sdf = field::shape_diameter_function(input.mesh, field_options.sdf, field_progress);
+            values = std::move(sdf->values);
+        } else {
+            values = field::vertex_field(input.mesh, input.dem ? &*input.dem : nullptr,
+                                         field_options, field_progress);
+        }
+        std::string name = field::to_string(field_options.kind);  // shape-index -> shape_index
+        std::replace(name.begin(), name.end(), '-', '_');
         if (to_ply) {
             io::write_ply(input.mesh, output, overwrite, {{name, &values}});
         } else {
-            if (!input.dem) throw UsageError("a mesh input gives a .ply output, not a raster");
             io::write_float_raster(*input.dem,
                                    field::field_to_pixels(input.mesh, *input.dem, values), output,
                                    overwrite, name);
@@ -71,6 +100,7 @@ int run_field(int argc, char** argv) {
         const auto [lo, hi] = std::minmax_element(values.begin(), values.end());
         std::printf("%s: %s on %zu vertices, range %.6g .. %.6g\n", output.c_str(), name.c_str(),
                     values.size(), double(*lo), double(*hi));
+        if (sdf) print_sdf_notes(*sdf);
         return 0;
     });
 }

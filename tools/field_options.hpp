@@ -10,10 +10,13 @@ namespace terrain::cli {
 
 struct FieldOptionValues {
     std::string name = "shape-index";
+    double cone_angle_degrees = 120;  // --cone-angle (the library takes radians)
+    bool no_postprocess = false;
     field::FieldOptions options;
 };
 
-// Adds --field, --rings, --radius bound to `values`.
+// Adds --field, --rings, --radius and the SDF's --rays, --cone-angle, --no-postprocess,
+// --allow-open bound to `values`.
 void add_field_options(po::options_description& options, FieldOptionValues& values);
 
 // The library's options from the parsed values; throws UsageError for contradictions.

@@ -29,7 +29,7 @@ constexpr Command kCommands[] = {
      terrain::cli::run_info},
     {"mesh", "triangulate a DEM on its body (or check a mesh file) into a binary PLY",
      terrain::cli::run_mesh},
-    {"field", "the scalar field (shape index, height) on a DEM's grid or a mesh's vertices",
+    {"field", "the scalar field (shape index, SDF, height) on a DEM's grid or a mesh's vertices",
      terrain::cli::run_field},
     {"reeb", "the Reeb graph of the field, simplified by persistence and area ratio",
      terrain::cli::run_reeb},

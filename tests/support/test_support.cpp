@@ -65,6 +65,18 @@ std::string write_raster(const std::filesystem::path& path, const RasterSpec& sp
     return path.string();
 }
 
+std::vector<float> read_raster_values(const std::string& path) {
+    GDALAllRegister();
+    std::unique_ptr<GDALDataset> ds(GDALDataset::Open(path.c_str(), GDAL_OF_RASTER));
+    if (!ds) throw std::runtime_error("cannot open " + path);
+    const int width = ds->GetRasterXSize(), height = ds->GetRasterYSize();
+    std::vector<float> values(static_cast<std::size_t>(width) * height);
+    if (ds->GetRasterBand(1)->RasterIO(GF_Read, 0, 0, width, height, values.data(), width, height,
+                                       GDT_Float32, 0, 0) != CE_None)
+        throw std::runtime_error("cannot read " + path);
+    return values;
+}
+
 namespace {
 std::string quote(const std::string& s) {
     std::string q = "'";

@@ -2,6 +2,8 @@
 // Helpers for the tests: sample data paths, a scratch directory, small rasters made with GDAL,
 // and running the `terrain` CLI.
 
+#include <tbb/global_control.h>
+
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -32,6 +34,16 @@ struct RasterSpec {
 };
 // Writes a GeoTIFF with GDAL; returns its path.
 std::string write_raster(const std::filesystem::path& path, const RasterSpec& spec);
+
+// Band 1 of a raster read with GDAL as floats, row-major.
+std::vector<float> read_raster_values(const std::string& path);
+
+// The result of `f()` with TBB limited to `threads` threads.
+template <class F>
+auto with_threads(int threads, F&& f) {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+    return f();
+}
 
 struct CliResult {
     int status = -1;

@@ -4,13 +4,57 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <cstring>
 #include <fstream>
+#include <map>
 #include <memory>
+#include <numbers>
+#include <sstream>
 
 #include "support/test_support.hpp"
+#include "terrain/field/sdf.hpp"
+#include "terrain/io/mesh_files.hpp"
 
 using Catch::Matchers::Contains;
 using terrain::test::run_cli;
+
+namespace {
+
+// The float vertex property `name` of a binary little-endian PLY.
+std::vector<float> read_ply_property(const std::string& path, const std::string& name) {
+    std::ifstream in(path, std::ios::binary);
+    std::string line;
+    std::size_t vertices = 0, stride = 0, offset = 0;
+    bool in_vertex = false, found = false;
+    const std::map<std::string, std::size_t> sizes = {
+        {"char", 1}, {"uchar", 1}, {"short", 2},  {"ushort", 2}, {"int", 4},
+        {"uint", 4}, {"float", 4}, {"double", 8}, {"int32", 4},  {"float32", 4}};
+    while (std::getline(in, line) && line != "end_header") {
+        std::istringstream words(line);
+        std::string word, type, property;
+        words >> word;
+        if (word == "element") {
+            std::size_t count = 0;
+            words >> type >> count;
+            in_vertex = type == "vertex";
+            if (in_vertex) vertices = count;
+        } else if (word == "property" && in_vertex) {
+            words >> type >> property;
+            if (property == name && type == "float") found = true, offset = stride;
+            stride += sizes.at(type);
+        }
+    }
+    REQUIRE(found);
+    std::vector<char> data(vertices * stride);
+    in.read(data.data(), static_cast<std::streamsize>(data.size()));
+    REQUIRE(in.gcount() == static_cast<std::streamsize>(data.size()));
+    std::vector<float> out(vertices);
+    for (std::size_t v = 0; v < vertices; ++v)
+        std::memcpy(&out[v], data.data() + v * stride + offset, sizeof(float));
+    return out;
+}
+
+}  // namespace
 
 TEST_CASE("terrain mesh on the shared DEMs and the samples", "[cli][mesh]") {
     const auto dir = terrain::test::scratch_dir("cli_mesh");
@@ -127,10 +171,96 @@ TEST_CASE("terrain field on a mesh writes a PLY property, bad options are refuse
     std::string header, line;
     while (std::getline(in, line) && line != "end_header") header += line + "\n";
     CHECK_THAT(header, Contains("property float height"));
-    CHECK(run_cli({"field", mesh, "--field", "sdf", "-o", (dir / "s.ply").string()}).status == 2);
     CHECK(run_cli({"field", mesh, "--field", "nonsense", "-o", (dir / "n.ply").string()}).status ==
           1);
     CHECK(run_cli({"field", mesh, "-o", (dir / "x.tif").string()}).status == 2);
     CHECK(run_cli({"field", mesh, "-o", (dir / "x.png").string()}).status == 2);
     CHECK(run_cli({"field", mesh, "-o", ply}).status == 1);  // exists
+}
+
+TEST_CASE("terrain field --field sdf: a mesh file round trip, open DEM tiles refused",
+          "[cli][field][sdf]") {
+    const auto dir = terrain::test::scratch_dir("cli_field_sdf");
+    // A closed mesh: a box twice as long as it is wide, its long sides cut into squares.
+    std::ofstream off(dir / "box.off");
+    off << "OFF\n12 20 0\n";
+    for (int z = 0; z <= 2; ++z)
+        for (const auto& [x, y] : {std::pair{0, 0}, {1, 0}, {1, 1}, {0, 1}})
+            off << x << " " << y << " " << z << "\n";
+    off << "3 0 2 1\n3 0 3 2\n3 8 9 10\n3 8 10 11\n";  // bottom, top
+    for (int level = 0; level < 2; ++level)
+        for (int k = 0; k < 4; ++k) {
+            const int a = 4 * level + k, b = 4 * level + (k + 1) % 4;
+            off << "3 " << a << " " << b << " " << b + 4 << "\n3 " << a << " " << b + 4 << " "
+                << a + 4 << "\n";
+        }
+    off.close();
+    const auto mesh = (dir / "box.off").string();
+    const auto ply = (dir / "box.ply").string();
+    const auto r = run_cli({"field", mesh, "--field", "sdf", "--rays", "9", "--cone-angle", "60",
+                            "--no-postprocess", "-o", ply, "-q"});
+    INFO(r.err);
+    REQUIRE(r.status == 0);
+    CHECK_THAT(r.out, Contains("sdf on 12 vertices, range 0 .. 100"));
+    CHECK_THAT(r.out, Contains("vertex diameters"));
+    const auto written = read_ply_property(ply, "sdf");
+    terrain::field::SdfOptions options;
+    options.rays = 9;
+    options.cone_angle = std::numbers::pi / 3;
+    options.postprocess = false;
+    const auto expected =
+        terrain::field::shape_diameter_function(terrain::io::read_mesh(mesh), options).values;
+    CHECK(written == expected);
+
+    // An open mesh: refused with the count of its boundary edges, or computed when allowed.
+    std::ofstream(dir / "open.off") << "OFF\n4 3 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n"
+                                       "3 0 2 1\n3 0 1 3\n3 0 3 2\n";
+    const auto open = (dir / "open.off").string();
+    const auto refused = run_cli({"field", open, "--field", "sdf", "-o", ply, "--overwrite"});
+    CHECK(refused.status == 1);
+    CHECK_THAT(refused.err, Contains("3 boundary edges"));
+    CHECK(run_cli({"field", open, "--field", "sdf", "--allow-open", "-o", ply, "--overwrite", "-q"})
+              .status == 0);
+    // Bad options.
+    CHECK(run_cli({"field", mesh, "--field", "sdf", "--rays", "0", "-o", ply, "--overwrite"})
+              .status == 1);
+    CHECK(
+        run_cli({"field", mesh, "--field", "sdf", "--cone-angle", "180", "-o", ply, "--overwrite"})
+            .status == 1);
+    // The same field options drive the Reeb graph (the paper's part-based case).
+    const auto reeb = run_cli(
+        {"reeb", mesh, "--field", "sdf", "--rays", "9", "-o", (dir / "box.json").string(), "-q"});
+    INFO(reeb.err);
+    CHECK(reeb.status == 0);
+
+    // A DEM tile is open: one line saying so. A global DEM closes: its SDF is a raster.
+    terrain::test::RasterSpec tile;
+    tile.width = tile.height = 10;
+    tile.crs = "EPSG:32611";
+    tile.geotransform = {400000, 30, 0, 3800000, 0, -30};
+    const auto tile_path = terrain::test::write_raster(dir / "tile.tif", tile);
+    const auto dem = run_cli(
+        {"field", tile_path, "--field", "sdf", "-o", (dir / "tile_sdf.tif").string(), "-q"});
+    CHECK(dem.status == 1);
+    CHECK_THAT(dem.err, Contains("open surface") && Contains("--field shape-index"));
+    terrain::test::RasterSpec global;
+    global.width = 36;
+    global.height = 18;
+    global.crs = "EPSG:4326";
+    global.geotransform = {-180, 10, 0, 90, 0, -10};
+    for (int row = 0; row < 18; ++row)
+        for (int col = 0; col < 36; ++col)
+            global.values.push_back(col < 18 ? 0.0 : 1e6);  // one half bulges out
+    const auto global_path = terrain::test::write_raster(dir / "global.tif", global);
+    const auto out = (dir / "global_sdf.tif").string();
+    const auto g = run_cli({"field", global_path, "--field", "sdf", "-o", out, "-q"});
+    INFO(g.err);
+    REQUIRE(g.status == 0);
+    const auto values = terrain::test::read_raster_values(out);
+    REQUIRE(values.size() == 36 * 18);
+    for (float v : values) {  // every pixel has its vertex (the pole rows collapse)
+        CHECK(v >= 0);
+        CHECK(v <= 100);
+    }
+    CHECK(*std::max_element(values.begin(), values.end()) == 100);
 }

@@ -9,12 +9,14 @@ namespace terrain::field {
 
 FieldKind parse_field_kind(const std::string& name) {
     if (name == "shape-index") return FieldKind::shape_index;
+    if (name == "sdf") return FieldKind::sdf;
     if (name == "height") return FieldKind::height;
-    throw Error("field", "unknown field '" + name + "'; use shape-index or height");
+    throw Error("field", "unknown field '" + name + "'; use shape-index, sdf or height");
 }
 
 const char* to_string(FieldKind kind) {
-    return kind == FieldKind::height ? "height" : "shape-index";
+    constexpr const char* kNames[] = {"shape-index", "sdf", "height"};  // FieldKind's order
+    return kNames[static_cast<int>(kind)];
 }
 
 std::vector<float> height_field(const TriangleMesh& mesh, const Dem* dem) {
@@ -41,6 +43,8 @@ std::vector<float> vertex_field(const TriangleMesh& mesh, const Dem* dem,
             report_progress(progress, 1.0, "height");
             return out;
         }
+        case FieldKind::sdf:
+            return shape_diameter_function(mesh, options.sdf, progress).values;
         default:
             return shape_index_field(mesh, options.shape_index, progress);
     }

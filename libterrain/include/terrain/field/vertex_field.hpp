@@ -7,20 +7,22 @@
 
 #include "terrain/core/dem.hpp"
 #include "terrain/core/progress.hpp"
+#include "terrain/field/sdf.hpp"
 #include "terrain/field/shape_index.hpp"
 #include "terrain/mesh/triangle_mesh.hpp"
 
 namespace terrain::field {
 
-enum class FieldKind { shape_index, height };
+enum class FieldKind { shape_index, sdf, height };
 
-// "shape-index" or "height"; throws terrain::Error for anything else.
+// "shape-index", "sdf" or "height"; throws terrain::Error for anything else.
 FieldKind parse_field_kind(const std::string& name);
 const char* to_string(FieldKind kind);
 
 struct FieldOptions {
     FieldKind kind = FieldKind::shape_index;
     ShapeIndexOptions shape_index;
+    SdfOptions sdf;
 };
 
 // Height above the reference body of each vertex: the DEM's height at the vertex's pixel
@@ -28,7 +30,8 @@ struct FieldOptions {
 // (dem == nullptr).
 std::vector<float> height_field(const TriangleMesh& mesh, const Dem* dem);
 
-// The field of `options.kind` on the mesh's vertices.
+// The field of `options.kind` on the mesh's vertices (shape_diameter_function for the SDF's
+// counts and diameters).
 std::vector<float> vertex_field(const TriangleMesh& mesh, const Dem* dem,
                                 const FieldOptions& options, const ProgressFn& progress = {});
 
