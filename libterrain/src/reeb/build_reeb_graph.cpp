@@ -305,59 +305,32 @@ void order_events(const TriangleMesh& mesh, const std::vector<float>& field, Ree
 }
 
 // True when the Reeb graph of any field on the mesh is a tree: every connected component is
-// of genus 0 with at most one boundary loop (a disk or a sphere).
+// of genus 0 with at most one boundary loop (a disk or a sphere). Assumes a 2-manifold.
 bool loop_free(const TriangleMesh& mesh) {
+    // A component's Euler characteristic is 2 - 2g - b: it is 1 or 2 exactly when the
+    // component is a disk (g = 0, b = 1) or a sphere (g = 0, b = 0).
     const std::size_t nv = mesh.vertex_count();
     std::vector<i32> comp(nv);
     std::iota(comp.begin(), comp.end(), 0);
-    auto root = [&](std::vector<i32>& p, i32 x) {
-        while (p[z(x)] != x) x = p[z(x)] = p[z(p[z(x)])];
+    auto root = [&](i32 x) {
+        while (comp[z(x)] != x) x = comp[z(x)] = comp[z(comp[z(x)])];
         return x;
     };
     for (const auto& t : mesh.triangles)
         for (int k = 0; k < 2; ++k) {
-            const i32 a = root(comp, t[z(k)]), b = root(comp, t[z(k + 1)]);
+            const i32 a = root(t[z(k)]), b = root(t[z(k + 1)]);
             if (a != b) comp[z(std::max(a, b))] = std::min(a, b);
         }
-    // Per component: 2 - chi - b = 2 g must be 0, and b <= 1.
-    const auto& off = mesh.neighbor_offsets;
-    const auto& nb = mesh.neighbors;
-    std::vector<std::uint8_t> uses(nb.size(), 0);
-    for (const auto& t : mesh.triangles)
-        for (int k = 0; k < 3; ++k) {
-            const i32 a = std::min(t[z(k)], t[z((k + 1) % 3)]),
-                      b = std::max(t[z(k)], t[z((k + 1) % 3)]);
-            const auto first = nb.begin() + off[z(a)], last = nb.begin() + off[z(a) + 1];
-            const auto it = std::lower_bound(first, last, b);
-            if (it != last && *it == b && uses[z(static_cast<i32>(it - nb.begin()))] < 2)
-                ++uses[z(static_cast<i32>(it - nb.begin()))];
-        }
-    std::vector<i32> bparent(nv);
-    std::iota(bparent.begin(), bparent.end(), 0);
     std::vector<std::int64_t> chi(nv, 0);
-    std::vector<char> on_boundary(nv, 0);
     for (std::size_t v = 0; v < nv; ++v) {
-        const i32 c = root(comp, static_cast<i32>(v));
-        chi[z(c)] += 1;
-        for (i32 i = off[v]; i < off[v + 1]; ++i) {
-            const i32 w = nb[z(i)];
-            if (z(w) <= v) continue;
-            chi[z(c)] -= 1;
-            if (uses[z(i)] == 1) {
-                on_boundary[v] = on_boundary[z(w)] = 1;
-                const i32 a = root(bparent, static_cast<i32>(v)), b = root(bparent, w);
-                if (a != b) bparent[z(std::max(a, b))] = std::min(a, b);
-            }
-        }
+        std::int64_t upper_neighbours = 0;
+        for (i32 i = mesh.neighbor_offsets[v]; i < mesh.neighbor_offsets[v + 1]; ++i)
+            upper_neighbours += z(mesh.neighbors[z(i)]) > v;
+        chi[z(root(static_cast<i32>(v)))] += 1 - upper_neighbours;
     }
-    for (const auto& t : mesh.triangles) chi[z(root(comp, t[0]))] += 1;
-    std::vector<std::int64_t> loops(nv, 0);
+    for (const auto& t : mesh.triangles) chi[z(root(t[0]))] += 1;
     for (std::size_t v = 0; v < nv; ++v)
-        if (on_boundary[v] && root(bparent, static_cast<i32>(v)) == static_cast<i32>(v))
-            ++loops[z(root(comp, static_cast<i32>(v)))];
-    for (std::size_t v = 0; v < nv; ++v)
-        if (comp[v] == static_cast<i32>(v) && (loops[v] > 1 || 2 - chi[v] - loops[v] != 0))
-            return false;
+        if (comp[v] == static_cast<i32>(v) && chi[v] != 1 && chi[v] != 2) return false;
     return true;
 }
 
@@ -375,11 +348,7 @@ void classify_links(const TriangleMesh& mesh, ReebGraph& g) {
             for (const i32 c : mesh.triangles[t]) tris[z(fill[z(c)]++)] = static_cast<i32>(t);
     }
     std::vector<i32> verts, parent;
-    for (std::size_t n = 0; n < g.node_count(); ++n) {
-        if (g.node_kinds[n] == NodeKind::regular) {
-            g.node_lower_links[n] = g.node_upper_links[n] = 1;
-            continue;
-        }
+    auto classify = [&](std::size_t n) {
         const i32 e = static_cast<i32>(n);
         verts.clear();
         for (i32 i = g.node_vertex_offsets[n]; i < g.node_vertex_offsets[n + 1]; ++i) {
@@ -428,7 +397,19 @@ void classify_links(const TriangleMesh& mesh, ReebGraph& g) {
                 ++(g.vertex_nodes[z(verts[i])] < e ? lower : upper);
         g.node_lower_links[n] = static_cast<std::uint8_t>(std::min(lower, 255));
         g.node_upper_links[n] = static_cast<std::uint8_t>(std::min(upper, 255));
+    };
+    // Single-vertex nodes in vertex order (their neighbourhoods are then read in memory
+    // order), plateaus after.
+    for (std::size_t v = 0; v < nv; ++v) {
+        const auto n = z(g.vertex_nodes[v]);
+        if (g.node_kinds[n] != NodeKind::regular &&
+            g.node_vertex_offsets[n + 1] - g.node_vertex_offsets[n] == 1)
+            classify(n);
     }
+    for (std::size_t n = 0; n < g.node_count(); ++n)
+        if (g.node_kinds[n] != NodeKind::regular &&
+            g.node_vertex_offsets[n + 1] - g.node_vertex_offsets[n] > 1)
+            classify(n);
 }
 
 // The contour tree of a loop-free mesh (Carr, Snoeyink & Axen): join and split trees by
