@@ -1,6 +1,9 @@
 #include <gdal_priv.h>
 
+#include <tbb/parallel_invoke.h>
+
 #include <filesystem>
+#include <mutex>
 
 #include "gdal_support.hpp"
 #include "terrain/core/error.hpp"
@@ -53,15 +56,27 @@ std::vector<std::string> write_segment_outputs(const std::string& dir, const Tri
     const bool overwrite = options.overwrite;
     const double steps = static_cast<double>(paths.size());
     std::size_t done = 0;
-    auto step = [&] { report_progress(progress, double(++done) / steps, "write"); };
+    std::mutex progress_mutex;  // the raster writers report from their own threads
+    auto step = [&] {
+        const std::lock_guard<std::mutex> lock(progress_mutex);
+        report_progress(progress, double(++done) / steps, "write");
+    };
     if (dem) {
+        // The three raster-based files are independent: written side by side.
         const auto pixels = segment::label_pixels(mesh, *dem, labels);
-        write_label_raster(*dem, pixels, graph, paths[0], overwrite);
-        step();
-        write_region_polygons(*dem, pixels, graph, paths[1], overwrite, options.polygons);
-        step();
-        write_preview_png(*dem, field::field_to_pixels(mesh, *dem, field), pixels, paths[5],
-                          overwrite);
+        tbb::parallel_invoke(
+            [&] {
+                write_label_raster(*dem, pixels, graph, paths[0], overwrite);
+                step();
+            },
+            [&] {
+                write_region_polygons(*dem, pixels, graph, paths[1], overwrite, options.polygons);
+                step();
+            },
+            [&] {
+                write_preview_png(*dem, field::field_to_pixels(mesh, *dem, field), pixels, paths[5],
+                                  overwrite);
+            });
     } else {
         write_labels_ply(mesh, field, labels, paths[0], overwrite, options.field_name);
         step();
