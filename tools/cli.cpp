@@ -97,4 +97,20 @@ io::ReadDemOptions to_read_options(const DemOptionValues& values) {
     return options;
 }
 
+void add_common_options(po::options_description& options, CommonValues& values,
+                        const char* output_help) {
+    options.add_options()("input", po::value(&values.input)->required(),
+                          "a DEM or a mesh (.off, .ply, .obj)")(
+        "output,o", po::value(&values.output)->required(), output_help)(
+        "overwrite", po::bool_switch(&values.overwrite), "replace existing outputs")(
+        "quiet,q", po::bool_switch(&values.quiet), "no progress output");
+}
+
+bool parse_command(int argc, char** argv, const std::string& usage,
+                   const po::options_description& options, po::variables_map& vm) {
+    po::positional_options_description positional;
+    positional.add("input", 1);
+    return parse(argc, argv, usage, options, positional, vm);
+}
+
 }  // namespace terrain::cli

@@ -24,6 +24,17 @@ struct UsageError : std::runtime_error {
 bool parse(int argc, char** argv, const std::string& usage, const po::options_description& options,
            const po::positional_options_description& positional, po::variables_map& vm);
 
+// The options of every mesh-based command: INPUT (positional), -o, --overwrite, -q.
+struct CommonValues {
+    std::string input, output;
+    bool overwrite = false, quiet = false;
+};
+void add_common_options(po::options_description& options, CommonValues& values,
+                        const char* output_help);
+// parse() with INPUT as the positional argument.
+bool parse_command(int argc, char** argv, const std::string& usage,
+                   const po::options_description& options, po::variables_map& vm);
+
 // GDAL-style progress on stderr ("0...10...20...30...40...50...60...70...80...90...100 - done.")
 // or nothing when quiet.
 ProgressFn terminal_progress(bool quiet);

@@ -17,34 +17,29 @@ namespace terrain::cli {
 
 int run_reeb(int argc, char** argv) {
     return guarded("reeb", [&] {
-        std::string input_path, output, field_output, algorithm = "auto";
-        bool quiet = false, overwrite = false;
+        CommonValues common;
+        std::string field_output, algorithm = "auto";
         InputOptionValues input_values;
         FieldOptionValues field_values;
         reeb::SimplifyOptions simplify_options;
         po::options_description options("terrain reeb options");
-        options.add_options()("input", po::value(&input_path)->required(),
-                              "a DEM or a mesh (.off, .ply, .obj)")(
-            "output,o", po::value(&output)->required(), "GRAPH.json (or GRAPH.dot for GraphViz)")(
-            "persistence", po::value(&simplify_options.persistence)->default_value(0.0),
-            "cancel arcs whose persistence is below P (field units)")(
+        add_common_options(options, common, "GRAPH.json (or GRAPH.dot for GraphViz)");
+        options.add_options()("persistence",
+                              po::value(&simplify_options.persistence)->default_value(0.0),
+                              "cancel arcs whose persistence is below P (field units)")(
             "area-ratio", po::value(&simplify_options.area_ratio)->default_value(0.0),
             "cancel arcs whose area ratio is below A percent of the surface")(
             "write-field", po::value(&field_output),
             "also write the simplified field (OUT.tif for a DEM, OUT.ply)")(
             "algorithm", po::value(&algorithm)->default_value("auto"),
-            "auto, sweep or contour-tree (disks and spheres only)")(
-            "overwrite", po::bool_switch(&overwrite), "replace existing outputs")(
-            "quiet,q", po::bool_switch(&quiet), "no progress output");
+            "auto, sweep or contour-tree (disks and spheres only)");
         add_field_options(options, field_values);
         add_input_options(options, input_values);
-        po::positional_options_description positional;
-        positional.add("input", 1);
         po::variables_map vm;
-        if (!parse(argc, argv,
-                   "terrain reeb INPUT [--field F] [--persistence P] [--area-ratio A] -o "
-                   "GRAPH.json [--write-field OUT]",
-                   options, positional, vm))
+        if (!parse_command(argc, argv,
+                           "terrain reeb INPUT [--field F] [--persistence P] [--area-ratio A] -o "
+                           "GRAPH.json [--write-field OUT]",
+                           options, vm))
             return 0;
         const auto field_options = to_field_options(field_values, vm);
         reeb::ReebOptions reeb_options;
@@ -54,14 +49,15 @@ int run_reeb(int argc, char** argv) {
             reeb_options.algorithm = reeb::ReebAlgorithm::contour_tree;
         else if (algorithm != "auto")
             throw UsageError("--algorithm must be auto, sweep or contour-tree");
-        const std::string ext = std::filesystem::path(output).extension().string();
+        const std::string ext = std::filesystem::path(common.output).extension().string();
         if (ext != ".json" && ext != ".dot")
             throw UsageError("the output must end in .json or .dot");
-        io::check_output_path(output, overwrite);
-        if (!field_output.empty()) io::check_output_path(field_output, overwrite);
+        io::check_output_path(common.output, common.overwrite);
+        if (!field_output.empty()) io::check_output_path(field_output, common.overwrite);
 
-        const auto progress = terminal_progress(quiet);
-        const Input input = load_input(input_path, input_values, scaled_progress(progress, 0, 0.3));
+        const auto progress = terminal_progress(common.quiet);
+        const Input input =
+            load_input(common.input, input_values, scaled_progress(progress, 0, 0.3));
         const Dem* dem = input.dem ? &*input.dem : nullptr;
         // Thresholds are checked before the long steps.
         reeb::simplify(TriangleMesh{}, reeb::ReebGraph{}, simplify_options);
@@ -78,11 +74,11 @@ int run_reeb(int argc, char** argv) {
             simplified = std::move(result.field);
         }
         if (ext == ".dot") {
-            reeb::write_reeb_dot(graph, output, overwrite);
+            reeb::write_reeb_dot(graph, common.output, common.overwrite);
         } else {
             reeb::write_reeb_json(
-                graph, input.mesh, output, overwrite,
-                {{"input", JsonWriter::escape(input_path)},
+                graph, input.mesh, common.output, common.overwrite,
+                {{"input", JsonWriter::escape(common.input)},
                  {"field", JsonWriter::escape(field_values.name)},
                  {"persistence", JsonWriter::number(simplify_options.persistence)},
                  {"area_ratio_percent", JsonWriter::number(simplify_options.area_ratio)},
@@ -90,11 +86,12 @@ int run_reeb(int argc, char** argv) {
         }
         if (!field_output.empty()) {
             if (io::is_mesh_file(field_output)) {
-                io::write_ply(input.mesh, field_output, overwrite, {{"field", &simplified}});
+                io::write_ply(input.mesh, field_output, common.overwrite, {{"field", &simplified}});
             } else {
                 if (!dem) throw UsageError("a mesh input gives a .ply field, not a raster");
                 io::write_float_raster(*dem, field::field_to_pixels(input.mesh, *dem, simplified),
-                                       field_output, overwrite, "simplified " + field_values.name);
+                                       field_output, common.overwrite,
+                                       "simplified " + field_values.name);
             }
         }
         report_progress(progress, 1.0);
@@ -102,7 +99,7 @@ int run_reeb(int argc, char** argv) {
         std::printf(
             "%s: %zu critical nodes (%zu minima, %zu maxima, %zu saddles), %zu arcs, %zu loops; "
             "%zu critical nodes before simplification\n",
-            output.c_str(), s.critical, s.minima, s.maxima, s.saddles, s.arcs, s.loops,
+            common.output.c_str(), s.critical, s.minima, s.maxima, s.saddles, s.arcs, s.loops,
             before.critical);
         return 0;
     });

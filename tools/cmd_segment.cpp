@@ -1,6 +1,6 @@
 // terrain segment INPUT -o OUTDIR [field options] [--persistence 10] [--area-ratio 0.5]
 //                  [--cost graph|standard] [--saddle-penalty 20] [--timings]
-// The main job: field, Reeb graph, simplification, region growing, and every output file.
+// The main job: field, Reeb graph, simplification, region growing, and every common.output file.
 // The outputs are written into a temporary sibling directory that replaces OUTDIR at the end,
 // so OUTDIR appears complete or not at all.
 #include "cli.hpp"
@@ -12,35 +12,29 @@ namespace terrain::cli {
 
 int run_segment(int argc, char** argv) {
     return guarded("segment", [&] {
-        std::string input_path, output;
-        bool quiet = false, overwrite = false;
+        CommonValues common;
         InputOptionValues input_values;
         FieldOptionValues field_values;
         SegmentOptionValues segment_values;
         po::options_description options("terrain segment options");
-        options.add_options()("input", po::value(&input_path)->required(),
-                              "a DEM or a mesh (.off, .ply, .obj)")(
-            "output,o", po::value(&output)->required(), "OUTDIR: the directory to write")(
-            "overwrite", po::bool_switch(&overwrite), "replace an existing OUTDIR")(
-            "quiet,q", po::bool_switch(&quiet), "no progress output");
+        add_common_options(options, common, "OUTDIR: the directory to write");
+        options.add_options();
         add_segment_options(options, segment_values);
         add_field_options(options, field_values);
         add_input_options(options, input_values);
-        po::positional_options_description positional;
-        positional.add("input", 1);
         po::variables_map vm;
-        if (!parse(argc, argv,
-                   "terrain segment INPUT -o OUTDIR [--persistence 10] [--area-ratio 0.5] "
-                   "[--cost graph|standard] [--saddle-penalty 20] [--timings]",
-                   options, positional, vm))
+        if (!parse_command(argc, argv,
+                           "terrain segment INPUT -o OUTDIR [--persistence 10] [--area-ratio 0.5] "
+                           "[--cost graph|standard] [--saddle-penalty 20] [--timings]",
+                           options, vm))
             return 0;
         const auto field_options = to_field_options(field_values, vm);
         check_segment_options(segment_values);
-        OutputDirectory dir(output, overwrite);
+        OutputDirectory dir(common.output, common.overwrite);
 
-        const auto progress = terminal_progress(quiet);
+        const auto progress = terminal_progress(common.quiet);
         SegmentJob job;
-        job.input = load_input(input_path, input_values, scaled_progress(progress, 0, 0.15));
+        job.input = load_input(common.input, input_values, scaled_progress(progress, 0, 0.15));
         job.timings.push_back({"read", job.input.read_seconds});
         if (job.input.dem) job.timings.push_back({"mesh", job.input.mesh_seconds});
         compute_field(job, field_options, scaled_progress(progress, 0.15, 0.45));
@@ -48,11 +42,11 @@ int run_segment(int argc, char** argv) {
         segment_once(job, segment_values, scaled_progress(progress, 0.6, 0.7));
         const auto files = write_segmentation(job, segment_values, dir.temp_path(),
                                               scaled_progress(progress, 0.7, 1));
-        write_run_json(job, input_path, field_values, segment_values, files,
+        write_run_json(job, common.input, field_values, segment_values, files,
                        dir.temp_path() + "/run.json");
         dir.commit();
         report_progress(progress, 1.0);
-        print_summary(job, output, segment_values.timings);
+        print_summary(job, common.output, segment_values.timings);
         return 0;
     });
 }

@@ -71,40 +71,36 @@ void write_text(const std::string& path, const std::string& text) {
 
 int run_sweep(int argc, char** argv) {
     return guarded("sweep", [&] {
-        std::string input_path, output, ratios_text;
-        bool quiet = false, overwrite = false;
+        CommonValues common;
+        std::string ratios_text;
         InputOptionValues input_values;
         FieldOptionValues field_values;
         SegmentOptionValues segment_values;
         po::options_description options("terrain sweep options");
-        options.add_options()("input", po::value(&input_path)->required(),
-                              "a DEM or a mesh (.off, .ply, .obj)")(
-            "output,o", po::value(&output)->required(), "OUTDIR: the directory to write")(
-            "area-ratios", po::value(&ratios_text)->default_value("0.1,0.25,0.5,1,2"),
-            "the scales: area-ratio thresholds in percent, comma separated")(
-            "overwrite", po::bool_switch(&overwrite), "replace an existing OUTDIR")(
-            "quiet,q", po::bool_switch(&quiet), "no progress output");
+        add_common_options(options, common, "OUTDIR: the directory to write");
+        options.add_options()("area-ratios",
+                              po::value(&ratios_text)->default_value("0.1,0.25,0.5,1,2"),
+                              "the scales: area-ratio thresholds in percent, comma separated");
         add_segment_options(options, segment_values);
         add_field_options(options, field_values);
         add_input_options(options, input_values);
-        po::positional_options_description positional;
-        positional.add("input", 1);
         po::variables_map vm;
-        if (!parse(argc, argv,
-                   "terrain sweep INPUT -o OUTDIR --area-ratios 0.1,0.25,0.5,1,2 [segment options]",
-                   options, positional, vm))
+        if (!parse_command(
+                argc, argv,
+                "terrain sweep INPUT -o OUTDIR --area-ratios 0.1,0.25,0.5,1,2 [segment options]",
+                options, vm))
             return 0;
         if (!vm["area-ratio"].defaulted())
             throw UsageError("terrain sweep takes --area-ratios (a list), not --area-ratio");
         const auto field_options = to_field_options(field_values, vm);
         check_segment_options(segment_values);
         const auto ratios = parse_ratios(ratios_text);
-        OutputDirectory dir(output, overwrite);
+        OutputDirectory dir(common.output, common.overwrite);
         const std::string d = dir.temp_path() + "/";
 
-        const auto progress = terminal_progress(quiet);
+        const auto progress = terminal_progress(common.quiet);
         SegmentJob job;
-        job.input = load_input(input_path, input_values, scaled_progress(progress, 0, 0.15));
+        job.input = load_input(common.input, input_values, scaled_progress(progress, 0, 0.15));
         job.add_time("read", job.input.read_seconds);
         if (job.input.dem) job.add_time("mesh", job.input.mesh_seconds);
         compute_field(job, field_options, scaled_progress(progress, 0.15, 0.4));
@@ -258,23 +254,15 @@ int run_sweep(int argc, char** argv) {
         SegmentOptionValues recorded = segment_values;
         recorded.simplify.area_ratio = scales.back().ratio;
         job.simplified.graph = reeb::ReebGraph{};
-        write_run_json(job, input_path, field_values, recorded, files, d + "run.json",
+        write_run_json(job, common.input, field_values, recorded, files, d + "run.json",
                        {{"scales", per_scale}});
         dir.commit();
         report_progress(progress, 1.0);
-        std::printf("%s: %zu scales;", output.c_str(), scales.size());
+        std::printf("%s: %zu scales;", common.output.c_str(), scales.size());
         for (const auto& s : scales)
             std::printf(" %s%%: %u regions;", s.name.c_str(), s.segmentation.region_count);
         std::printf(" %zu critical nodes before simplification\n", job.critical_before);
-        if (segment_values.timings) {
-            std::printf("%-10s %10s\n", "stage", "seconds");
-            double total = 0;
-            for (const auto& t : job.timings) {
-                std::printf("%-10s %10.3f\n", t.name.c_str(), t.seconds);
-                total += t.seconds;
-            }
-            std::printf("%-10s %10.3f\n", "total", total);
-        }
+        if (segment_values.timings) print_timings(job.timings);
         return 0;
     });
 }

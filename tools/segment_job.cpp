@@ -164,10 +164,13 @@ void print_summary(const SegmentJob& job, const std::string& output, bool timing
     std::printf("%s: %u regions on %zu vertices (critical nodes %zu -> %zu)\n", output.c_str(),
                 job.segmentation.region_count, job.input.mesh.vertex_count(), job.critical_before,
                 reeb::summarize(job.simplified.graph).critical);
-    if (!timings) return;
+    if (timings) print_timings(job.timings);
+}
+
+void print_timings(const std::vector<StageTime>& timings) {
     double total = 0;
     std::printf("%-10s %10s\n", "stage", "seconds");
-    for (const auto& t : job.timings) {
+    for (const auto& t : timings) {
         std::printf("%-10s %10.3f\n", t.name.c_str(), t.seconds);
         total += t.seconds;
     }

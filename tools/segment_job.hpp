@@ -60,6 +60,8 @@ void write_run_json(const SegmentJob& job, const std::string& input_path,
                     const std::vector<std::string>& files, const std::string& path,
                     const std::vector<std::pair<std::string, std::string>>& extra = {});
 void print_summary(const SegmentJob& job, const std::string& output, bool timings);
+// The stage table (the paper's Table 2): one line per stage and the total.
+void print_timings(const std::vector<StageTime>& timings);
 
 // A directory written in full beside its final place, then moved there: OUTDIR appears
 // complete or not at all. An existing non-empty OUTDIR is refused unless overwrite.

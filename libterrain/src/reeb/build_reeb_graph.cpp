@@ -21,6 +21,7 @@
 #include <numeric>
 #include <string>
 
+#include "../core/indices.hpp"
 #include "terrain/core/error.hpp"
 #include "terrain/reeb/reeb_graph.hpp"
 
@@ -177,12 +178,9 @@ std::string check_reeb_graph(const ReebGraph& g, const std::vector<float>& field
 
 namespace {
 
-using i32 = std::int32_t;
-constexpr i32 kNone = -1;
-
-inline std::size_t z(i32 i) {
-    return static_cast<std::size_t>(i);
-}
+using detail::i32;
+using detail::kNone;
+using detail::z;
 
 // Half-edge h = 3*t + k runs from corner k of triangle t to corner (k+1)%3.
 inline i32 next_he(i32 h) {

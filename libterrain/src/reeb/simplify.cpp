@@ -12,17 +12,16 @@
 #include <queue>
 #include <string>
 
+#include "../core/indices.hpp"
 #include "terrain/core/error.hpp"
 
 namespace terrain::reeb {
 
 namespace {
 
-using i32 = std::int32_t;
-constexpr i32 kNone = -1;
-inline std::size_t z(i32 i) {
-    return static_cast<std::size_t>(i);
-}
+using detail::i32;
+using detail::kNone;
+using detail::z;
 
 // The arcs at each node as doubly linked lists of arc ends (slot 2a and 2a+1 of arc a), so
 // that moving an arc end from one node to another allocates nothing.

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <queue>
 
+#include "../core/indices.hpp"
 #include "terrain/core/error.hpp"
 
 namespace terrain::segment {
@@ -25,11 +26,9 @@ const char* to_string(GrowCost cost) {
 
 namespace {
 
-using i32 = std::int32_t;
-constexpr i32 kNone = -1;
-inline std::size_t z(i32 i) {
-    return static_cast<std::size_t>(i);
-}
+using detail::i32;
+using detail::kNone;
+using detail::z;
 
 struct Candidate {
     float cost;
