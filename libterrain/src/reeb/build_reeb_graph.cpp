@@ -15,6 +15,8 @@
 // The contours entering P end their arcs at P when P is critical, and each new contour starts
 // an arc at P.
 
+#include <tbb/parallel_invoke.h>
+
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -415,25 +417,25 @@ void classify_links(const TriangleMesh& mesh, ReebGraph& g) {
 // whose chains of regular nodes become the arcs.
 void contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& progress) {
     const std::size_t nn = g.node_count();
-    std::vector<i32> uf(nn), head(nn), jp(nn, kNone), sp(nn, kNone), jc(nn, 0), sc(nn, 0),
-        mark(nn, kNone);
-    std::vector<std::uint8_t> rank(nn);
-    auto find = [&](i32 x) {
-        i32 r = x;
-        while (uf[z(r)] != r) r = uf[z(r)];
-        while (uf[z(x)] != r) {
-            const i32 nx = uf[z(x)];
-            uf[z(x)] = r;
-            x = nx;
-        }
-        return r;
-    };
-    // Union by rank; head[root] is the last event added to the component.
+    std::vector<i32> jp(nn, kNone), sp(nn, kNone), jc(nn, 0), sc(nn, 0);
+    // One union-find sweep; union by rank, head[root] is the last event added to the
+    // component. The join (ascending) and split (descending) sweeps are independent and run
+    // side by side, each with its own union-find.
     auto sweep = [&](bool ascending, std::vector<i32>& parent, std::vector<i32>& children) {
+        std::vector<i32> uf(nn), head(nn), mark(nn, kNone);
+        std::vector<std::uint8_t> rank(nn, 0);
         std::iota(uf.begin(), uf.end(), 0);
         std::iota(head.begin(), head.end(), 0);
-        std::fill(rank.begin(), rank.end(), 0);
-        std::fill(mark.begin(), mark.end(), kNone);
+        auto find = [&](i32 x) {
+            i32 r = x;
+            while (uf[z(r)] != r) r = uf[z(r)];
+            while (uf[z(x)] != r) {
+                const i32 nx = uf[z(x)];
+                uf[z(x)] = r;
+                x = nx;
+            }
+            return r;
+        };
         for (std::size_t k = 0; k < nn; ++k) {
             const i32 e = static_cast<i32>(ascending ? k : nn - 1 - k);
             i32 cur = e;
@@ -459,10 +461,8 @@ void contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& prog
             }
         }
     };
-    sweep(true, jp, jc);
-    report_progress(progress, 0.45, "reeb: join tree");
-    sweep(false, sp, sc);
-    report_progress(progress, 0.6, "reeb: split tree");
+    tbb::parallel_invoke([&] { sweep(true, jp, jc); }, [&] { sweep(false, sp, sc); });
+    report_progress(progress, 0.6, "reeb: join and split trees");
 
     // Merge: remove leaves one by one; each removal is one edge of the augmented tree.
     std::vector<char> dead(nn, 0);
