@@ -334,6 +334,56 @@ bool loop_free(const TriangleMesh& mesh) {
     return true;
 }
 
+// The numbers of connected components of a node's lower and upper links: the vertices
+// around the node (not in it), joined by the edges of its star's triangles that do not touch
+// it (the paper's link subgraphs).
+class LinkCounter {
+  public:
+    // `star`: the triangles with a corner in node e (repeats allowed).
+    std::pair<int, int> count(const TriangleMesh& mesh, const ReebGraph& g, i32 e,
+                              const std::vector<i32>& star) {
+        verts_.clear();
+        for (const i32 t : star)
+            for (const i32 c : mesh.triangles[z(t)])
+                if (g.vertex_nodes[z(c)] != e) verts_.push_back(c);
+        std::sort(verts_.begin(), verts_.end());
+        verts_.erase(std::unique(verts_.begin(), verts_.end()), verts_.end());
+        parent_.resize(verts_.size());
+        std::iota(parent_.begin(), parent_.end(), 0);
+        auto index = [&](i32 v) {
+            return static_cast<i32>(std::lower_bound(verts_.begin(), verts_.end(), v) -
+                                    verts_.begin());
+        };
+        auto find = [&](i32 x) {
+            while (parent_[z(x)] != x) x = parent_[z(x)] = parent_[z(parent_[z(x)])];
+            return x;
+        };
+        for (const i32 t : star) {
+            const auto& tri = mesh.triangles[z(t)];
+            for (int j = 0; j < 3; ++j) {
+                const i32 a = tri[z(j)], b = tri[z((j + 1) % 3)];
+                const i32 na = g.vertex_nodes[z(a)], nb = g.vertex_nodes[z(b)];
+                if (na == e || nb == e || (na < e) != (nb < e)) continue;
+                const i32 ra = find(index(a)), rb = find(index(b));
+                if (ra != rb) parent_[z(ra)] = rb;
+            }
+        }
+        int lower = 0, upper = 0;
+        for (std::size_t i = 0; i < verts_.size(); ++i)
+            if (find(static_cast<i32>(i)) == static_cast<i32>(i))
+                ++(g.vertex_nodes[z(verts_[i])] < e ? lower : upper);
+        return {lower, upper};
+    }
+
+  private:
+    std::vector<i32> verts_, parent_;
+};
+
+void set_links(ReebGraph& g, i32 e, std::pair<int, int> links) {
+    g.node_lower_links[z(e)] = static_cast<std::uint8_t>(std::min(links.first, 255));
+    g.node_upper_links[z(e)] = static_cast<std::uint8_t>(std::min(links.second, 255));
+}
+
 // Numbers of connected components of each critical node's lower and upper links (the link
 // graph: the vertices around the node and the star's edges between them).
 void classify_links(const TriangleMesh& mesh, ReebGraph& g) {
@@ -347,56 +397,15 @@ void classify_links(const TriangleMesh& mesh, ReebGraph& g) {
         for (std::size_t t = 0; t < mesh.triangle_count(); ++t)
             for (const i32 c : mesh.triangles[t]) tris[z(fill[z(c)]++)] = static_cast<i32>(t);
     }
-    std::vector<i32> verts, parent;
+    LinkCounter counter;
+    std::vector<i32> star;
     auto classify = [&](std::size_t n) {
-        const i32 e = static_cast<i32>(n);
-        verts.clear();
+        star.clear();
         for (i32 i = g.node_vertex_offsets[n]; i < g.node_vertex_offsets[n + 1]; ++i) {
             const i32 v = g.node_vertices[z(i)];
-            for (i32 k = mesh.neighbor_offsets[z(v)]; k < mesh.neighbor_offsets[z(v) + 1]; ++k)
-                if (g.vertex_nodes[z(mesh.neighbors[z(k)])] != e)
-                    verts.push_back(mesh.neighbors[z(k)]);
+            star.insert(star.end(), tris.begin() + tri_off[z(v)], tris.begin() + tri_off[z(v) + 1]);
         }
-        if (g.node_vertex_offsets[n + 1] - g.node_vertex_offsets[n] > 1) {  // CSR lists are sorted
-            std::sort(verts.begin(), verts.end());
-            verts.erase(std::unique(verts.begin(), verts.end()), verts.end());
-        }
-        parent.resize(verts.size());
-        std::iota(parent.begin(), parent.end(), 0);
-        auto index = [&](i32 v) {
-            if (verts.size() <= 16) {
-                i32 i = 0;
-                while (verts[z(i)] != v) ++i;
-                return i;
-            }
-            return static_cast<i32>(std::lower_bound(verts.begin(), verts.end(), v) -
-                                    verts.begin());
-        };
-        auto find = [&](i32 x) {
-            while (parent[z(x)] != x) x = parent[z(x)] = parent[z(parent[z(x)])];
-            return x;
-        };
-        for (i32 i = g.node_vertex_offsets[n]; i < g.node_vertex_offsets[n + 1]; ++i) {
-            const i32 v = g.node_vertices[z(i)];
-            for (i32 k = tri_off[z(v)]; k < tri_off[z(v) + 1]; ++k) {
-                const auto& t = mesh.triangles[z(tris[z(k)])];
-                // Only the edge opposite v can join two link vertices.
-                const int j = t[0] == v ? 1 : t[1] == v ? 2 : 0;
-                {
-                    const i32 a = t[z(j)], b = t[z((j + 1) % 3)];
-                    const i32 na = g.vertex_nodes[z(a)], nb = g.vertex_nodes[z(b)];
-                    if (na == e || nb == e || (na < e) != (nb < e)) continue;
-                    const i32 ra = find(index(a)), rb = find(index(b));
-                    if (ra != rb) parent[z(ra)] = rb;
-                }
-            }
-        }
-        int lower = 0, upper = 0;
-        for (std::size_t i = 0; i < verts.size(); ++i)
-            if (find(static_cast<i32>(i)) == static_cast<i32>(i))
-                ++(g.vertex_nodes[z(verts[i])] < e ? lower : upper);
-        g.node_lower_links[n] = static_cast<std::uint8_t>(std::min(lower, 255));
-        g.node_upper_links[n] = static_cast<std::uint8_t>(std::min(upper, 255));
+        set_links(g, static_cast<i32>(n), counter.count(mesh, g, static_cast<i32>(n), star));
     };
     // Single-vertex nodes in vertex order (their neighbourhoods are then read in memory
     // order), plateaus after.
@@ -640,7 +649,7 @@ class Sweep {
         i32 label, unresolved, need_boundary;
     };
     std::vector<LabelCount> label_counts_;
-    std::vector<i32> link_vertices_, link_parent_;
+    LinkCounter links_;
 };
 
 void Sweep::run(const ProgressFn& progress) {
@@ -824,19 +833,14 @@ void Sweep::general_event(i32 e, i32 begin, i32 end) {
         return static_cast<i32>(std::lower_bound(star_.begin(), star_.end(), t) - star_.begin());
     };
 
-    // 2. Contours entering the event (before it is processed), their boundary ends inside the
-    //    star, and the link components for the node's classification.
+    // 2. Contours entering the event (before it is processed) and their boundary ends inside
+    //    the star; the link components for the node's classification.
     d_in_.clear();
     label_counts_.clear();
-    link_vertices_.clear();
     for (const i32 t : star_) {
         const auto& tri = mesh_.triangles[z(t)];
         bool has_lower = false;
-        for (const i32 c : tri) {
-            const i32 n = g_.vertex_nodes[z(c)];
-            if (n != e) link_vertices_.push_back(c);
-            has_lower |= n < e;
-        }
+        for (const i32 c : tri) has_lower |= g_.vertex_nodes[z(c)] < e;
         if (!has_lower) continue;
         const i32 c = find(tri_label_[z(t)]);
         tri_label_[z(t)] = c;
@@ -853,37 +857,7 @@ void Sweep::general_event(i32 e, i32 begin, i32 end) {
                     if (lc.label == c) --lc.need_boundary;
         }
     }
-    // Link components: union-find over the link vertices joined by the star's edges.
-    std::sort(link_vertices_.begin(), link_vertices_.end());
-    link_vertices_.erase(std::unique(link_vertices_.begin(), link_vertices_.end()),
-                         link_vertices_.end());
-    link_parent_.resize(link_vertices_.size());
-    std::iota(link_parent_.begin(), link_parent_.end(), 0);
-    auto link_root = [&](i32 x) {
-        while (link_parent_[z(x)] != x)
-            x = link_parent_[z(x)] = link_parent_[z(link_parent_[z(x)])];
-        return x;
-    };
-    auto link_index = [&](i32 v) {
-        return static_cast<i32>(std::lower_bound(link_vertices_.begin(), link_vertices_.end(), v) -
-                                link_vertices_.begin());
-    };
-    for (const i32 t : star_) {
-        const auto& tri = mesh_.triangles[z(t)];
-        for (i32 j = 0; j < 3; ++j) {
-            const i32 a = tri[z(j)], b = tri[z((j + 1) % 3)];
-            const i32 na = g_.vertex_nodes[z(a)], nb = g_.vertex_nodes[z(b)];
-            if (na == e || nb == e || (na < e) != (nb < e)) continue;
-            const i32 ra = link_root(link_index(a)), rb = link_root(link_index(b));
-            if (ra != rb) link_parent_[z(ra)] = rb;
-        }
-    }
-    int lower_links = 0, upper_links = 0;
-    for (std::size_t i = 0; i < link_vertices_.size(); ++i)
-        if (link_root(static_cast<i32>(i)) == static_cast<i32>(i))
-            ++(g_.vertex_nodes[z(link_vertices_[i])] < e ? lower_links : upper_links);
-    g_.node_lower_links[z(e)] = static_cast<std::uint8_t>(std::min(lower_links, 255));
-    g_.node_upper_links[z(e)] = static_cast<std::uint8_t>(std::min(upper_links, 255));
+    set_links(g_, e, links_.count(mesh_, g_, e, star_));
 
     // 3. The event is processed from here on. Segments: new mixed triangles of the star joined
     //    across active edges; their exits into the old contours are the ends.
