@@ -59,8 +59,7 @@ int run_reeb(int argc, char** argv) {
         const Input input =
             load_input(common.input, input_values, scaled_progress(progress, 0, 0.3));
         const Dem* dem = input.dem ? &*input.dem : nullptr;
-        // Thresholds are checked before the long steps.
-        reeb::simplify(TriangleMesh{}, reeb::ReebGraph{}, simplify_options);
+        reeb::check_simplify_options(simplify_options);  // before the long steps
         const auto values = field::vertex_field(input.mesh, dem, field_options,
                                                 scaled_progress(progress, 0.3, 0.7));
         auto graph = reeb::build_reeb_graph(input.mesh, values, reeb_options,

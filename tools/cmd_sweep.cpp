@@ -55,7 +55,7 @@ struct Scale {
     double ratio = 0;
     std::string name;  // the ratio as written in file names ("0.25")
     segment::Segmentation segmentation;
-    std::size_t critical_after = 0;
+    reeb::ReebSummary after;  // of its simplified graph
     segment::RegionGraph regions;
     double seconds = 0;
 };
@@ -113,15 +113,11 @@ int run_sweep(int argc, char** argv) {
             const auto s0 = std::chrono::steady_clock::now();
             SegmentOptionValues values = segment_values;
             values.simplify.area_ratio = ratios[i];
-            const auto simplified = reeb::simplify(job.input.mesh, job.graph, values.simplify);
-            segment::GrowOptions grow = values.grow;
-            grow.cost = values.cost == "auto" ? (job.input.dem ? segment::GrowCost::graph
-                                                               : segment::GrowCost::standard)
-                                              : segment::parse_grow_cost(values.cost);
+            auto result = segment_scale(job, values);
             scales[i].ratio = ratios[i];
             scales[i].name = JsonWriter::number(ratios[i]);
-            scales[i].critical_after = reeb::summarize(simplified.graph).critical;
-            scales[i].segmentation = segment::grow_regions(job.input.mesh, simplified.graph, grow);
+            scales[i].after = result.after;
+            scales[i].segmentation = std::move(result.segmentation);
             scales[i].regions =
                 segment::region_graph(job.input.mesh, job.field, scales[i].segmentation.labels,
                                       scales[i].segmentation.region_count, job.dem());
@@ -226,7 +222,7 @@ int run_sweep(int argc, char** argv) {
             const double n = s.segmentation.region_count;
             const double mean = n > 0 ? total / n : 0;
             csv += s.name + "," + std::to_string(s.segmentation.region_count) + "," +
-                   std::to_string(s.critical_after) + "," + JsonWriter::number(mean) + "," +
+                   std::to_string(s.after.critical) + "," + JsonWriter::number(mean) + "," +
                    JsonWriter::number(total) + "\n";
             xs.push_back(s.ratio);
             counts.push_back(n);
@@ -241,19 +237,19 @@ int run_sweep(int argc, char** argv) {
 
         // run.json: the last scale stands in for the one-segmentation fields; every scale listed.
         job.segmentation = scales.back().segmentation;
+        job.after = scales.back().after;
         std::string per_scale = "[";
         for (std::size_t i = 0; i < scales.size(); ++i) {
             const auto& s = scales[i];
             per_scale += std::string(i ? "," : "") + "{\"area_ratio_percent\":" + s.name +
                          ",\"regions\":" + std::to_string(s.segmentation.region_count) +
-                         ",\"critical_nodes_after\":" + std::to_string(s.critical_after) +
+                         ",\"critical_nodes_after\":" + std::to_string(s.after.critical) +
                          ",\"relaxed_nodes\":" + std::to_string(s.segmentation.relaxed_nodes) +
                          ",\"seconds\":" + JsonWriter::number(s.seconds) + "}";
         }
         per_scale += "]";
         SegmentOptionValues recorded = segment_values;
         recorded.simplify.area_ratio = scales.back().ratio;
-        job.simplified.graph = reeb::ReebGraph{};
         write_run_json(job, common.input, field_values, recorded, files, d + "run.json",
                        {{"scales", per_scale}});
         dir.commit();

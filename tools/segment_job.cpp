@@ -75,19 +75,31 @@ void compute_reeb(SegmentJob& job, const ProgressFn& progress) {
     job.add_time("reeb", since(t0));
 }
 
-void segment_once(SegmentJob& job, const SegmentOptionValues& values, const ProgressFn& progress) {
+ScaleResult segment_scale(const SegmentJob& job, const SegmentOptionValues& values,
+                          const ProgressFn& progress) {
+    ScaleResult out;
     auto t0 = clock::now();
-    job.simplified = reeb::simplify(job.input.mesh, job.graph, values.simplify,
-                                    scaled_progress(progress, 0, 0.3));
-    job.add_time("simplify", since(t0));
+    const auto simplified = reeb::simplify(job.input.mesh, job.graph, values.simplify,
+                                           scaled_progress(progress, 0, 0.3));
+    out.after = reeb::summarize(simplified.graph);
+    out.simplify_seconds = since(t0);
     t0 = clock::now();
     segment::GrowOptions grow = values.grow;
     grow.cost = values.cost == "auto"
                     ? (job.input.dem ? segment::GrowCost::graph : segment::GrowCost::standard)
                     : segment::parse_grow_cost(values.cost);
-    job.segmentation = segment::grow_regions(job.input.mesh, job.simplified.graph, grow,
+    out.segmentation = segment::grow_regions(job.input.mesh, simplified.graph, grow,
                                              scaled_progress(progress, 0.3, 1));
-    job.add_time("grow", since(t0));
+    out.grow_seconds = since(t0);
+    return out;
+}
+
+void segment_once(SegmentJob& job, const SegmentOptionValues& values, const ProgressFn& progress) {
+    auto result = segment_scale(job, values, progress);
+    job.segmentation = std::move(result.segmentation);
+    job.after = result.after;
+    job.add_time("simplify", result.simplify_seconds);
+    job.add_time("grow", result.grow_seconds);
 }
 
 std::vector<std::string> write_segmentation(SegmentJob& job, const SegmentOptionValues& values,
@@ -113,7 +125,7 @@ void write_run_json(const SegmentJob& job, const std::string& input_path,
     if (!os) throw Error("write", "cannot write " + path);
     JsonWriter j(os);
     const auto topo = mesh_topology(job.input.mesh);
-    const auto after = reeb::summarize(job.simplified.graph);
+    const auto& after = job.after;
     j.begin_object();
     j.field("input", fs::absolute(input_path).lexically_normal().string());
     j.key("parameters")
@@ -163,7 +175,7 @@ void write_run_json(const SegmentJob& job, const std::string& input_path,
 void print_summary(const SegmentJob& job, const std::string& output, bool timings) {
     std::printf("%s: %u regions on %zu vertices (critical nodes %zu -> %zu)\n", output.c_str(),
                 job.segmentation.region_count, job.input.mesh.vertex_count(), job.critical_before,
-                reeb::summarize(job.simplified.graph).critical);
+                job.after.critical);
     if (timings) print_timings(job.timings);
 }
 

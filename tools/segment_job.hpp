@@ -39,7 +39,7 @@ struct SegmentJob {
     std::vector<float> field;  // as computed
     reeb::ReebGraph graph;     // before simplification
     std::size_t critical_before = 0;
-    reeb::SimplifyResult simplified;  // of the last segment_once
+    reeb::ReebSummary after;  // the simplified graph of the segmentation below
     segment::Segmentation segmentation;
     segment::RegionGraph regions;
     std::vector<StageTime> timings;
@@ -49,8 +49,16 @@ struct SegmentJob {
 
 void compute_field(SegmentJob& job, const field::FieldOptions& options, const ProgressFn& progress);
 void compute_reeb(SegmentJob& job, const ProgressFn& progress);
+struct ScaleResult {
+    segment::Segmentation segmentation;
+    reeb::ReebSummary after;  // of the simplified graph
+    double simplify_seconds = 0, grow_seconds = 0;
+};
 // Simplifies job.graph with values.simplify and grows the regions (cost auto: graph for DEMs,
-// standard for meshes); fills job.simplified, job.segmentation and job.regions.
+// standard for meshes). Reads the job only, so scales can run side by side.
+ScaleResult segment_scale(const SegmentJob& job, const SegmentOptionValues& values,
+                          const ProgressFn& progress = {});
+// segment_scale into the job (segmentation, after, timings).
 void segment_once(SegmentJob& job, const SegmentOptionValues& values, const ProgressFn& progress);
 // Every output of one segmentation into `dir`; returns the file names written.
 std::vector<std::string> write_segmentation(SegmentJob& job, const SegmentOptionValues& values,

@@ -444,12 +444,16 @@ ArcMetrics arc_metrics(const TriangleMesh& mesh, const ReebGraph& g) {
     return m;
 }
 
-SimplifyResult simplify(const TriangleMesh& mesh, const ReebGraph& graph,
-                        const SimplifyOptions& options, const ProgressFn& progress) {
+void check_simplify_options(const SimplifyOptions& options) {
     if (!std::isfinite(options.persistence) || options.persistence < 0)
         throw Error("simplify", "the persistence threshold must be a number >= 0");
     if (!std::isfinite(options.area_ratio) || options.area_ratio < 0 || options.area_ratio > 100)
         throw Error("simplify", "the area ratio is a percentage: it must be between 0 and 100");
+}
+
+SimplifyResult simplify(const TriangleMesh& mesh, const ReebGraph& graph,
+                        const SimplifyOptions& options, const ProgressFn& progress) {
+    check_simplify_options(options);
     if (graph.vertex_nodes.size() != mesh.vertex_count())
         throw Error("simplify", "the graph was not built on this mesh");
     SimplifyResult result;

@@ -27,7 +27,11 @@ struct SimplifyResult {
     std::size_t saddle_extremum = 0, extremum_extremum = 0;  // cancellations done
 };
 
-// Throws terrain::Error for negative or non-finite thresholds, or an area ratio above 100.
+// Throws terrain::Error (stage "simplify") for a negative or non-finite threshold, or an area
+// ratio above 100 percent.
+void check_simplify_options(const SimplifyOptions& options);
+
+// Throws as check_simplify_options does.
 SimplifyResult simplify(const TriangleMesh& mesh, const ReebGraph& graph,
                         const SimplifyOptions& options, const ProgressFn& progress = {});
 
