@@ -27,6 +27,11 @@ bool parse(int argc, char** argv, const std::string& usage, const po::options_de
     return true;
 }
 
+namespace {
+// True while a progress line is unfinished on stderr: an error then starts a new line.
+bool progress_line_open = false;
+}  // namespace
+
 ProgressFn terminal_progress(bool quiet) {
     if (quiet) return {};
     // Prints each tenth once, like GDALTermProgress; shared state lives in the closure.
@@ -39,25 +44,31 @@ ProgressFn terminal_progress(bool quiet) {
                 std::cerr << "100 - done." << std::endl;
             else
                 std::cerr << *last * 10 << "..." << std::flush;
+            progress_line_open = *last != 10;
         }
         return true;
     };
 }
 
 int guarded(const std::string& command, const std::function<int()>& body) {
+    auto report = [&](const std::string& message) {
+        if (progress_line_open) std::cerr << "\n";
+        progress_line_open = false;
+        std::cerr << "terrain " << command << ": " << message << "\n";
+    };
     try {
         return body();
     } catch (const UsageError& e) {
-        std::cerr << "terrain " << command << ": " << e.what() << "\n";
+        report(e.what());
         return kUsageError;
     } catch (const terrain::Error& e) {
-        std::cerr << "terrain " << command << ": " << e.what() << "\n";
+        report(e.what());
         return kUserError;
     } catch (const std::bad_alloc&) {
-        std::cerr << "terrain " << command << ": out of memory; try a smaller input\n";
+        report("out of memory; try a smaller input");
         return kUserError;
     } catch (const std::exception& e) {
-        std::cerr << "terrain " << command << ": " << e.what() << "\n";
+        report(e.what());
         return kUserError;
     }
 }

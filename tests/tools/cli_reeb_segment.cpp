@@ -83,6 +83,10 @@ TEST_CASE("terrain reeb writes the graph as JSON and DOT", "[cli][reeb]") {
     CHECK(r.status == 1);
     CHECK_THAT(r.err, Contains("percent"));
     CHECK(run_cli({"reeb", dem, "-o", (dir / "g.txt").string(), "-q"}).status == 2);
+    // A failure after progress started is reported on a line of its own.
+    r = run_cli({"field", dem, "--field", "sdf", "-o", (dir / "sdf.tif").string()});
+    CHECK(r.status == 1);
+    CHECK_THAT(r.err, Contains("...\nterrain field: "));
 }
 
 TEST_CASE("terrain segment writes every output, complete or not at all", "[cli][segment]") {
