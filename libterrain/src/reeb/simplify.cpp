@@ -1,8 +1,9 @@
 // Critical-node cancellation on a Reeb graph (docs/reeb.md). The graph is copied into a
-// mutable form: critical nodes keep their incident arcs, regular nodes sit in doubly linked
-// lists (one per arc, sorted by value), absorbed nodes forward to the node that took them.
-// Candidates wait in a min-heap keyed by (persistence, arc id) with lazy deletion: an arc's
-// version changes whenever its metrics may have changed, and stale entries are skipped.
+// mutable form: each node's arcs in a linked list of arc ends, regular nodes in doubly linked
+// lists (one per arc, sorted by value), absorbed nodes forwarding to the node that took them.
+// Candidates wait in a min-heap keyed by (persistence, arc id) with lazy deletion: each arc
+// remembers the key of its live entry, entries with another key are stale and skipped, and a
+// popped arc is checked again before it is cancelled.
 
 #include "terrain/reeb/simplify.hpp"
 
