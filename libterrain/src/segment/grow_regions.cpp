@@ -113,7 +113,6 @@ class Grower {
     // of each incident arc for a critical node. CSR.
     void build_reeb_neighbours() {
         const std::size_t nn = g_.node_count();
-        std::vector<std::vector<i32>> tmp;  // only used for critical nodes' lists
         nb_off_.assign(nn + 1, 0);
         auto along = [&](std::size_t a, bool from_lower) {
             const i32 b = g_.arc_offsets[a], e = g_.arc_offsets[a + 1];
