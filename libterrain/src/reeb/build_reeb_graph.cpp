@@ -18,10 +18,13 @@
 #include <tbb/parallel_invoke.h>
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cmath>
+#include <memory>
 #include <numeric>
 #include <string>
+#include <utility>
 
 #include "../core/indices.hpp"
 #include "terrain/core/error.hpp"
@@ -249,9 +252,7 @@ inline std::uint32_t float_key(float f) {
 // the graph's node_vertex_offsets, node_vertices and vertex_nodes.
 void order_events(const TriangleMesh& mesh, const std::vector<float>& field, ReebGraph& g) {
     const std::size_t nv = field.size();
-    std::vector<i32> rep(nv);
-    std::iota(rep.begin(), rep.end(), 0);
-    bool any_plateau = false;
+    std::vector<i32> rep;  // each vertex's plateau representative (its lowest vertex)
     auto root = [&](i32 x) {
         while (rep[z(x)] != x) x = rep[z(x)] = rep[z(rep[z(x)])];
         return x;
@@ -260,48 +261,75 @@ void order_events(const TriangleMesh& mesh, const std::vector<float>& field, Ree
         for (auto i = mesh.neighbor_offsets[v]; i < mesh.neighbor_offsets[v + 1]; ++i) {
             const i32 w = mesh.neighbors[z(i)];
             if (z(w) > v && field[z(w)] == field[v]) {
+                if (rep.empty()) {
+                    rep.resize(nv);
+                    std::iota(rep.begin(), rep.end(), 0);
+                }
                 const i32 a = root(static_cast<i32>(v)), b = root(w);
                 if (a != b) rep[z(std::max(a, b))] = std::min(a, b);
-                any_plateau = true;
             }
         }
+    const bool any_plateau = !rep.empty();
     if (any_plateau)
         for (std::size_t v = 0; v < nv; ++v) rep[v] = root(static_cast<i32>(v));
 
-    // Stable LSD radix sort on (value bits, plateau), 16 bits per pass; ties keep vertex order.
-    struct Key {
-        std::uint64_t key;
-        i32 vertex;
-    };
-    std::vector<Key> keys(nv), tmp(nv);
-    for (std::size_t v = 0; v < nv; ++v)
-        keys[v] = {(std::uint64_t{float_key(field[v])} << 32) | static_cast<std::uint32_t>(rep[v]),
-                   static_cast<i32>(v)};
-    std::vector<std::uint32_t> count(65537);
-    for (int shift = 0; shift < 64; shift += 16) {
-        std::fill(count.begin(), count.end(), 0u);
-        for (const Key& k : keys) ++count[((k.key >> shift) & 0xffffu) + 1];
-        if (count[((keys.empty() ? 0 : keys[0].key >> shift) & 0xffffu) + 1] == nv) continue;
-        for (std::size_t i = 1; i < count.size(); ++i) count[i] += count[i - 1];
-        for (const Key& k : keys) tmp[count[(k.key >> shift) & 0xffffu]++] = k;
+    // Stable LSD radix sort of (value bits << 32 | vertex) on the value bits, 11 bits per
+    // pass: ties keep vertex order.
+    std::vector<std::uint64_t> keys(nv), tmp(nv);
+    for (std::size_t v = 0; v < nv; ++v) keys[v] = (std::uint64_t{float_key(field[v])} << 32) | v;
+    constexpr int kBits = 11;
+    constexpr std::size_t kBuckets = std::size_t{1} << kBits;
+    std::vector<std::uint32_t> count(3 * kBuckets, 0u);
+    for (const std::uint64_t k : keys)
+        for (int p = 0; p < 3; ++p)
+            ++count[z(p) * kBuckets + ((k >> (32 + kBits * p)) & (kBuckets - 1))];
+    for (int p = 0; p < 3; ++p) {
+        std::uint32_t* c = count.data() + z(p) * kBuckets;
+        const int shift = 32 + kBits * p;
+        if (nv == 0 || c[(keys[0] >> shift) & (kBuckets - 1)] == nv) continue;  // one bucket
+        std::uint32_t sum = 0;
+        for (std::size_t b = 0; b < kBuckets; ++b) sum += std::exchange(c[b], sum);
+        for (const std::uint64_t k : keys) tmp[c[(k >> shift) & (kBuckets - 1)]++] = k;
         keys.swap(tmp);
     }
+    tmp = {};
+    // Equal values: plateaus together, ordered by their lowest vertex.
+    auto same_value = [](std::uint64_t a, std::uint64_t b) { return (a >> 32) == (b >> 32); };
+    auto vertex = [](std::uint64_t k) { return static_cast<i32>(k & 0xffffffffu); };
+    if (any_plateau)
+        for (std::size_t i = 0; i < nv;) {
+            std::size_t j = i + 1;
+            while (j < nv && same_value(keys[i], keys[j])) ++j;
+            if (j - i > 1)
+                std::sort(keys.begin() + static_cast<std::ptrdiff_t>(i),
+                          keys.begin() + static_cast<std::ptrdiff_t>(j),
+                          [&](std::uint64_t a, std::uint64_t b) {
+                              const i32 ra = rep[z(vertex(a))], rb = rep[z(vertex(b))];
+                              return ra != rb ? ra < rb : vertex(a) < vertex(b);
+                          });
+            i = j;
+        }
+    auto same_event = [&](std::uint64_t a, std::uint64_t b) {
+        return any_plateau && same_value(a, b) && rep[z(vertex(a))] == rep[z(vertex(b))];
+    };
     g.node_vertices.resize(nv);
     g.vertex_nodes.resize(nv);
     g.node_vertex_offsets.clear();
     g.node_vertex_offsets.reserve(nv + 1);
+    g.node_values.clear();
+    g.node_values.reserve(nv);
     for (std::size_t i = 0; i < nv; ++i) {
-        if (i == 0 || keys[i].key != keys[i - 1].key)
+        const i32 v = vertex(keys[i]);
+        if (i == 0 || !same_event(keys[i], keys[i - 1])) {
             g.node_vertex_offsets.push_back(static_cast<i32>(i));
-        g.node_vertices[i] = keys[i].vertex;
-        g.vertex_nodes[z(keys[i].vertex)] = static_cast<i32>(g.node_vertex_offsets.size() - 1);
+            g.node_values.push_back(field[z(v)]);
+        }
+        g.node_vertices[i] = v;
+        g.vertex_nodes[z(v)] = static_cast<i32>(g.node_vertex_offsets.size() - 1);
     }
     g.node_vertex_offsets.push_back(static_cast<i32>(nv));
     g.node_vertex_offsets.shrink_to_fit();
-    const std::size_t n_nodes = g.node_vertex_offsets.size() - 1;
-    g.node_values.resize(n_nodes);
-    for (std::size_t e = 0; e < n_nodes; ++e)
-        g.node_values[e] = field[z(g.node_vertices[z(g.node_vertex_offsets[e])])];
+    g.node_values.shrink_to_fit();
 }
 
 // True when the Reeb graph of any field on the mesh is a tree: every connected component is
@@ -384,41 +412,103 @@ void set_links(ReebGraph& g, i32 e, std::pair<int, int> links) {
     g.node_upper_links[z(e)] = static_cast<std::uint8_t>(std::min(links.second, 255));
 }
 
-// Numbers of connected components of each critical node's lower and upper links (the link
-// graph: the vertices around the node and the star's edges between them).
-void classify_links(const TriangleMesh& mesh, ReebGraph& g) {
-    const std::size_t nv = mesh.vertex_count();
-    std::vector<i32> tri_off(nv + 1, 0), tris(mesh.triangle_count() * 3);
-    for (const auto& t : mesh.triangles)
-        for (const i32 c : t) ++tri_off[z(c) + 1];
-    std::partial_sum(tri_off.begin(), tri_off.end(), tri_off.begin());
-    {
-        std::vector<i32> fill(tri_off.begin(), tri_off.end() - 1);
-        for (std::size_t t = 0; t < mesh.triangle_count(); ++t)
-            for (const i32 c : mesh.triangles[t]) tris[z(fill[z(c)]++)] = static_cast<i32>(t);
-    }
-    LinkCounter counter;
-    std::vector<i32> star;
-    auto classify = [&](std::size_t n) {
-        star.clear();
-        for (i32 i = g.node_vertex_offsets[n]; i < g.node_vertex_offsets[n + 1]; ++i) {
-            const i32 v = g.node_vertices[z(i)];
-            star.insert(star.end(), tris.begin() + tri_off[z(v)], tris.begin() + tri_off[z(v) + 1]);
-        }
-        set_links(g, static_cast<i32>(n), counter.count(mesh, g, static_cast<i32>(n), star));
+constexpr i32 kSeveral = -2;
+// Up to two link components' representatives below and above a node: {kNone, kNone} for an
+// empty link, {r, kNone} for one component, {r, s} for two, {kSeveral, ...} when the node is
+// handled vertex by vertex (more components, a plateau, a vertex of very high degree).
+struct LinkReps {
+    std::array<i32, 2> lower, upper;
+};
+
+// Link components of every single-vertex node, in a pass over the triangles and one over the
+// vertices, both in memory order. In a 2-manifold the link of a vertex is a cycle (interior)
+// or a path (boundary), so a part of it has as many components as vertices minus edges,
+// except the whole cycle (one). Going round an interior vertex counter-clockwise, each run of
+// lower (upper) link vertices starts right after an upper (lower) one: the triangle holding
+// that step names the run's first vertex, its representative. Sets the graph's link counts of
+// those nodes; `general` marks the nodes left to a LinkCounter.
+std::vector<LinkReps> link_components(const TriangleMesh& mesh, ReebGraph& g,
+                                      std::vector<char>& general) {
+    const std::size_t nv = mesh.vertex_count(), nn = g.node_count();
+    const auto& node = g.vertex_nodes;
+    struct Star {
+        std::array<i32, 2> lower_starts, upper_starts;
+        std::uint8_t triangles, lower_edges, upper_edges, lower_runs, upper_runs;
     };
-    // Single-vertex nodes in vertex order (their neighbourhoods are then read in memory
-    // order), plateaus after.
-    for (std::size_t v = 0; v < nv; ++v) {
-        const auto n = z(g.vertex_nodes[v]);
-        if (g.node_kinds[n] != NodeKind::regular &&
-            g.node_vertex_offsets[n + 1] - g.node_vertex_offsets[n] == 1)
-            classify(n);
+    std::vector<Star> stars(nv, Star{{kNone, kNone}, {kNone, kNone}, 0, 0, 0, 0, 0});
+    for (const auto& t : mesh.triangles) {
+        const i32 n0 = node[z(t[0])], n1 = node[z(t[1])], n2 = node[z(t[2])];
+        // Corner v of node n sees the link step a -> b (counter-clockwise round v).
+        auto add = [&](i32 v, i32 n, i32 a, i32 b) {
+            Star& s = stars[z(v)];
+            ++s.triangles;
+            s.lower_edges += (n > a) & (n > b);
+            s.upper_edges += (n < a) & (n < b);
+            if (a > n && b < n) s.lower_starts[s.lower_runs++ & 1] = b;
+            if (a < n && b > n) s.upper_starts[s.upper_runs++ & 1] = b;
+        };
+        add(t[0], n0, n1, n2);
+        add(t[1], n1, n2, n0);
+        add(t[2], n2, n0, n1);
     }
-    for (std::size_t n = 0; n < g.node_count(); ++n)
-        if (g.node_kinds[n] != NodeKind::regular &&
-            g.node_vertex_offsets[n + 1] - g.node_vertex_offsets[n] > 1)
-            classify(n);
+    std::vector<LinkReps> reps(nn);
+    general.assign(nn, 0);
+    for (std::size_t v = 0; v < nv; ++v) {
+        const i32 n = node[v];
+        const i32 b = mesh.neighbor_offsets[v], e = mesh.neighbor_offsets[v + 1];
+        if (e - b > 250 || g.node_vertex_offsets[z(n) + 1] - g.node_vertex_offsets[z(n)] > 1) {
+            general[z(n)] = 1;
+            reps[z(n)] = {{kSeveral, kNone}, {kSeveral, kNone}};
+            continue;
+        }
+        int below = 0;
+        i32 some_below = kNone, some_above = kNone;
+        for (i32 i = b; i < e; ++i) {
+            const i32 m = node[z(mesh.neighbors[z(i)])];
+            below += m < n;
+            some_below = m < n ? m : some_below;
+            some_above = m < n ? some_above : m;
+        }
+        const int above = e - b - below;
+        const Star& s = stars[v];
+        const bool interior = s.triangles == e - b;
+        const int lower = (above == 0 && interior && below > 0) ? 1 : below - s.lower_edges;
+        const int upper = (below == 0 && interior && above > 0) ? 1 : above - s.upper_edges;
+        g.node_lower_links[z(n)] = static_cast<std::uint8_t>(lower);
+        g.node_upper_links[z(n)] = static_cast<std::uint8_t>(upper);
+        auto side = [&](int count, i32 some, int runs, const std::array<i32, 2>& starts) {
+            if (count <= 1) return std::array<i32, 2>{count == 0 ? kNone : some, kNone};
+            if (count == 2 && runs == 2) return starts;
+            return std::array<i32, 2>{kSeveral, kNone};
+        };
+        reps[z(n)] = {side(lower, some_below, s.lower_runs, s.lower_starts),
+                      side(upper, some_above, s.upper_runs, s.upper_starts)};
+    }
+    return reps;
+}
+
+// The link counts of the critical nodes that link_components left (plateaus, vertices of very
+// high degree), from their stars' triangles.
+void count_general_links(const TriangleMesh& mesh, ReebGraph& g, const std::vector<char>& general) {
+    std::vector<std::pair<i32, i32>> star;  // (node, triangle)
+    auto wanted = [&](i32 n) { return general[z(n)] && g.node_kinds[z(n)] != NodeKind::regular; };
+    for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
+        const auto& tri = mesh.triangles[t];
+        for (int k = 0; k < 3; ++k) {
+            const i32 n = g.vertex_nodes[z(tri[z(k)])];
+            if (wanted(n)) star.push_back({n, static_cast<i32>(t)});
+        }
+    }
+    if (star.empty()) return;
+    std::sort(star.begin(), star.end());
+    LinkCounter counter;
+    std::vector<i32> tris;
+    for (std::size_t i = 0; i < star.size();) {
+        const i32 n = star[i].first;
+        tris.clear();
+        for (; i < star.size() && star[i].first == n; ++i) tris.push_back(star[i].second);
+        set_links(g, n, counter.count(mesh, g, n, tris));
+    }
 }
 
 // The contour tree of a loop-free mesh (Carr, Snoeyink & Axen): join and split trees by
@@ -426,29 +516,91 @@ void classify_links(const TriangleMesh& mesh, ReebGraph& g) {
 // whose chains of regular nodes become the arcs.
 void contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& progress) {
     const std::size_t nn = g.node_count();
-    std::vector<i32> jp(nn, kNone), sp(nn, kNone), jc(nn, 0), sc(nn, 0);
-    // One union-find sweep; union by rank, head[root] is the last event added to the
-    // component. The join (ascending) and split (descending) sweeps are independent and run
-    // side by side, each with its own union-find.
+    g.node_lower_links.assign(nn, 1);
+    g.node_upper_links.assign(nn, 1);
+    std::vector<char> general;
+    const std::vector<LinkReps> reps = link_components(mesh, g, general);
+    report_progress(progress, 0.4, "reeb: links");
+
+    std::vector<i32> jp(nn, kNone), sp(nn, kNone), jc(nn), sc(nn);
+    // One union-find sweep. A node's entry holds its parent, or (at a root) minus one minus its
+    // rank, and the last event added to its component (the component's head). Most events have
+    // one link component below (above): one find, and the event hangs under the root. The join
+    // (ascending) and split (descending) sweeps are independent and run side by side.
+    struct Entry {
+        i32 up, head;
+    };
     auto sweep = [&](bool ascending, std::vector<i32>& parent, std::vector<i32>& children) {
-        std::vector<i32> uf(nn), head(nn), mark(nn, kNone);
-        std::vector<std::uint8_t> rank(nn, 0);
-        std::iota(uf.begin(), uf.end(), 0);
-        std::iota(head.begin(), head.end(), 0);
+        std::vector<Entry> uf(nn, Entry{-1, 0});
         auto find = [&](i32 x) {
             i32 r = x;
-            while (uf[z(r)] != r) r = uf[z(r)];
-            while (uf[z(x)] != r) {
-                const i32 nx = uf[z(x)];
-                uf[z(x)] = r;
+            while (uf[z(r)].up >= 0) r = uf[z(r)].up;
+            while (x != r) {
+                const i32 nx = uf[z(x)].up;
+                uf[z(x)].up = r;
                 x = nx;
             }
             return r;
         };
+        auto reps_at = [&](std::size_t k) -> const std::array<i32, 2>& {
+            const std::size_t e = ascending ? k : nn - 1 - k;
+            return ascending ? reps[e].lower : reps[e].upper;
+        };
+        // Paths are short: two steps up without branching, then the rare longer path.
+        auto find_short = [&](i32 x) {
+            const i32 ux = uf[z(x)].up;
+            const i32 b = ux >= 0 ? ux : x;
+            const i32 ub = uf[z(b)].up;
+            i32 c = ub >= 0 ? ub : b;
+            if (uf[z(c)].up >= 0) [[unlikely]]
+                c = find(c);
+            uf[z(x)].up = ux >= 0 ? c : ux;
+            return c;
+        };
+        // The sweep waits on memory: the entries of the representatives a few events ahead
+        // are fetched early (and, from those, their parents').
+        constexpr std::size_t kAhead = 16;
+        auto prefetch = [&](i32 x) { __builtin_prefetch(&uf[z(x >= 0 && z(x) < nn ? x : 0)]); };
+        std::vector<i32> roots;
         for (std::size_t k = 0; k < nn; ++k) {
+            if (k + kAhead < nn) {
+                const auto& r = reps_at(k + kAhead);
+                prefetch(r[0]);
+                prefetch(r[1]);
+            }
+            if (k + kAhead / 2 < nn) {
+                const auto& r = reps_at(k + kAhead / 2);
+                if (r[0] >= 0) prefetch(uf[z(r[0])].up);
+                if (r[1] >= 0) prefetch(uf[z(r[1])].up);
+            }
             const i32 e = static_cast<i32>(ascending ? k : nn - 1 - k);
-            i32 cur = e;
-            mark[z(e)] = e;
+            const auto& rep = reps_at(k);
+            if (rep[0] >= 0) {
+                // The event hangs under the component of its first link component.
+                const i32 c = find_short(rep[0]);
+                Entry& root = uf[z(c)];
+                parent[z(root.head)] = e;
+                children[z(e)] = 1;
+                uf[z(e)].up = c;
+                root.head = e;
+                root.up -= root.up == -1;  // rank 0 -> 1
+                if (rep[1] < 0) continue;
+                const i32 o = find_short(rep[1]);
+                if (o == c) continue;
+                // A second component joins here.
+                parent[z(uf[z(o)].head)] = e;
+                children[z(e)] = 2;
+                const bool c_higher = uf[z(c)].up <= uf[z(o)].up;
+                const i32 hi = c_higher ? c : o, lo = c_higher ? o : c;
+                if (uf[z(hi)].up == uf[z(lo)].up) --uf[z(hi)].up;
+                uf[z(lo)].up = hi;
+                uf[z(hi)].head = e;
+                continue;
+            }
+            uf[z(e)] = {-1, e};
+            children[z(e)] = 0;
+            if (rep[0] == kNone) continue;
+            roots.clear();
             for (i32 i = g.node_vertex_offsets[z(e)]; i < g.node_vertex_offsets[z(e) + 1]; ++i) {
                 const i32 v = g.node_vertices[z(i)];
                 for (i32 j = mesh.neighbor_offsets[z(v)]; j < mesh.neighbor_offsets[z(v) + 1];
@@ -456,17 +608,19 @@ void contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& prog
                     const i32 n = g.vertex_nodes[z(mesh.neighbors[z(j)])];
                     if (ascending ? n >= e : n <= e) continue;
                     const i32 c = find(n);
-                    if (mark[z(c)] == e) continue;
-                    parent[z(head[z(c)])] = e;
-                    ++children[z(e)];
-                    i32 r = cur, o = c;
-                    if (rank[z(r)] < rank[z(o)]) std::swap(r, o);
-                    if (rank[z(r)] == rank[z(o)]) ++rank[z(r)];
-                    uf[z(o)] = r;
-                    mark[z(r)] = e;
-                    head[z(r)] = e;
-                    cur = r;
+                    if (std::find(roots.begin(), roots.end(), c) == roots.end()) roots.push_back(c);
                 }
+            }
+            i32 cur = e;
+            for (const i32 c : roots) {
+                parent[z(uf[z(c)].head)] = e;
+                ++children[z(e)];
+                i32 r = cur, o = c;
+                if (uf[z(r)].up > uf[z(o)].up) std::swap(r, o);  // r has the higher rank
+                if (uf[z(r)].up == uf[z(o)].up) --uf[z(r)].up;
+                uf[z(o)].up = r;
+                uf[z(r)].head = e;
+                cur = r;
             }
         }
     };
@@ -516,7 +670,7 @@ void contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& prog
     }
     report_progress(progress, 0.75, "reeb: contour tree");
 
-    // Up-edges per node (CSR), then arcs from every critical node upwards.
+    // Up-edges per node (CSR, in the order of the removed leaves' indices).
     std::vector<i32> up_off(nn + 1, 0), up_to(nn);
     for (std::size_t x = 0; x < nn; ++x)
         if (attach[x] != kNone) ++up_off[z(goes_up[x] ? static_cast<i32>(x) : attach[x]) + 1];
@@ -531,35 +685,54 @@ void contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& prog
         }
     }
     g.node_kinds.assign(nn, NodeKind::regular);
-    g.node_arcs.assign(nn, kNone);
     for (std::size_t n = 0; n < nn; ++n) {
         const int d = down_deg[n], u = up_deg[n];
-        if (d == 1 && u == 1) continue;
+        if (d == 1 && u == 1) {  // Reeb-regular, whatever its link (a boundary vertex)
+            g.node_lower_links[n] = g.node_upper_links[n] = 1;
+            continue;
+        }
         g.node_kinds[n] = d == 0   ? NodeKind::minimum
                           : u == 0 ? NodeKind::maximum
                                    : NodeKind::saddle;
     }
+    // Arcs in the order of their lower nodes, then of their up-edges. A regular node takes the
+    // arc of the edge below it; `below` holds that edge as the regular node under it, or as
+    // -2 - arc when the edge leaves a critical node. One pass in increasing order then fills in
+    // every regular node (its lower neighbour comes first), so no chain is followed.
+    auto critical = [&](i32 n) { return g.node_kinds[z(n)] != NodeKind::regular; };
+    std::vector<i32>& below = attach;  // attach is no longer needed
     g.arcs.clear();
-    g.arc_offsets.assign(1, 0);
-    g.arc_nodes.clear();
-    g.arc_nodes.reserve(nn);
-    for (std::size_t c = 0; c < nn; ++c) {
-        if (g.node_kinds[c] == NodeKind::regular) continue;
-        for (i32 k = up_off[c]; k < up_off[c + 1]; ++k) {
-            const i32 arc = static_cast<i32>(g.arcs.size());
-            i32 n = up_to[z(k)];
-            while (g.node_kinds[z(n)] == NodeKind::regular) {
-                g.arc_nodes.push_back(n);
-                g.node_arcs[z(n)] = arc;
-                n = up_to[z(up_off[z(n)])];
+    for (std::size_t lo = 0; lo < nn; ++lo)
+        for (i32 k = up_off[lo]; k < up_off[lo + 1]; ++k) {
+            const i32 hi = up_to[z(k)];
+            if (critical(static_cast<i32>(lo))) {
+                const i32 arc = static_cast<i32>(g.arcs.size());
+                g.arcs.push_back({static_cast<i32>(lo), critical(hi) ? hi : kNone});
+                if (!critical(hi)) below[z(hi)] = -2 - arc;
+            } else if (!critical(hi)) {
+                below[z(hi)] = static_cast<i32>(lo);
             }
-            g.arcs.push_back({static_cast<i32>(c), n});
-            g.arc_offsets.push_back(static_cast<i32>(g.arc_nodes.size()));
         }
+    g.node_arcs.assign(nn, kNone);
+    g.arc_offsets.assign(g.arcs.size() + 1, 0);
+    for (std::size_t n = 0; n < nn; ++n) {
+        if (critical(static_cast<i32>(n))) continue;
+        const i32 b = below[n];
+        const i32 arc = b >= 0 ? g.node_arcs[z(b)] : -2 - b;
+        g.node_arcs[n] = arc;
+        ++g.arc_offsets[z(arc) + 1];
+        const i32 hi = up_to[z(up_off[n])];
+        if (critical(hi)) g.arcs[z(arc)][1] = hi;
     }
-    g.node_lower_links.assign(nn, 1);
-    g.node_upper_links.assign(nn, 1);
-    classify_links(mesh, g);
+    std::partial_sum(g.arc_offsets.begin(), g.arc_offsets.end(), g.arc_offsets.begin());
+    g.arc_nodes.resize(z(g.arc_offsets.back()));
+    {
+        std::vector<i32> fill(g.arc_offsets.begin(), g.arc_offsets.end() - 1);
+        for (std::size_t n = 0; n < nn; ++n)
+            if (!critical(static_cast<i32>(n)))
+                g.arc_nodes[z(fill[z(g.node_arcs[n])]++)] = static_cast<i32>(n);
+    }
+    count_general_links(mesh, g, general);
 }
 
 class Sweep {
