@@ -124,6 +124,26 @@ TEST_CASE("Disk-like DEMs give a tree; a hole in the DEM can give a loop", "[ree
     // Noise on the holed disk: at most one loop.
     for (unsigned seed : {8u, 9u, 10u})
         CHECK(checked(holed_mesh, test::noise_field(holed_mesh.vertex_count(), seed)).loops <= 1);
+    // Two islands, a disk and a ring: two components, and the ring's loop is found.
+    const auto islands = test::grid_dem(40, 30, [](int c, int r) {
+        const bool gap = c >= 12 && c < 15, ring_hole = c >= 22 && c < 30 && r >= 10 && r < 20;
+        return (gap || ring_hole) ? std::nan("") : 0.3 * c + 0.01 * r;
+    });
+    const auto islands_mesh = mesh::dem_to_mesh(islands);
+    CHECK_FALSE(reeb::reeb_is_tree(islands_mesh));
+    const auto t = checked(islands_mesh, field::height_field(islands_mesh, &islands));
+    CHECK(t.components == 2);
+    CHECK(t.loops == 1);
+    // Two disks: a forest from the contour tree.
+    const auto disks = test::grid_dem(
+        40, 30, [](int c, int) { return (c >= 12 && c < 15) ? std::nan("") : 0.3 * c; });
+    const auto disks_mesh = mesh::dem_to_mesh(disks);
+    CHECK(reeb::reeb_is_tree(disks_mesh));
+    const auto f = test::noise_field(disks_mesh.vertex_count(), 11);
+    const auto forest = reeb::build_reeb_graph(disks_mesh, f, {reeb::ReebAlgorithm::contour_tree});
+    REQUIRE(reeb::check_reeb_graph(forest, f).empty());
+    CHECK(reeb::summarize(forest).components == 2);
+    CHECK(reeb::summarize(forest).loops == 0);
 }
 
 TEST_CASE("Real tiles: trees with consistent nodes and arcs", "[reeb]") {

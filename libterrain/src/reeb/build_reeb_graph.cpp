@@ -247,6 +247,11 @@ inline std::uint32_t float_key(float f) {
     return (u & 0x80000000u) ? ~u : (u | 0x80000000u);
 }
 
+// The float of a sort key (-0 comes back as +0).
+inline float key_float(std::uint32_t k) {
+    return std::bit_cast<float>((k & 0x80000000u) ? (k & 0x7fffffffu) : ~k);
+}
+
 // Sorts the vertices into events (nodes) in increasing value: adjacent vertices with equal
 // values form one event; other ties go by the plateau's lowest vertex, then by vertex. Fills
 // the graph's node_vertex_offsets, node_vertices and vertex_nodes.
@@ -315,21 +320,26 @@ void order_events(const TriangleMesh& mesh, const std::vector<float>& field, Ree
     g.node_vertices.resize(nv);
     g.vertex_nodes.resize(nv);
     g.node_vertex_offsets.clear();
-    g.node_vertex_offsets.reserve(nv + 1);
     g.node_values.clear();
-    g.node_values.reserve(nv);
+    std::size_t n_nodes = nv;
+    if (any_plateau) {
+        n_nodes = 0;
+        for (std::size_t i = 0; i < nv; ++i) n_nodes += i == 0 || !same_event(keys[i], keys[i - 1]);
+    }
+    g.node_vertex_offsets.reserve(n_nodes + 1);
+    g.node_values.reserve(n_nodes);
+    constexpr std::size_t kAhead = 16;  // vertex_nodes is written in random order
     for (std::size_t i = 0; i < nv; ++i) {
+        if (i + kAhead < nv) __builtin_prefetch(&g.vertex_nodes[z(vertex(keys[i + kAhead]))], 1);
         const i32 v = vertex(keys[i]);
         if (i == 0 || !same_event(keys[i], keys[i - 1])) {
             g.node_vertex_offsets.push_back(static_cast<i32>(i));
-            g.node_values.push_back(field[z(v)]);
+            g.node_values.push_back(key_float(static_cast<std::uint32_t>(keys[i] >> 32)));
         }
         g.node_vertices[i] = v;
         g.vertex_nodes[z(v)] = static_cast<i32>(g.node_vertex_offsets.size() - 1);
     }
     g.node_vertex_offsets.push_back(static_cast<i32>(nv));
-    g.node_vertex_offsets.shrink_to_fit();
-    g.node_values.shrink_to_fit();
 }
 
 // True when the Reeb graph of any field on the mesh is a tree: every connected component is
@@ -425,9 +435,11 @@ struct LinkReps {
 // or a path (boundary), so a part of it has as many components as vertices minus edges,
 // except the whole cycle (one). Going round an interior vertex counter-clockwise, each run of
 // lower (upper) link vertices starts right after an upper (lower) one: the triangle holding
-// that step names the run's first vertex, its representative. Sets the graph's link counts of
-// those nodes; `general` marks the nodes left to a LinkCounter.
-std::vector<LinkReps> link_components(const TriangleMesh& mesh, ReebGraph& g,
+// that step names the run's first vertex, its representative. Gives the link counts of those
+// vertices in `vertex_links`; `general` marks the nodes left to a LinkCounter.
+using LinkCounts = std::array<std::uint8_t, 2>;
+std::vector<LinkReps> link_components(const TriangleMesh& mesh, const ReebGraph& g,
+                                      std::vector<LinkCounts>& vertex_links,
                                       std::vector<char>& general) {
     const std::size_t nv = mesh.vertex_count(), nn = g.node_count();
     const auto& node = g.vertex_nodes;
@@ -444,8 +456,14 @@ std::vector<LinkReps> link_components(const TriangleMesh& mesh, ReebGraph& g,
             ++s.triangles;
             s.lower_edges += (n > a) & (n > b);
             s.upper_edges += (n < a) & (n < b);
-            if (a > n && b < n) s.lower_starts[s.lower_runs++ & 1] = b;
-            if (a < n && b > n) s.upper_starts[s.upper_runs++ & 1] = b;
+            // Without branches: the steps' directions are unpredictable.
+            const bool down = (a > n) & (b < n), up = (a < n) & (b > n);
+            i32& ls = s.lower_starts[s.lower_runs & 1];
+            ls = down ? b : ls;
+            s.lower_runs += down;
+            i32& us = s.upper_starts[s.upper_runs & 1];
+            us = up ? b : us;
+            s.upper_runs += up;
         };
         add(t[0], n0, n1, n2);
         add(t[1], n1, n2, n0);
@@ -453,29 +471,32 @@ std::vector<LinkReps> link_components(const TriangleMesh& mesh, ReebGraph& g,
     }
     std::vector<LinkReps> reps(nn);
     general.assign(nn, 0);
+    vertex_links.resize(nv);
+    constexpr std::size_t kAhead = 16;  // the nodes' entries are written in random order
     for (std::size_t v = 0; v < nv; ++v) {
+        if (v + kAhead < nv) __builtin_prefetch(&reps[z(node[v + kAhead])], 1);
         const i32 n = node[v];
         const i32 b = mesh.neighbor_offsets[v], e = mesh.neighbor_offsets[v + 1];
-        if (e - b > 250 || g.node_vertex_offsets[z(n) + 1] - g.node_vertex_offsets[z(n)] > 1) {
-            general[z(n)] = 1;
-            reps[z(n)] = {{kSeveral, kNone}, {kSeveral, kNone}};
-            continue;
-        }
-        int below = 0;
+        int below = 0, same = 0;
         i32 some_below = kNone, some_above = kNone;
         for (i32 i = b; i < e; ++i) {
             const i32 m = node[z(mesh.neighbors[z(i)])];
             below += m < n;
+            same += m == n;  // a plateau
             some_below = m < n ? m : some_below;
             some_above = m < n ? some_above : m;
+        }
+        if (e - b > 250 || same > 0) {
+            general[z(n)] = 1;
+            reps[z(n)] = {{kSeveral, kNone}, {kSeveral, kNone}};
+            continue;
         }
         const int above = e - b - below;
         const Star& s = stars[v];
         const bool interior = s.triangles == e - b;
         const int lower = (above == 0 && interior && below > 0) ? 1 : below - s.lower_edges;
         const int upper = (below == 0 && interior && above > 0) ? 1 : above - s.upper_edges;
-        g.node_lower_links[z(n)] = static_cast<std::uint8_t>(lower);
-        g.node_upper_links[z(n)] = static_cast<std::uint8_t>(upper);
+        vertex_links[v] = {static_cast<std::uint8_t>(lower), static_cast<std::uint8_t>(upper)};
         auto side = [&](int count, i32 some, int runs, const std::array<i32, 2>& starts) {
             if (count <= 1) return std::array<i32, 2>{count == 0 ? kNone : some, kNone};
             if (count == 2 && runs == 2) return starts;
@@ -490,16 +511,18 @@ std::vector<LinkReps> link_components(const TriangleMesh& mesh, ReebGraph& g,
 // The link counts of the critical nodes that link_components left (plateaus, vertices of very
 // high degree), from their stars' triangles.
 void count_general_links(const TriangleMesh& mesh, ReebGraph& g, const std::vector<char>& general) {
-    std::vector<std::pair<i32, i32>> star;  // (node, triangle)
-    auto wanted = [&](i32 n) { return general[z(n)] && g.node_kinds[z(n)] != NodeKind::regular; };
-    for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
-        const auto& tri = mesh.triangles[t];
-        for (int k = 0; k < 3; ++k) {
-            const i32 n = g.vertex_nodes[z(tri[z(k)])];
-            if (wanted(n)) star.push_back({n, static_cast<i32>(t)});
-        }
+    std::vector<char> wanted;  // per vertex
+    for (std::size_t n = 0; n < g.node_count(); ++n) {
+        if (!general[n] || g.node_kinds[n] == NodeKind::regular) continue;
+        if (wanted.empty()) wanted.assign(mesh.vertex_count(), 0);
+        for (i32 i = g.node_vertex_offsets[n]; i < g.node_vertex_offsets[n + 1]; ++i)
+            wanted[z(g.node_vertices[z(i)])] = 1;
     }
-    if (star.empty()) return;
+    if (wanted.empty()) return;
+    std::vector<std::pair<i32, i32>> star;  // (node, triangle)
+    for (std::size_t t = 0; t < mesh.triangle_count(); ++t)
+        for (const i32 c : mesh.triangles[t])
+            if (wanted[z(c)]) star.push_back({g.vertex_nodes[z(c)], static_cast<i32>(t)});
     std::sort(star.begin(), star.end());
     LinkCounter counter;
     std::vector<i32> tris;
@@ -513,16 +536,22 @@ void count_general_links(const TriangleMesh& mesh, ReebGraph& g, const std::vect
 
 // The contour tree of a loop-free mesh (Carr, Snoeyink & Axen): join and split trees by
 // union-find sweeps over the events, merged leaf by leaf into the augmented contour tree,
-// whose chains of regular nodes become the arcs.
-void contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& progress) {
+// whose chains of regular nodes become the arcs. Returns false, leaving the graph half made,
+// when the mesh has handles or holes: the join tree gives its components, and a single
+// component's Euler characteristic is V - E + F.
+bool contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& progress) {
     const std::size_t nn = g.node_count();
     g.node_lower_links.assign(nn, 1);
     g.node_upper_links.assign(nn, 1);
     std::vector<char> general;
-    const std::vector<LinkReps> reps = link_components(mesh, g, general);
-    report_progress(progress, 0.4, "reeb: links");
+    std::vector<LinkCounts> vertex_links;
+    const std::vector<LinkReps> reps = link_components(mesh, g, vertex_links, general);
+    report_progress(progress, 0.3, "reeb: links");
 
-    std::vector<i32> jp(nn, kNone), sp(nn, kNone), jc(nn), sc(nn);
+    std::vector<i32> jp(nn, kNone), sp(nn, kNone);
+    // Children in the join and split trees. The sweeps run in opposite directions, so they
+    // share cache lines only where they cross.
+    std::vector<std::array<i32, 2>> kids(nn);
     // One union-find sweep. A node's entry holds its parent, or (at a root) minus one minus its
     // rank, and the last event added to its component (the component's head). Most events have
     // one link component below (above): one find, and the event hangs under the root. The join
@@ -530,7 +559,8 @@ void contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& prog
     struct Entry {
         i32 up, head;
     };
-    auto sweep = [&](bool ascending, std::vector<i32>& parent, std::vector<i32>& children) {
+    auto sweep = [&](bool ascending, std::vector<i32>& parent) {
+        const std::size_t side = ascending ? 0 : 1;
         std::vector<Entry> uf(nn, Entry{-1, 0});
         auto find = [&](i32 x) {
             i32 r = x;
@@ -580,7 +610,7 @@ void contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& prog
                 const i32 c = find_short(rep[0]);
                 Entry& root = uf[z(c)];
                 parent[z(root.head)] = e;
-                children[z(e)] = 1;
+                kids[z(e)][side] = 1;
                 uf[z(e)].up = c;
                 root.head = e;
                 root.up -= root.up == -1;  // rank 0 -> 1
@@ -589,7 +619,7 @@ void contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& prog
                 if (o == c) continue;
                 // A second component joins here.
                 parent[z(uf[z(o)].head)] = e;
-                children[z(e)] = 2;
+                kids[z(e)][side] = 2;
                 const bool c_higher = uf[z(c)].up <= uf[z(o)].up;
                 const i32 hi = c_higher ? c : o, lo = c_higher ? o : c;
                 if (uf[z(hi)].up == uf[z(lo)].up) --uf[z(hi)].up;
@@ -598,7 +628,7 @@ void contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& prog
                 continue;
             }
             uf[z(e)] = {-1, e};
-            children[z(e)] = 0;
+            kids[z(e)][side] = 0;
             if (rep[0] == kNone) continue;
             roots.clear();
             for (i32 i = g.node_vertex_offsets[z(e)]; i < g.node_vertex_offsets[z(e) + 1]; ++i) {
@@ -614,7 +644,7 @@ void contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& prog
             i32 cur = e;
             for (const i32 c : roots) {
                 parent[z(uf[z(c)].head)] = e;
-                ++children[z(e)];
+                ++kids[z(e)][side];
                 i32 r = cur, o = c;
                 if (uf[z(r)].up > uf[z(o)].up) std::swap(r, o);  // r has the higher rank
                 if (uf[z(r)].up == uf[z(o)].up) --uf[z(r)].up;
@@ -624,14 +654,20 @@ void contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& prog
             }
         }
     };
-    tbb::parallel_invoke([&] { sweep(true, jp, jc); }, [&] { sweep(false, sp, sc); });
+    tbb::parallel_invoke([&] { sweep(true, jp); }, [&] { sweep(false, sp); });
+    const auto components = std::count(jp.begin(), jp.end(), kNone);
+    const auto chi = static_cast<std::int64_t>(mesh.vertex_count()) -
+                     static_cast<std::int64_t>(mesh.neighbors.size() / 2) +
+                     static_cast<std::int64_t>(mesh.triangle_count());
+    if (components == 1 ? (chi != 1 && chi != 2) : !loop_free(mesh)) return false;
     report_progress(progress, 0.6, "reeb: join and split trees");
 
-    // Merge: remove leaves one by one; each removal is one edge of the augmented tree.
-    std::vector<char> dead(nn, 0);
+    // Merge: remove leaves one by one; each removal is one edge of the augmented tree. A
+    // removed node's join-children count is set to -1; attach[x] = 2 * y + (x was below y).
+    auto dead = [&](i32 x) { return kids[z(x)][0] < 0; };
     auto next_alive = [&](std::vector<i32>& parent, i32 x) {
         i32 p = parent[z(x)];
-        while (p != kNone && dead[z(p)]) p = parent[z(p)];
+        while (p != kNone && dead(p)) p = parent[z(p)];
         for (i32 q = parent[z(x)]; q != p;) {
             const i32 nx = parent[z(q)];
             parent[z(q)] = p;
@@ -641,60 +677,62 @@ void contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& prog
         return p;
     };
     auto is_leaf = [&](i32 x) {
-        return (jc[z(x)] == 0 && sc[z(x)] == 1) || (sc[z(x)] == 0 && jc[z(x)] == 1);
+        const auto [j, s] = kids[z(x)];
+        return (j == 0 && s == 1) || (s == 0 && j == 1);
     };
-    std::vector<i32> queue, attach(nn, kNone), up_deg(nn, 0), down_deg(nn, 0);
-    std::vector<char> goes_up(nn, 0);
+    std::vector<i32> queue, attach(nn, kNone);
     queue.reserve(nn);
     for (std::size_t n = 0; n < nn; ++n)
         if (is_leaf(static_cast<i32>(n))) queue.push_back(static_cast<i32>(n));
     for (std::size_t qi = 0; qi < queue.size(); ++qi) {
         const i32 x = queue[qi];
-        if (dead[z(x)] || !is_leaf(x)) continue;
-        const bool lower = jc[z(x)] == 0;
+        if (dead(x) || !is_leaf(x)) continue;
+        const bool lower = kids[z(x)][0] == 0;
         const i32 y = next_alive(lower ? jp : sp, x);
         if (y == kNone) throw Error("reeb", "internal error: contour tree leaf without parent");
-        dead[z(x)] = 1;
-        attach[z(x)] = y;
-        goes_up[z(x)] = lower;
-        if (lower) {
-            --jc[z(y)];
-            ++up_deg[z(x)];
-            ++down_deg[z(y)];
-        } else {
-            --sc[z(y)];
-            ++down_deg[z(x)];
-            ++up_deg[z(y)];
-        }
+        kids[z(x)][0] = -1;
+        attach[z(x)] = 2 * y + lower;
+        --kids[z(y)][lower ? 0 : 1];
         if (is_leaf(y)) queue.push_back(y);
     }
+    queue = {};
+    kids = {};
     report_progress(progress, 0.75, "reeb: contour tree");
 
-    // Up-edges per node (CSR, in the order of the removed leaves' indices).
-    std::vector<i32> up_off(nn + 1, 0), up_to(nn);
+    // Up-edges per node (CSR, in the order of the removed leaves' indices), and down degrees.
+    std::vector<i32> up_off(nn + 1, 0), up_to(nn), down_deg(nn, 0);
+    auto edge = [&](std::size_t x) {
+        const i32 y = attach[x] >> 1, self = static_cast<i32>(x);
+        return (attach[x] & 1) ? std::pair{self, y} : std::pair{y, self};
+    };
     for (std::size_t x = 0; x < nn; ++x)
-        if (attach[x] != kNone) ++up_off[z(goes_up[x] ? static_cast<i32>(x) : attach[x]) + 1];
+        if (attach[x] != kNone) {
+            const auto [lo, hi] = edge(x);
+            ++up_off[z(lo) + 1];
+            ++down_deg[z(hi)];
+        }
     std::partial_sum(up_off.begin(), up_off.end(), up_off.begin());
     {
         std::vector<i32> fill(up_off.begin(), up_off.end() - 1);
-        for (std::size_t x = 0; x < nn; ++x) {
-            if (attach[x] == kNone) continue;
-            const i32 lo = goes_up[x] ? static_cast<i32>(x) : attach[x];
-            const i32 hi = goes_up[x] ? attach[x] : static_cast<i32>(x);
-            up_to[z(fill[z(lo)]++)] = hi;
-        }
+        for (std::size_t x = 0; x < nn; ++x)
+            if (attach[x] != kNone) {
+                const auto [lo, hi] = edge(x);
+                up_to[z(fill[z(lo)]++)] = hi;
+            }
     }
     g.node_kinds.assign(nn, NodeKind::regular);
     for (std::size_t n = 0; n < nn; ++n) {
-        const int d = down_deg[n], u = up_deg[n];
-        if (d == 1 && u == 1) {  // Reeb-regular, whatever its link (a boundary vertex)
-            g.node_lower_links[n] = g.node_upper_links[n] = 1;
-            continue;
-        }
+        const int d = down_deg[n], u = up_off[n + 1] - up_off[n];
+        if (d == 1 && u == 1) continue;  // Reeb-regular, whatever its link (links stay 1, 1)
         g.node_kinds[n] = d == 0   ? NodeKind::minimum
                           : u == 0 ? NodeKind::maximum
                                    : NodeKind::saddle;
+        if (general[n]) continue;  // counted below
+        const auto links = vertex_links[z(g.node_vertices[z(g.node_vertex_offsets[n])])];
+        g.node_lower_links[n] = links[0];
+        g.node_upper_links[n] = links[1];
     }
+    vertex_links = {};
     // Arcs in the order of their lower nodes, then of their up-edges. A regular node takes the
     // arc of the edge below it; `below` holds that edge as the regular node under it, or as
     // -2 - arc when the edge leaves a critical node. One pass in increasing order then fills in
@@ -732,7 +770,9 @@ void contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& prog
             if (!critical(static_cast<i32>(n)))
                 g.arc_nodes[z(fill[z(g.node_arcs[n])]++)] = static_cast<i32>(n);
     }
+    report_progress(progress, 0.9, "reeb: arcs");
     count_general_links(mesh, g, general);
+    return true;
 }
 
 class Sweep {
@@ -740,7 +780,8 @@ class Sweep {
     Sweep(const TriangleMesh& mesh, const std::vector<float>& field, ReebGraph& g)
         : mesh_(mesh), field_(field), g_(g) {}
 
-    void run(const ProgressFn& progress);
+    // `ordered`: the graph's events are already set (order_events).
+    void run(const ProgressFn& progress, bool ordered);
 
   private:
     struct Contour {
@@ -825,10 +866,10 @@ class Sweep {
     LinkCounter links_;
 };
 
-void Sweep::run(const ProgressFn& progress) {
+void Sweep::run(const ProgressFn& progress, bool ordered) {
     topo_ = build_topology(mesh_);
     report_progress(progress, 0.1, "reeb: topology");
-    order_events(mesh_, field_, g_);
+    if (!ordered) order_events(mesh_, field_, g_);
     report_progress(progress, 0.3, "reeb: order");
     const std::size_t n_nodes = g_.node_vertex_offsets.size() - 1;
     g_.node_kinds.assign(n_nodes, NodeKind::regular);
@@ -1237,19 +1278,25 @@ ReebGraph build_reeb_graph(const TriangleMesh& mesh, const std::vector<float>& f
     if (mesh.vertex_count() >= static_cast<std::size_t>(INT32_MAX / 4))
         throw Error("reeb", "the mesh is too large (more than 500 million vertices)");
     ReebGraph g;
-    const bool tree = options.algorithm != ReebAlgorithm::sweep && loop_free(mesh);
-    if (options.algorithm == ReebAlgorithm::contour_tree && !tree)
+    if (options.algorithm == ReebAlgorithm::sweep) {
+        Sweep(mesh, field, g).run(progress, false);
+        return g;
+    }
+    order_events(mesh, field, g);
+    report_progress(progress, 0.2, "reeb: order");
+    if (contour_tree(mesh, g, progress)) {
+        report_progress(progress, 1.0, "reeb");
+        return g;
+    }
+    if (options.algorithm == ReebAlgorithm::contour_tree)
         throw Error("reeb",
                     "the contour-tree algorithm needs a mesh whose components are disks "
                     "or spheres; this one has handles or holes");
-    if (tree) {
-        order_events(mesh, field, g);
-        report_progress(progress, 0.3, "reeb: order");
-        contour_tree(mesh, g, progress);
-        report_progress(progress, 1.0, "reeb");
-    } else {
-        Sweep(mesh, field, g).run(progress);
-    }
+    // Handles or holes: the sweep, on the same events.
+    const ProgressFn rest = [&](double f, std::string_view message) {
+        return progress ? progress(0.3 + 0.7 * f, message) : true;
+    };
+    Sweep(mesh, field, g).run(rest, true);
     return g;
 }
 
