@@ -684,7 +684,19 @@ bool contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& prog
     queue.reserve(nn);
     for (std::size_t n = 0; n < nn; ++n)
         if (is_leaf(static_cast<i32>(n))) queue.push_back(static_cast<i32>(n));
+    constexpr std::size_t kAhead = 16;  // as in the sweeps: fetch the next leaves' entries early
     for (std::size_t qi = 0; qi < queue.size(); ++qi) {
+        if (qi + kAhead < queue.size()) {
+            const i32 x = queue[qi + kAhead];
+            __builtin_prefetch(&kids[z(x)]);
+            __builtin_prefetch(&jp[z(x)]);
+            __builtin_prefetch(&sp[z(x)]);
+        }
+        if (qi + kAhead / 2 < queue.size()) {
+            const i32 x = queue[qi + kAhead / 2];
+            const i32 p = (kids[z(x)][0] == 0 ? jp : sp)[z(x)];
+            __builtin_prefetch(&kids[z(p >= 0 ? p : 0)]);
+        }
         const i32 x = queue[qi];
         if (dead(x) || !is_leaf(x)) continue;
         const bool lower = kids[z(x)][0] == 0;
