@@ -93,46 +93,52 @@ void finish_mesh(TriangleMesh& mesh) {
 }
 
 MeshTopology mesh_topology(const TriangleMesh& mesh) {
+    if (mesh.neighbor_offsets.size() != mesh.vertex_count() + 1) {
+        TriangleMesh finished = mesh;  // no adjacency yet
+        finish_mesh(finished);
+        return mesh_topology(finished);
+    }
     MeshTopology topo;
     topo.vertices = mesh.vertex_count();
     topo.faces = mesh.triangle_count();
-    // Edges as sorted (min,max) keys; an edge's multiplicity is the number of triangles.
-    std::vector<std::uint64_t> edges;
-    edges.reserve(3 * mesh.triangles.size());
+    const auto& off = mesh.neighbor_offsets;
+    const auto& nb = mesh.neighbors;
+    // Each edge (a < b) is a slot of a's sorted neighbour list: count its triangles there.
+    std::vector<std::uint8_t> uses(nb.size(), 0);
     for (const auto& t : mesh.triangles)
         for (int k = 0; k < 3; ++k) {
-            const auto a = static_cast<std::uint32_t>(t[k]);
-            const auto b = static_cast<std::uint32_t>(t[(k + 1) % 3]);
-            edges.push_back((std::uint64_t(std::min(a, b)) << 32) | std::max(a, b));
+            const std::int32_t a = std::min(t[k], t[(k + 1) % 3]),
+                               b = std::max(t[k], t[(k + 1) % 3]);
+            const auto first = nb.begin() + off[a], last = nb.begin() + off[a + 1];
+            const auto slot =
+                static_cast<std::size_t>(std::lower_bound(first, last, b) - nb.begin());
+            uses[slot] = static_cast<std::uint8_t>(std::min(uses[slot] + 1, 3));
         }
-    std::sort(edges.begin(), edges.end());
     std::vector<std::uint32_t> parent(topo.vertices);
     std::iota(parent.begin(), parent.end(), 0u);
     auto find = [&](std::uint32_t x) {
         while (parent[x] != x) x = parent[x] = parent[parent[x]];
         return x;
     };
-    std::vector<std::uint32_t> boundary_parent;
-    std::vector<std::uint64_t> boundary;
-    for (std::size_t i = 0; i < edges.size();) {
-        std::size_t j = i;
-        while (j < edges.size() && edges[j] == edges[i]) ++j;
-        ++topo.edges;
-        if (j - i == 1) boundary.push_back(edges[i]);
-        i = j;
-    }
     // Boundary loops: components of the graph of boundary edges.
-    for (auto e : boundary) {
-        const auto a = find(std::uint32_t(e >> 32)), b = find(std::uint32_t(e & 0xffffffffu));
-        if (a != b) parent[a] = b;
-    }
-    topo.boundary_edges = boundary.size();
-    {
-        std::vector<std::uint32_t> roots;
-        for (auto e : boundary) roots.push_back(find(std::uint32_t(e >> 32)));
-        std::sort(roots.begin(), roots.end());
-        topo.boundary_loops = std::size_t(std::unique(roots.begin(), roots.end()) - roots.begin());
-    }
+    std::vector<std::uint32_t> boundary_vertices;
+    for (std::size_t v = 0; v < topo.vertices; ++v)
+        for (auto i = off[v]; i < off[v + 1]; ++i) {
+            const auto w = static_cast<std::size_t>(nb[static_cast<std::size_t>(i)]);
+            if (w <= v) continue;
+            ++topo.edges;
+            if (uses[static_cast<std::size_t>(i)] != 1) continue;
+            ++topo.boundary_edges;
+            boundary_vertices.push_back(static_cast<std::uint32_t>(v));
+            const auto a = find(static_cast<std::uint32_t>(v)),
+                       b = find(static_cast<std::uint32_t>(w));
+            if (a != b) parent[a] = b;
+        }
+    for (auto& v : boundary_vertices) v = find(v);
+    std::sort(boundary_vertices.begin(), boundary_vertices.end());
+    topo.boundary_loops =
+        static_cast<std::size_t>(std::unique(boundary_vertices.begin(), boundary_vertices.end()) -
+                                 boundary_vertices.begin());
     // Components by triangles.
     std::iota(parent.begin(), parent.end(), 0u);
     for (const auto& t : mesh.triangles)
