@@ -92,6 +92,11 @@ std::string slurp(const std::filesystem::path& p) {
 }  // namespace
 
 CliResult run_cli(const std::vector<std::string>& args) {
+    return run_program(TERRAIN_CLI, args);
+}
+
+CliResult run_program(const std::string& program, const std::vector<std::string>& args,
+                      const std::vector<std::string>& environment) {
     static int counter = 0;
     const auto dir = std::filesystem::current_path() / "scratch" / "cli";
     std::filesystem::create_directories(dir);
@@ -99,7 +104,9 @@ CliResult run_cli(const std::vector<std::string>& args) {
     const std::string id = std::to_string(::getpid()) + "_" + std::to_string(counter++);
     const auto out = dir / ("out" + id + ".txt");
     const auto err = dir / ("err" + id + ".txt");
-    std::string command = quote(TERRAIN_CLI);
+    std::string command = environment.empty() ? "" : "env ";
+    for (const auto& setting : environment) command += quote(setting) + " ";
+    command += quote(program);
     for (const auto& a : args) command += " " + quote(a);
     command += " </dev/null >" + quote(out) + " 2>" + quote(err);
     const int raw = std::system(command.c_str());

@@ -51,5 +51,8 @@ struct CliResult {
 };
 // Runs the built `terrain` binary with arguments (shell-quoted), capturing stdout and stderr.
 CliResult run_cli(const std::vector<std::string>& args);
+// The same with another program, and NAME=value settings for its environment.
+CliResult run_program(const std::string& program, const std::vector<std::string>& args,
+                      const std::vector<std::string>& environment = {});
 
 }  // namespace terrain::test

@@ -204,3 +204,35 @@ TEST_CASE("terrain segment on a constant field, a mostly-NoData DEM and a mesh f
     CHECK(std::count(seg.begin(), seg.end(), '\n') == 12);
     CHECK_FALSE(fs::exists(dir / "box" / "labels.tif"));
 }
+
+TEST_CASE("OpenImageIO is loaded only to write images, from its module", "[cli][segment]") {
+    const auto dir = terrain::test::scratch_dir("cli_image_module");
+    const auto dem = vesta_crop(dir);
+    // The program alone, away from the build tree: no module where it looks.
+    const auto bin = dir / "moved" / "bin";
+    fs::create_directories(bin);
+    const auto program = bin / "terrain";
+    fs::copy_file(TERRAIN_CLI, program, fs::copy_options::overwrite_existing);
+    CHECK(terrain::test::run_program(program.string(), {"--version"}).status == 0);
+    const auto out = dir / "seg";
+    fs::remove_all(out);
+    auto r =
+        terrain::test::run_program(program.string(), {"segment", dem, "-o", out.string(), "-q"});
+    CHECK(r.status == 1);
+    CHECK(std::count(r.err.begin(), r.err.end(), '\n') == 1);
+    CHECK_THAT(r.err,
+               Contains("libterrain_oiio.so was not found") && Contains("TERRAIN_OIIO_MODULE"));
+    CHECK_FALSE(fs::exists(out));  // outputs complete or not at all
+    // Named by the environment, the module writes the preview.
+    r = terrain::test::run_program(program.string(), {"segment", dem, "-o", out.string(), "-q"},
+                                   {std::string("TERRAIN_OIIO_MODULE=") + TERRAIN_OIIO_MODULE});
+    INFO(r.err);
+    CHECK(r.status == 0);
+    CHECK(fs::file_size(out / "preview.png") > 1000);
+    // Not a module: a clear error.
+    r = terrain::test::run_program(program.string(),
+                                   {"segment", dem, "-o", (dir / "seg2").string(), "-q"},
+                                   {"TERRAIN_OIIO_MODULE=" + dem});
+    CHECK(r.status == 1);
+    CHECK_THAT(r.err, Contains("cannot load"));
+}

@@ -1,10 +1,10 @@
-#include <OpenImageIO/imageio.h>
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <numbers>
 
+#include "image_module.hpp"
 #include "terrain/core/error.hpp"
 #include "terrain/io/describe_dem.hpp"
 #include "terrain/io/output_file.hpp"
@@ -129,15 +129,8 @@ void write_preview_png(const Dem& dem, const std::vector<float>& field_pixels,
                       image.begin() + static_cast<std::ptrdiff_t>((std::size_t(y) * OW + x) * 4));
         }
 
-    {
-        auto out = OIIO::ImageOutput::create(output.temp_path());
-        if (!out) throw Error("write", "cannot write PNG files: " + OIIO::geterror());
-        OIIO::ImageSpec spec(OW, OH, 4, OIIO::TypeDesc::UINT8);
-        spec.attribute("png:compressionLevel", 1);  // a third faster than 6, 3% larger
-        if (!out->open(output.temp_path(), spec) ||
-            !out->write_image(OIIO::TypeDesc::UINT8, image.data()) || !out->close())
-            throw Error("write", "writing '" + path + "' failed: " + out->geterror());
-    }
+    // zlib level 1: a third faster than 6, 3% larger.
+    detail::write_image(output.temp_path(), path, OW, OH, 4, image.data(), 1);
     output.commit();
 }
 

@@ -1,7 +1,6 @@
 // sweep.png: a small line plot drawn by hand (no plotting library in the stack): region count
 // in blue on the left axis, mean region area in red on the right axis, against the area ratio
 // on a log axis; tick values in a built-in 3x5 digit font.
-#include <OpenImageIO/imageio.h>
 
 #include <algorithm>
 #include <array>
@@ -9,6 +8,7 @@
 #include <cstdio>
 #include <string>
 
+#include "image_module.hpp"
 #include "terrain/core/error.hpp"
 #include "terrain/io/output_file.hpp"
 #include "terrain/io/segment_outputs.hpp"
@@ -147,12 +147,7 @@ void write_sweep_plot(const std::vector<double>& ratios, const std::vector<doubl
     c.dot(left + 200, 18, red, 6);
 
     AtomicOutput output(path, overwrite);
-    auto out = OIIO::ImageOutput::create(output.temp_path());
-    if (!out) throw Error("write", "cannot write PNG '" + path + "'");
-    const OIIO::ImageSpec spec(W, H, 3, OIIO::TypeDesc::UINT8);
-    if (!out->open(output.temp_path(), spec) ||
-        !out->write_image(OIIO::TypeDesc::UINT8, c.data()) || !out->close())
-        throw Error("write", "writing '" + path + "' failed: " + out->geterror());
+    detail::write_image(output.temp_path(), path, W, H, 3, c.data());
     output.commit();
 }
 
