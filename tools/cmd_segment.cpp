@@ -40,8 +40,14 @@ int run_segment(int argc, char** argv) {
         compute_field(job, field_options, scaled_progress(progress, 0.15, 0.45));
         compute_reeb(job, scaled_progress(progress, 0.45, 0.6));
         segment_once(job, segment_values, scaled_progress(progress, 0.6, 0.7));
+        // The preview is written last, once the large data is freed: OpenImageIO, loaded for
+        // it, then does not add to the peak memory.
+        io::PreviewImage preview;
         const auto files = write_segmentation(job, segment_values, dir.temp_path(),
-                                              scaled_progress(progress, 0.7, 1));
+                                              scaled_progress(progress, 0.7, 0.95),
+                                              job.input.dem ? &preview : nullptr);
+        release_large_data(job);
+        if (job.input.dem) write_deferred_preview(job, preview, dir.temp_path());
         write_run_json(job, common.input, field_values, segment_values, files,
                        dir.temp_path() + "/run.json");
         dir.commit();

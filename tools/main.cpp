@@ -1,4 +1,6 @@
 // terrain: planetary terrain segmentation. Dispatches to one subcommand per file.
+#include <malloc.h>
+
 #include <cstring>
 #include <iostream>
 #include <string>
@@ -52,6 +54,11 @@ void print_usage(std::ostream& out) {
 }  // namespace
 
 int main(int argc, char** argv) {
+    // The commands allocate a few arrays of megabytes each. glibc raises its mmap threshold
+    // after such an array is freed, so later ones come from the heap and stay resident after
+    // being freed; a fixed threshold gives them back at once (about 16 MB less peak memory
+    // for a 1000x1000 DEM).
+    mallopt(M_MMAP_THRESHOLD, 256 * 1024);
     if (argc < 2) {
         print_usage(std::cerr);
         return terrain::cli::kUsageError;

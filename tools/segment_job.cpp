@@ -1,5 +1,6 @@
 #include "segment_job.hpp"
 
+#include <malloc.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -103,18 +104,43 @@ void segment_once(SegmentJob& job, const SegmentOptionValues& values, const Prog
 }
 
 std::vector<std::string> write_segmentation(SegmentJob& job, const SegmentOptionValues& values,
-                                            const std::string& dir, const ProgressFn& progress) {
+                                            const std::string& dir, const ProgressFn& progress,
+                                            io::PreviewImage* deferred_preview) {
     const auto t0 = clock::now();
     job.regions = segment::region_graph(job.input.mesh, job.field, job.segmentation.labels,
                                         job.segmentation.region_count, job.dem());
     io::SegmentOutputOptions options;
     options.polygons.driver = values.format;
+    options.deferred_preview = deferred_preview;
     auto paths = io::write_segment_outputs(dir, job.input.mesh, job.field, job.segmentation.labels,
                                            job.regions, job.dem(), options, progress);
     job.add_time("write", since(t0));
     std::vector<std::string> names;
     for (const auto& p : paths) names.push_back(fs::path(p).filename().string());
     return names;
+}
+
+void release_large_data(SegmentJob& job) {
+    if (!job.topology) job.topology = mesh_topology(job.input.mesh);
+    auto& m = job.input.mesh;
+    m.positions = {};
+    m.triangles = {};
+    m.vertex_areas = {};
+    m.neighbor_offsets = {};
+    m.neighbors = {};
+    m.vertex_pixel = {};
+    job.field = {};
+    job.graph = {};
+    job.segmentation.labels = {};
+    job.segmentation.seeds = {};
+    malloc_trim(0);
+}
+
+void write_deferred_preview(SegmentJob& job, const io::PreviewImage& preview,
+                            const std::string& dir) {
+    const auto t0 = clock::now();
+    io::write_preview_image(preview, (fs::path(dir) / "preview.png").string(), false);
+    job.add_time("write", since(t0));
 }
 
 void write_run_json(const SegmentJob& job, const std::string& input_path,
@@ -124,7 +150,7 @@ void write_run_json(const SegmentJob& job, const std::string& input_path,
     std::ofstream os(path, std::ios::binary);
     if (!os) throw Error("write", "cannot write " + path);
     JsonWriter j(os);
-    const auto topo = mesh_topology(job.input.mesh);
+    const auto topo = job.topology ? *job.topology : mesh_topology(job.input.mesh);
     const auto& after = job.after;
     j.begin_object();
     j.field("input", fs::absolute(input_path).lexically_normal().string());
@@ -174,8 +200,9 @@ void write_run_json(const SegmentJob& job, const std::string& input_path,
 
 void print_summary(const SegmentJob& job, const std::string& output, bool timings) {
     std::printf("%s: %u regions on %zu vertices (critical nodes %zu -> %zu)\n", output.c_str(),
-                job.segmentation.region_count, job.input.mesh.vertex_count(), job.critical_before,
-                job.after.critical);
+                job.segmentation.region_count,
+                job.topology ? job.topology->vertices : job.input.mesh.vertex_count(),
+                job.critical_before, job.after.critical);
     if (timings) print_timings(job.timings);
 }
 

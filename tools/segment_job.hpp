@@ -3,6 +3,7 @@
 // one segmentation per area ratio, the output files, run.json, and the atomic output
 // directory.
 
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -10,6 +11,7 @@
 #include "cli.hpp"
 #include "field_options.hpp"
 #include "input.hpp"
+#include "terrain/io/segment_outputs.hpp"
 #include "terrain/reeb/simplify.hpp"
 #include "terrain/segment/grow_regions.hpp"
 #include "terrain/segment/regions.hpp"
@@ -43,6 +45,7 @@ struct SegmentJob {
     segment::Segmentation segmentation;
     segment::RegionGraph regions;
     std::vector<StageTime> timings;
+    std::optional<MeshTopology> topology;  // kept by release_large_data for run.json
     const Dem* dem() const { return input.dem ? &*input.dem : nullptr; }
     void add_time(const std::string& name, double seconds);
 };
@@ -60,9 +63,18 @@ ScaleResult segment_scale(const SegmentJob& job, const SegmentOptionValues& valu
                           const ProgressFn& progress = {});
 // segment_scale into the job (segmentation, after, timings).
 void segment_once(SegmentJob& job, const SegmentOptionValues& values, const ProgressFn& progress);
-// Every output of one segmentation into `dir`; returns the file names written.
+// Every output of one segmentation into `dir`; returns the file names written. With
+// `deferred_preview`, preview.png is only rendered, for write_deferred_preview.
 std::vector<std::string> write_segmentation(SegmentJob& job, const SegmentOptionValues& values,
-                                            const std::string& dir, const ProgressFn& progress);
+                                            const std::string& dir, const ProgressFn& progress,
+                                            io::PreviewImage* deferred_preview = nullptr);
+// Frees the mesh's arrays, the field, the graph and the labels (what is left: counts, timings,
+// the mesh's topology and frame, the DEM), and gives the memory back to the system.
+void release_large_data(SegmentJob& job);
+// Writes the preview rendered by write_segmentation into dir/preview.png, timed as "write":
+// loading OpenImageIO for it then does not add to the job's peak memory.
+void write_deferred_preview(SegmentJob& job, const io::PreviewImage& preview,
+                            const std::string& dir);
 void write_run_json(const SegmentJob& job, const std::string& input_path,
                     const FieldOptionValues& field, const SegmentOptionValues& values,
                     const std::vector<std::string>& files, const std::string& path,

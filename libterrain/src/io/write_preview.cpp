@@ -82,12 +82,10 @@ std::vector<float> hillshade(const Dem& dem) {
 
 }  // namespace
 
-void write_preview_png(const Dem& dem, const std::vector<float>& field_pixels,
-                       const std::vector<std::uint32_t>& pixels, const std::string& path,
-                       bool overwrite) {
+PreviewImage render_preview(const Dem& dem, const std::vector<float>& field_pixels,
+                            const std::vector<std::uint32_t>& pixels) {
     if (pixels.size() != dem.size() || field_pixels.size() != dem.size())
         throw Error("write", "the preview needs one label and one field value per DEM pixel");
-    AtomicOutput output(path, overwrite);
     const int W = dem.width, H = dem.height, longest = std::max(W, H);
     // Output pixel X shows source column X * reduce / enlarge.
     const int enlarge = std::max(1, (kTarget + longest / 2) / longest);
@@ -129,9 +127,24 @@ void write_preview_png(const Dem& dem, const std::vector<float>& field_pixels,
                       image.begin() + static_cast<std::ptrdiff_t>((std::size_t(y) * OW + x) * 4));
         }
 
+    return {OW, OH, std::move(image)};
+}
+
+void write_preview_image(const PreviewImage& image, const std::string& path, bool overwrite) {
+    if (image.rgba.size() != static_cast<std::size_t>(image.width) * image.height * 4)
+        throw Error("write", "the preview image's size does not match its pixels");
+    AtomicOutput output(path, overwrite);
     // zlib level 1: a third faster than 6, 3% larger.
-    detail::write_image(output.temp_path(), path, OW, OH, 4, image.data(), 1);
+    detail::write_image(output.temp_path(), path, image.width, image.height, 4, image.rgba.data(),
+                        1);
     output.commit();
+}
+
+void write_preview_png(const Dem& dem, const std::vector<float>& field_pixels,
+                       const std::vector<std::uint32_t>& pixels, const std::string& path,
+                       bool overwrite) {
+    check_output_path(path, overwrite);
+    write_preview_image(render_preview(dem, field_pixels, pixels), path, overwrite);
 }
 
 }  // namespace terrain::io

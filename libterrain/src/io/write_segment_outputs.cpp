@@ -74,8 +74,12 @@ std::vector<std::string> write_segment_outputs(const std::string& dir, const Tri
                 step();
             },
             [&] {
-                write_preview_png(*dem, field::field_to_pixels(mesh, *dem, field), pixels, paths[5],
-                                  overwrite);
+                auto image =
+                    render_preview(*dem, field::field_to_pixels(mesh, *dem, field), pixels);
+                if (options.deferred_preview)
+                    *options.deferred_preview = std::move(image);
+                else
+                    write_preview_image(image, paths[5], overwrite);
             });
     } else {
         write_labels_ply(mesh, field, labels, paths[0], overwrite, options.field_name);

@@ -69,6 +69,17 @@ void write_preview_png(const Dem& dem, const std::vector<float>& field_pixels,
                        const std::vector<std::uint32_t>& pixels, const std::string& path,
                        bool overwrite);
 
+// The preview in two steps: its pixels (8-bit RGBA, row-major), then the PNG. Writing goes
+// through OpenImageIO, loaded on first use (about 120 MB resident, a quarter of a second): a
+// program low on memory renders first, frees its large data, then writes.
+struct PreviewImage {
+    int width = 0, height = 0;
+    std::vector<std::uint8_t> rgba;
+};
+PreviewImage render_preview(const Dem& dem, const std::vector<float>& field_pixels,
+                            const std::vector<std::uint32_t>& pixels);
+void write_preview_image(const PreviewImage& image, const std::string& path, bool overwrite);
+
 // labels.ply: io::write_ply's mesh with per-vertex `uint label` and `float <field_name>`.
 void write_labels_ply(const TriangleMesh& mesh, const std::vector<float>& field,
                       const std::vector<std::uint32_t>& labels, const std::string& path,
@@ -99,6 +110,10 @@ struct SegmentOutputOptions {
     bool overwrite = false;
     RegionPolygonOptions polygons;     // regions.<extension of the driver>
     std::string field_name = "field";  // the field's name in labels.ply
+    // When set, preview.png is rendered into *deferred_preview instead of written; the caller
+    // writes it with write_preview_image (to the path returned for it) once it has freed what
+    // it no longer needs.
+    PreviewImage* deferred_preview = nullptr;
 };
 
 // Everything for one segmentation into the existing directory `dir`: for a DEM (dem !=
