@@ -1,6 +1,7 @@
 #include "terrain/mesh/triangle_mesh.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <numeric>
@@ -173,29 +174,48 @@ std::size_t split_pinched_vertices(TriangleMesh& mesh, std::int32_t* first_pinch
     }
     std::size_t split = 0;
     std::vector<std::pair<std::int32_t, std::int32_t>> others;  // (other vertex, local index)
-    std::vector<std::int32_t> parent;
+    std::vector<std::int32_t> parent, size;
+    constexpr std::int32_t kPairwise = 16;
     for (std::size_t v = 0; v < n; ++v) {
         const auto begin = offsets[v], end = offsets[v + 1];
         const auto k = end - begin;
         if (k < 2) continue;
-        others.clear();
-        for (std::int32_t i = 0; i < k; ++i)
-            for (auto w : mesh.triangles[incident[begin + i]])
-                if (w != std::int32_t(v)) others.emplace_back(w, i);
-        std::sort(others.begin(), others.end());
         parent.resize(k);
         for (std::int32_t i = 0; i < k; ++i) parent[i] = i;
         auto find = [&](std::int32_t x) {
             while (parent[x] != x) x = parent[x] = parent[parent[x]];
             return x;
         };
-        for (std::size_t i = 1; i < others.size(); ++i)
-            if (others[i].first == others[i - 1].first) {
-                const auto a = find(others[i].second), b = find(others[i - 1].second);
-                if (a != b) parent[std::max(a, b)] = std::min(a, b);
+        auto unite = [&](std::int32_t i, std::int32_t j) {
+            const auto a = find(i), b = find(j);
+            if (a != b) parent[std::max(a, b)] = std::min(a, b);
+        };
+        // Two triangles at v are in one fan when they share another corner (an edge at v).
+        if (k <= kPairwise) {
+            // The usual few triangles: compared pair by pair, no sort.
+            std::array<std::int32_t, 2 * kPairwise> oc{};
+            for (std::int32_t i = 0; i < k; ++i) {
+                int j = 0;
+                for (auto w : mesh.triangles[incident[begin + i]])
+                    if (w != std::int32_t(v) && j < 2) oc[2 * i + j++] = w;
             }
+            for (std::int32_t i = 0; i < k; ++i)
+                for (std::int32_t j = i + 1; j < k; ++j)
+                    if (oc[2 * i] == oc[2 * j] || oc[2 * i] == oc[2 * j + 1] ||
+                        oc[2 * i + 1] == oc[2 * j] || oc[2 * i + 1] == oc[2 * j + 1])
+                        unite(i, j);
+        } else {
+            others.clear();
+            for (std::int32_t i = 0; i < k; ++i)
+                for (auto w : mesh.triangles[incident[begin + i]])
+                    if (w != std::int32_t(v)) others.emplace_back(w, i);
+            std::sort(others.begin(), others.end());
+            for (std::size_t i = 1; i < others.size(); ++i)
+                if (others[i].first == others[i - 1].first)
+                    unite(others[i].second, others[i - 1].second);
+        }
         // Fan sizes by root; roots are the lowest local index of their fan.
-        std::vector<std::int32_t> size(k, 0);
+        size.assign(k, 0);
         for (std::int32_t i = 0; i < k; ++i) ++size[find(i)];
         std::int32_t keep = -1, fans = 0;
         for (std::int32_t i = 0; i < k; ++i)
