@@ -120,8 +120,19 @@ std::vector<std::string> write_segmentation(SegmentJob& job, const SegmentOption
     return names;
 }
 
+MeshCounts mesh_counts(const TriangleMesh& mesh) {
+    MeshCounts c;
+    c.vertices = mesh.vertex_count();
+    c.faces = mesh.triangle_count();
+    const auto edges = static_cast<std::int64_t>(mesh.neighbors.size() / 2);
+    c.boundary_edges = static_cast<std::size_t>(2 * edges - 3 * static_cast<std::int64_t>(c.faces));
+    c.euler_characteristic =
+        static_cast<std::int64_t>(c.vertices) - edges + static_cast<std::int64_t>(c.faces);
+    return c;
+}
+
 void release_large_data(SegmentJob& job) {
-    if (!job.topology) job.topology = mesh_topology(job.input.mesh);
+    if (!job.mesh_counts) job.mesh_counts = mesh_counts(job.input.mesh);
     auto& m = job.input.mesh;
     m.positions = {};
     m.triangles = {};
@@ -150,7 +161,7 @@ void write_run_json(const SegmentJob& job, const std::string& input_path,
     std::ofstream os(path, std::ios::binary);
     if (!os) throw Error("write", "cannot write " + path);
     JsonWriter j(os);
-    const auto topo = job.topology ? *job.topology : mesh_topology(job.input.mesh);
+    const auto topo = job.mesh_counts ? *job.mesh_counts : mesh_counts(job.input.mesh);
     const auto& after = job.after;
     j.begin_object();
     j.field("input", fs::absolute(input_path).lexically_normal().string());
@@ -201,7 +212,7 @@ void write_run_json(const SegmentJob& job, const std::string& input_path,
 void print_summary(const SegmentJob& job, const std::string& output, bool timings) {
     std::printf("%s: %u regions on %zu vertices (critical nodes %zu -> %zu)\n", output.c_str(),
                 job.segmentation.region_count,
-                job.topology ? job.topology->vertices : job.input.mesh.vertex_count(),
+                job.mesh_counts ? job.mesh_counts->vertices : job.input.mesh.vertex_count(),
                 job.critical_before, job.after.critical);
     if (timings) print_timings(job.timings);
 }

@@ -36,6 +36,14 @@ struct StageTime {
     double seconds = 0;
 };
 
+// The mesh's counts in run.json. Edges come from the adjacency lists; in an edge-manifold
+// mesh 3F = 2 E_interior + E_boundary, so E_boundary = 2E - 3F without looking at edges.
+struct MeshCounts {
+    std::size_t vertices = 0, faces = 0, boundary_edges = 0;
+    std::int64_t euler_characteristic = 0;
+};
+MeshCounts mesh_counts(const TriangleMesh& mesh);
+
 struct SegmentJob {
     Input input;
     std::vector<float> field;  // as computed
@@ -45,7 +53,7 @@ struct SegmentJob {
     segment::Segmentation segmentation;
     segment::RegionGraph regions;
     std::vector<StageTime> timings;
-    std::optional<MeshTopology> topology;  // kept by release_large_data for run.json
+    std::optional<MeshCounts> mesh_counts;  // kept by release_large_data for run.json
     const Dem* dem() const { return input.dem ? &*input.dem : nullptr; }
     void add_time(const std::string& name, double seconds);
 };

@@ -105,6 +105,9 @@ TEST_CASE("terrain segment writes every output, complete or not at all", "[cli][
     const auto counts = run.GetRoot().GetObj("counts");
     const long regions = counts.GetLong("regions");
     CHECK(counts.GetLong("vertices") == 4096);
+    CHECK(counts.GetLong("faces") == 2 * 63 * 63);
+    CHECK(counts.GetLong("boundary_edges") == 4 * 63);  // the square's rim
+    CHECK(counts.GetLong("euler_characteristic") == 1);  // a disk
     CHECK(regions >= 1);
     CHECK(run.GetRoot().GetObj("parameters").GetString("cost") == "graph");
     CHECK(run.GetRoot().GetObj("timings_seconds").GetDouble("reeb") >= 0);
