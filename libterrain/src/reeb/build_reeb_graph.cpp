@@ -257,27 +257,6 @@ inline float key_float(std::uint32_t k) {
 // the graph's node_vertex_offsets, node_vertices and vertex_nodes.
 void order_events(const TriangleMesh& mesh, const std::vector<float>& field, ReebGraph& g) {
     const std::size_t nv = field.size();
-    std::vector<i32> rep;  // each vertex's plateau representative (its lowest vertex)
-    auto root = [&](i32 x) {
-        while (rep[z(x)] != x) x = rep[z(x)] = rep[z(rep[z(x)])];
-        return x;
-    };
-    for (std::size_t v = 0; v < nv; ++v)
-        for (auto i = mesh.neighbor_offsets[v]; i < mesh.neighbor_offsets[v + 1]; ++i) {
-            const i32 w = mesh.neighbors[z(i)];
-            if (z(w) > v && field[z(w)] == field[v]) {
-                if (rep.empty()) {
-                    rep.resize(nv);
-                    std::iota(rep.begin(), rep.end(), 0);
-                }
-                const i32 a = root(static_cast<i32>(v)), b = root(w);
-                if (a != b) rep[z(std::max(a, b))] = std::min(a, b);
-            }
-        }
-    const bool any_plateau = !rep.empty();
-    if (any_plateau)
-        for (std::size_t v = 0; v < nv; ++v) rep[v] = root(static_cast<i32>(v));
-
     // Stable LSD radix sort of (value bits << 32 | vertex) on the value bits, 11 bits per
     // pass: ties keep vertex order.
     std::vector<std::uint64_t> keys(nv), tmp(nv);
@@ -298,9 +277,40 @@ void order_events(const TriangleMesh& mesh, const std::vector<float>& field, Ree
         keys.swap(tmp);
     }
     tmp = {};
-    // Equal values: plateaus together, ordered by their lowest vertex.
     auto same_value = [](std::uint64_t a, std::uint64_t b) { return (a >> 32) == (b >> 32); };
     auto vertex = [](std::uint64_t k) { return static_cast<i32>(k & 0xffffffffu); };
+    // Plateaus: adjacent vertices of equal value. Only a vertex whose value another vertex
+    // shares (next to it in the sorted order) can be in one; in a noisy field that is rare.
+    std::vector<char> tied;
+    for (std::size_t i = 1; i < nv; ++i)
+        if (same_value(keys[i], keys[i - 1])) {
+            if (tied.empty()) tied.assign(nv, 0);
+            tied[z(vertex(keys[i]))] = tied[z(vertex(keys[i - 1]))] = 1;
+        }
+    std::vector<i32> rep;  // each vertex's plateau representative (its lowest vertex)
+    auto root = [&](i32 x) {
+        while (rep[z(x)] != x) x = rep[z(x)] = rep[z(rep[z(x)])];
+        return x;
+    };
+    for (std::size_t v = 0; v < tied.size(); ++v) {
+        if (!tied[v]) continue;
+        for (auto i = mesh.neighbor_offsets[v]; i < mesh.neighbor_offsets[v + 1]; ++i) {
+            const i32 w = mesh.neighbors[z(i)];
+            if (z(w) > v && field[z(w)] == field[v]) {
+                if (rep.empty()) {
+                    rep.resize(nv);
+                    std::iota(rep.begin(), rep.end(), 0);
+                }
+                const i32 a = root(static_cast<i32>(v)), b = root(w);
+                if (a != b) rep[z(std::max(a, b))] = std::min(a, b);
+            }
+        }
+    }
+    tied = {};
+    const bool any_plateau = !rep.empty();
+    if (any_plateau)
+        for (std::size_t v = 0; v < nv; ++v) rep[v] = root(static_cast<i32>(v));
+    // Equal values: plateaus together, ordered by their lowest vertex.
     if (any_plateau)
         for (std::size_t i = 0; i < nv;) {
             std::size_t j = i + 1;
