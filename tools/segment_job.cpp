@@ -176,8 +176,13 @@ void write_run_json(const SegmentJob& job, const std::string& input_path,
                values.cost == "auto" ? (job.input.dem ? "graph" : "standard") : values.cost.c_str())
         .field("saddle_penalty", values.grow.saddle_penalty)
         .field("format", values.format)
-        .field("frame", to_string(job.input.mesh.frame))
-        .end_object();
+        .field("frame", to_string(job.input.mesh.frame));
+    if (field.name == "sdf")
+        j.field("rays", field.options.sdf.rays)
+            .field("cone_angle_degrees", field.cone_angle_degrees)
+            .field("postprocess", !field.no_postprocess)
+            .field("allow_open", field.options.sdf.allow_open);
+    j.end_object();
     j.key("counts")
         .begin_object()
         .field("vertices", topo.vertices)

@@ -1,10 +1,12 @@
 // `terrain mesh` and `terrain field` as users run them, outputs read back with GDAL.
+#include <cpl_json.h>
 #include <gdal_priv.h>
 #include <ogr_spatialref.h>
 #include <catch2/catch.hpp>
 
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <memory>
@@ -232,6 +234,21 @@ TEST_CASE("terrain field --field sdf: a mesh file round trip, open DEM tiles ref
         {"reeb", mesh, "--field", "sdf", "--rays", "9", "-o", (dir / "box.json").string(), "-q"});
     INFO(reeb.err);
     CHECK(reeb.status == 0);
+    // ... and the segmentation, whose run.json records them.
+    const auto seg_dir = dir / "box_seg";
+    std::filesystem::remove_all(seg_dir);
+    const auto seg = run_cli({"segment", mesh, "--field", "sdf", "--rays", "9", "--cone-angle",
+                              "60", "--no-postprocess", "-o", seg_dir.string(), "-q"});
+    INFO(seg.err);
+    REQUIRE(seg.status == 0);
+    CPLJSONDocument run;
+    REQUIRE(run.Load((seg_dir / "run.json").string()));
+    const auto parameters = run.GetRoot().GetObj("parameters");
+    CHECK(parameters.GetString("field") == "sdf");
+    CHECK(parameters.GetInteger("rays") == 9);
+    CHECK(parameters.GetDouble("cone_angle_degrees") == 60);
+    CHECK_FALSE(parameters.GetBool("postprocess"));
+    CHECK_FALSE(parameters.GetBool("allow_open"));
 
     // A DEM tile is open: one line saying so. A global DEM closes: its SDF is a raster.
     terrain::test::RasterSpec tile;
