@@ -265,6 +265,16 @@ TEST_CASE("regions.gpkg keeps the DEM's full CRS, the same bytes every run",
         CHECK(e.path().filename() == "regions.gpkg");
     }
     CHECK(files == 1);
+    // A shapefile: its .dbf header carries a fixed date (2000-01-01), not today's.
+    options.driver = "ESRI Shapefile";
+    const auto shp = (dir / "regions.shp").string();
+    io::write_region_polygons(t.dem, t.pixels, t.graph, shp, false, options);
+    const auto dbf = test::file_bytes((dir / "regions.dbf").string());
+    REQUIRE(dbf.size() > 4);
+    CHECK(static_cast<int>(dbf[1]) == 100);  // years since 1900
+    CHECK(static_cast<int>(dbf[2]) == 1);
+    CHECK(static_cast<int>(dbf[3]) == 1);
+    CHECK(read_features(shp).features.size() == t.graph.regions.size());
     options.driver = "NoSuchDriver";
     CHECK_THROWS_AS(io::write_region_polygons(t.dem, t.pixels, t.graph, (dir / "x.shp").string(),
                                               false, options),

@@ -148,8 +148,13 @@ std::vector<std::string> write_ogr(GDALDriver& driver, const std::string& temp,
             : driver.Create(temp.c_str(), 0, 0, 0, GDT_Unknown, nullptr));
     CPLSetThreadLocalConfigOption("OGR_CURRENT_DATE", nullptr);
     if (!ds) throw Error("write", "cannot create '" + path + "'" + errors.suffix());
+    // A shapefile's .dbf header holds a date, today's unless given: a fixed one keeps the
+    // bytes the same run to run.
+    CPLStringList layer_options;
+    if (std::string(driver.GetDescription()) == "ESRI Shapefile")
+        layer_options.SetNameValue("DBF_DATE_LAST_UPDATE", "2000-01-01");
     OGRLayer* layer = ds->CreateLayer(layer_name.c_str(), const_cast<OGRSpatialReference*>(srs),
-                                      wkbMultiPolygon, nullptr);
+                                      wkbMultiPolygon, layer_options.List());
     if (!layer) throw Error("write", "cannot create a layer in '" + path + "'" + errors.suffix());
     if (graph.regions.empty()) return dataset_files(ds.get());
     for (const auto& [name, value] : region_attributes(graph, graph.regions.front())) {
