@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <type_traits>
 
 #include "terrain/core/error.hpp"
 #include "terrain/core/json_writer.hpp"
@@ -133,17 +134,19 @@ MeshCounts mesh_counts(const TriangleMesh& mesh) {
 
 void release_large_data(SegmentJob& job) {
     if (!job.mesh_counts) job.mesh_counts = mesh_counts(job.input.mesh);
+    // (`v = {}` would keep a vector's capacity: it is the initializer-list assignment.)
+    auto drop = [](auto& v) { std::decay_t<decltype(v)>().swap(v); };
     auto& m = job.input.mesh;
-    m.positions = {};
-    m.triangles = {};
-    m.vertex_areas = {};
-    m.neighbor_offsets = {};
-    m.neighbors = {};
-    m.vertex_pixel = {};
-    job.field = {};
-    job.graph = {};
-    job.segmentation.labels = {};
-    job.segmentation.seeds = {};
+    drop(m.positions);
+    drop(m.triangles);
+    drop(m.vertex_areas);
+    drop(m.neighbor_offsets);
+    drop(m.neighbors);
+    drop(m.vertex_pixel);
+    drop(job.field);
+    job.graph = reeb::ReebGraph();
+    drop(job.segmentation.labels);
+    drop(job.segmentation.seeds);
     malloc_trim(0);
 }
 

@@ -13,6 +13,7 @@
 #include <memory>
 #include <numbers>
 
+#include "../core/release.hpp"
 #include "../io/gdal_support.hpp"
 #include "terrain/core/error.hpp"
 #include "terrain/io/describe_dem.hpp"
@@ -190,7 +191,7 @@ TriangleMesh dem_to_mesh(const Dem& dem, const DemToMeshOptions& options,
     report_progress(progress, 0.4, "mesh");
 
     set_positions(mesh, xyz);
-    xyz = {};
+    detail::release(xyz);
 
     // Triangles, block by block. With rows growing southwards and columns eastwards (the
     // geotransform's determinant negative) the orders below are counter-clockwise seen from
@@ -249,9 +250,9 @@ TriangleMesh dem_to_mesh(const Dem& dem, const DemToMeshOptions& options,
     mesh.triangles.reserve(total);
     for (auto& r : per_row) {
         mesh.triangles.insert(mesh.triangles.end(), r.begin(), r.end());
-        r = {};
+        detail::release(r);
     }
-    per_row = {};
+    detail::release(per_row);
     if (mesh.triangles.empty())
         throw Error("mesh",
                     "'" + dem.source + "' gives no triangle: no 2x2 block has three valid pixels");

@@ -1,4 +1,5 @@
 #include "terrain/mesh/triangle_mesh.hpp"
+#include "../core/release.hpp"
 
 #include <algorithm>
 #include <array>
@@ -64,7 +65,7 @@ void finish_mesh(TriangleMesh& mesh) {
         for (int k = 0; k < 3; ++k) area[t[k]] += third;
     }
     mesh.vertex_areas.assign(area.begin(), area.end());
-    area = {};
+    detail::release(area);
 
     // CSR adjacency from the triangles' edges, each list sorted and without repeats.
     std::vector<std::int32_t> offsets(n + 1, 0);
@@ -78,7 +79,7 @@ void finish_mesh(TriangleMesh& mesh) {
             all[fill[t[k]]++] = t[(k + 1) % 3];
             all[fill[t[k]]++] = t[(k + 2) % 3];
         }
-    fill = {};
+    detail::release(fill);
     mesh.neighbor_offsets.assign(n + 1, 0);
     std::size_t write = 0;
     for (std::size_t v = 0; v < n; ++v) {

@@ -27,6 +27,7 @@
 #include <utility>
 
 #include "../core/indices.hpp"
+#include "../core/release.hpp"
 #include "terrain/core/error.hpp"
 #include "terrain/reeb/reeb_graph.hpp"
 
@@ -276,7 +277,7 @@ void order_events(const TriangleMesh& mesh, const std::vector<float>& field, Ree
         for (const std::uint64_t k : keys) tmp[c[(k >> shift) & (kBuckets - 1)]++] = k;
         keys.swap(tmp);
     }
-    tmp = {};
+    detail::release(tmp);
     auto same_value = [](std::uint64_t a, std::uint64_t b) { return (a >> 32) == (b >> 32); };
     auto vertex = [](std::uint64_t k) { return static_cast<i32>(k & 0xffffffffu); };
     // Plateaus: adjacent vertices of equal value. Only a vertex whose value another vertex
@@ -306,7 +307,7 @@ void order_events(const TriangleMesh& mesh, const std::vector<float>& field, Ree
             }
         }
     }
-    tied = {};
+    detail::release(tied);
     const bool any_plateau = !rep.empty();
     if (any_plateau)
         for (std::size_t v = 0; v < nv; ++v) rep[v] = root(static_cast<i32>(v));
@@ -717,8 +718,8 @@ bool contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& prog
         --kids[z(y)][lower ? 0 : 1];
         if (is_leaf(y)) queue.push_back(y);
     }
-    queue = {};
-    kids = {};
+    detail::release(queue);
+    detail::release(kids);
     report_progress(progress, 0.75, "reeb: contour tree");
 
     // Up-edges per node (CSR, in the order of the removed leaves' indices), and down degrees.
@@ -754,7 +755,7 @@ bool contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& prog
         g.node_lower_links[n] = links[0];
         g.node_upper_links[n] = links[1];
     }
-    vertex_links = {};
+    detail::release(vertex_links);
     // Arcs in the order of their lower nodes, then of their up-edges. A regular node takes the
     // arc of the edge below it; `below` holds that edge as the regular node under it, or as
     // -2 - arc when the edge leaves a critical node. One pass in increasing order then fills in
