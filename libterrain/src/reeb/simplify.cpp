@@ -151,14 +151,10 @@ class Simplifier {
                static_cast<std::uint32_t>(a);
     }
 
-    // Arcs below and above a node: its arcs ending there as the upper / lower end.
+    // Arcs below and above a node: its arcs ending there as the upper / lower end (down_ is
+    // updated wherever an arc end moves or an arc turns around).
     i32 down(i32 n) const { return down_[z(n)]; }
     i32 up(i32 n) const { return inc_.degree(n) - down_[z(n)]; }
-    void recount(i32 n) {
-        i32 d = 0;
-        inc_.for_each(n, [&](i32 a) { d += arcs_[z(a)].end[1] == n; });
-        down_[z(n)] = d;
-    }
     bool extremum(i32 n) const { return down(n) == 0 || up(n) == 0; }
     float persistence(i32 a) const {
         const Arc& arc = arcs_[z(a)];
@@ -233,6 +229,7 @@ class Simplifier {
             if (value_[z(arc.end[0])] > fk) {
                 absorb_list(arc, keep);
                 ++down_[z(arc.end[0])];
+                --down_[z(keep)];
                 std::swap(arc.end[0], arc.end[1]);
             }
         } else {
@@ -249,6 +246,7 @@ class Simplifier {
             if (value_[z(arc.end[1])] < fk) {
                 absorb_list(arc, keep);
                 --down_[z(arc.end[1])];
+                ++down_[z(keep)];
                 std::swap(arc.end[0], arc.end[1]);
             }
         }
@@ -287,6 +285,7 @@ class Simplifier {
             inc_.move(inc_.slot(b, gone), keep);
             for (auto& e : other.end)
                 if (e == gone) e = keep;
+            down_[z(keep)] += other.end[1] == keep;
         }
         down_[z(gone)] = 0;
         if (lo_ext && hi_ext) {
@@ -295,7 +294,6 @@ class Simplifier {
         } else {
             for (const i32 b : touched) fit_arc(b, keep);
         }
-        recount(keep);
         // keep's other arcs need a new look only if they may have become candidates: its
         // value moved, it became an extremum, or its area share per arc went down. Arcs that
         // stopped being candidates are dropped when they reach the top of the heap.
