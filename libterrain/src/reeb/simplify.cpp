@@ -10,7 +10,6 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
-#include <queue>
 #include <string>
 
 #include "../core/indices.hpp"
@@ -73,6 +72,52 @@ class Incidence {
     std::vector<i32> head_, degree_, next_, prev_, owner_;
 };
 
+// Min-priority queue of 64-bit keys: a radix heap (keys at or above the last key popped, in
+// buckets by the highest bit where they differ from it) with a binary heap beside it for the
+// few keys pushed below that. Pops come in the same order as from any exact min-heap.
+class KeyQueue {
+  public:
+    bool empty() const { return size_ == 0 && low_.empty(); }
+    void push(std::uint64_t key) {
+        if (key < last_) {
+            low_.push_back(key);
+            std::push_heap(low_.begin(), low_.end(), std::greater<>());
+        } else {
+            bucket_[z(std::bit_width(key ^ last_))].push_back(key);
+            ++size_;
+        }
+    }
+    std::uint64_t pop() {
+        if (size_ > 0 && bucket_[0].empty()) refill();
+        if (!low_.empty() && (size_ == 0 || low_.front() < last_)) {
+            std::pop_heap(low_.begin(), low_.end(), std::greater<>());
+            const std::uint64_t key = low_.back();
+            low_.pop_back();
+            return key;
+        }
+        bucket_[0].pop_back();
+        --size_;
+        return last_;
+    }
+
+  private:
+    // The smallest non-empty bucket's minimum becomes last_; its keys spread over the lower
+    // buckets (bucket 0 holds the keys equal to last_).
+    void refill() {
+        std::size_t i = 1;
+        while (bucket_[i].empty()) ++i;
+        std::vector<std::uint64_t>& b = bucket_[i];
+        last_ = *std::min_element(b.begin(), b.end());
+        for (const std::uint64_t key : b) bucket_[z(std::bit_width(key ^ last_))].push_back(key);
+        b.clear();
+    }
+
+    std::array<std::vector<std::uint64_t>, 65> bucket_;
+    std::size_t size_ = 0;  // keys in the buckets
+    std::uint64_t last_ = 0;
+    std::vector<std::uint64_t> low_;  // keys below last_, a min-heap
+};
+
 std::vector<double> node_areas(const TriangleMesh& mesh, const ReebGraph& g) {
     std::vector<double> area(g.node_count(), 0.0);
     for (std::size_t v = 0; v < g.vertex_nodes.size(); ++v)
@@ -119,11 +164,10 @@ class Simplifier {
 
     void run(const ProgressFn& progress, SimplifyResult& result) {
         for (std::size_t a = 0; a < arcs_.size(); ++a) consider(static_cast<i32>(a));
-        const std::size_t initial = heap_.size();
+        const std::size_t initial = candidates_;
         std::size_t done = 0;
         while (!heap_.empty()) {
-            const std::uint64_t key = heap_.top();
-            heap_.pop();
+            const std::uint64_t key = heap_.pop();
             const i32 a = static_cast<i32>(key & 0xffffffffu);
             if (arcs_[z(a)].queued != key) continue;
             arcs_[z(a)].queued = 0;
@@ -196,6 +240,7 @@ class Simplifier {
         if (arc.queued == key) return;
         arc.queued = key;
         heap_.push(key);
+        ++candidates_;
     }
 
     // Node n's vertices (and everything already forwarded to it) join `keep`.
@@ -417,7 +462,8 @@ class Simplifier {
     Incidence inc_;
     std::vector<i32> touched_, all_;
     std::vector<Arc> arcs_;
-    std::priority_queue<std::uint64_t, std::vector<std::uint64_t>, std::greater<>> heap_;
+    KeyQueue heap_;
+    std::size_t candidates_ = 0;  // keys pushed
 };
 
 }  // namespace
