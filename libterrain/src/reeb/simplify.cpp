@@ -1,9 +1,10 @@
 // Critical-node cancellation on a Reeb graph (docs/reeb.md). The graph is copied into a
-// mutable form: each node's arcs in a linked list of arc ends, regular nodes in doubly linked
-// lists (one per arc, sorted by value), absorbed nodes forwarding to the node that took them.
-// Candidates wait in a min-heap keyed by (persistence, arc id) with lazy deletion: each arc
-// remembers the key of its live entry, entries with another key are stale and skipped, and a
-// popped arc is checked again before it is cancelled.
+// mutable form: nodes renumbered so that each arc's regular nodes start out side by side,
+// each node's arcs in a run of an arena, regular nodes in doubly linked lists (one per arc,
+// sorted by value), absorbed nodes forwarding to the node that took them. Candidates wait in
+// a priority queue keyed by (persistence, arc id) with lazy deletion: each arc remembers the
+// key of its live entry, entries with another key are stale and skipped, and a popped arc is
+// checked again before it is cancelled.
 
 #include "terrain/reeb/simplify.hpp"
 
@@ -23,45 +24,62 @@ using detail::i32;
 using detail::kNone;
 using detail::z;
 
-// The arcs at each node as doubly linked lists of arc ends (slot 2a and 2a+1 of arc a), so
-// that moving an arc end from one node to another allocates nothing.
+// The arcs at each node, each node's in a run of an arena (newest last, read newest first),
+// and the number of those arcs that end there from below. A run that fills up moves to the
+// arena's end with twice the room; a node that loses all its arcs keeps its run.
 class Incidence {
   public:
-    void init(std::size_t nodes, std::size_t arcs) {
-        head_.assign(nodes, kNone);
-        degree_.assign(nodes, 0);
-        next_.assign(2 * arcs, kNone);
-        prev_.assign(2 * arcs, kNone);
-        owner_.assign(2 * arcs, kNone);
+    // Arcs a = 0, 1, ... join their ends in turn.
+    void init(std::size_t nodes, const std::vector<std::array<i32, 2>>& ends) {
+        node_.assign(nodes, Run{});
+        for (const auto& e : ends) {
+            ++node_[z(e[0])].size;
+            ++node_[z(e[1])].size;
+            ++node_[z(e[1])].down;
+        }
+        i32 offset = 0;
+        for (Run& r : node_) {
+            r.offset = offset;
+            r.room = r.size;
+            offset += r.size;
+            r.size = 0;
+        }
+        arcs_.resize(z(offset));
+        for (std::size_t a = 0; a < ends.size(); ++a)
+            for (const i32 n : ends[a]) {
+                Run& r = node_[z(n)];
+                arcs_[z(r.offset + r.size++)] = static_cast<i32>(a);
+            }
     }
-    void link(i32 slot, i32 node) {
-        owner_[z(slot)] = node;
-        prev_[z(slot)] = kNone;
-        next_[z(slot)] = head_[z(node)];
-        if (head_[z(node)] != kNone) prev_[z(head_[z(node)])] = slot;
-        head_[z(node)] = slot;
-        ++degree_[z(node)];
+    void link(i32 a, i32 n) {
+        Run& r = node_[z(n)];
+        if (r.size == r.room) {
+            const i32 offset = static_cast<i32>(arcs_.size());
+            r.room = std::max(4, 2 * r.room);
+            arcs_.resize(arcs_.size() + z(r.room));
+            std::copy_n(arcs_.begin() + r.offset, r.size, arcs_.begin() + offset);
+            r.offset = offset;
+        }
+        arcs_[z(r.offset + r.size++)] = a;
     }
-    void unlink(i32 slot) {
-        const i32 node = owner_[z(slot)], p = prev_[z(slot)], n = next_[z(slot)];
-        if (p != kNone)
-            next_[z(p)] = n;
-        else
-            head_[z(node)] = n;
-        if (n != kNone) prev_[z(n)] = p;
-        --degree_[z(node)];
-        owner_[z(slot)] = kNone;
+    // Arc a leaves node n (the newest of its entries there, for an arc with both ends at n).
+    void unlink(i32 a, i32 n) {
+        Run& r = node_[z(n)];
+        const auto first = arcs_.begin() + r.offset, last = first + r.size;
+        auto it = last - 1;
+        while (*it != a) --it;
+        std::copy(it + 1, last, it);
+        --r.size;
     }
-    void move(i32 slot, i32 node) {
-        unlink(slot);
-        link(slot, node);
-    }
-    // The slot of arc a's end at node n.
-    i32 slot(i32 a, i32 n) const { return owner_[z(2 * a)] == n ? 2 * a : 2 * a + 1; }
-    i32 degree(i32 n) const { return degree_[z(n)]; }
+    // All of node n's arcs leave it.
+    void clear(i32 n) { node_[z(n)].size = 0; }
+    i32 degree(i32 n) const { return node_[z(n)].size; }
+    i32& down(i32 n) { return node_[z(n)].down; }
+    i32 down(i32 n) const { return node_[z(n)].down; }
     template <class F>
     void for_each(i32 n, F&& f) const {
-        for (i32 sl = head_[z(n)]; sl != kNone; sl = next_[z(sl)]) f(sl / 2);
+        const Run& r = node_[z(n)];
+        for (i32 i = r.offset + r.size - 1; i >= r.offset; --i) f(arcs_[z(i)]);
     }
     void arcs(i32 n, std::vector<i32>& out) const {
         out.clear();
@@ -69,7 +87,12 @@ class Incidence {
     }
 
   private:
-    std::vector<i32> head_, degree_, next_, prev_, owner_;
+    struct Run {
+        i32 offset = 0, size = 0, room = 0;
+        i32 down = 0;  // arcs whose upper end is the node
+    };
+    std::vector<Run> node_;
+    std::vector<i32> arcs_;
 };
 
 // Min-priority queue of 64-bit keys: a radix heap (keys at or above the last key popped, in
@@ -125,52 +148,92 @@ std::vector<double> node_areas(const TriangleMesh& mesh, const ReebGraph& g) {
     return area;
 }
 
+// The summed area of node n's vertices, added in increasing vertex order (as a sweep over
+// the vertices would add them).
+double node_area(const TriangleMesh& mesh, const ReebGraph& g, std::size_t n,
+                 std::vector<i32>& scratch) {
+    const auto first = g.node_vertices.begin() + g.node_vertex_offsets[n];
+    const auto last = g.node_vertices.begin() + g.node_vertex_offsets[n + 1];
+    const i32* v = &*first;
+    std::size_t count = static_cast<std::size_t>(last - first);
+    if (!std::is_sorted(first, last)) {
+        scratch.assign(first, last);
+        std::sort(scratch.begin(), scratch.end());
+        v = scratch.data();
+    }
+    double s = 0;
+    for (std::size_t i = 0; i < count; ++i)
+        s += mesh.vertex_areas.empty() ? 1.0 : mesh.vertex_areas[z(v[i])];
+    return s;
+}
+
+// Nodes are renumbered for locality: first the nodes that are in no arc's list (the critical
+// ones, the only possible arc ends), in their order, then the listed regular nodes in the
+// order of arc_nodes, so that each arc's list starts out contiguous in memory.
 class Simplifier {
   public:
     Simplifier(const TriangleMesh& mesh, const ReebGraph& g, const SimplifyOptions& options)
         : g_(g), options_(options) {
-        const std::size_t nn = g.node_count(), na = g.arc_count();
-        value_ = g.node_values;
-        area_ = node_areas(mesh, g);
+        const std::size_t nn = g.node_count(), na = g.arc_count(), nl = g.arc_nodes.size();
+        // at_[n]: arc ends marked, the other regular nodes of the lists by their position in
+        // arc_nodes (placed_ says which positions hold their node); then the new numbers.
+        constexpr i32 kEnd = -2;
+        at_.assign(nn, kNone);
+        for (const auto& e : g.arcs) at_[z(e[0])] = at_[z(e[1])] = kEnd;
+        std::vector<char> placed(nl, 0);
+        for (std::size_t p = 0; p < nl; ++p) {
+            const i32 r = g.arc_nodes[p];
+            if (at_[z(r)] != kNone || g.node_kinds[z(r)] != NodeKind::regular) continue;
+            at_[z(r)] = static_cast<i32>(p);
+            placed[p] = 1;
+        }
+        i32 first = 0;
+        for (const i32 i : at_) first += i < 0;
+        nodes_.resize(z(first) + nl);
+        critical_.resize(z(first));
+        modified_.assign(z(first), 0);
         total_area_ = 0;
-        for (const double a : area_) total_area_ += a;
+        std::vector<i32> scratch;
+        i32 k = 0;
+        for (std::size_t n = 0; n < nn; ++n) {
+            const double area = node_area(mesh, g, n, scratch);
+            total_area_ += area;
+            const i32 i = at_[n] < 0 ? k++ : first + at_[n];
+            at_[n] = i;
+            nodes_[z(i)].value = g.node_values[n];
+            nodes_[z(i)].area = area;
+            if (i < first) critical_[z(i)] = g.node_kinds[n] != NodeKind::regular;
+        }
         if (total_area_ <= 0) total_area_ = 1;
-        forward_.assign(nn, kNone);
-        critical_.resize(nn);
-        modified_.assign(nn, 0);
-        for (std::size_t n = 0; n < nn; ++n) critical_[n] = g.node_kinds[n] != NodeKind::regular;
-        prev_.assign(nn, kNone);
-        next_.assign(nn, kNone);
-        inc_.init(nn, na);
-        down_.assign(nn, 0);
         arcs_.resize(na);
+        queued_.assign(na, 0);
+        std::vector<std::array<i32, 2>> ends(na);
+        for (std::size_t a = 0; a < na; ++a)
+            ends[a] = arcs_[a].end = {at_[z(g.arcs[a][0])], at_[z(g.arcs[a][1])]};
+        inc_.init(z(first), ends);
         for (std::size_t a = 0; a < na; ++a) {
             Arc& arc = arcs_[a];
-            arc.end = g.arcs[a];
-            inc_.link(static_cast<i32>(2 * a), arc.end[0]);
-            inc_.link(static_cast<i32>(2 * a + 1), arc.end[1]);
-            ++down_[z(arc.end[1])];
-            for (i32 i = g.arc_offsets[a]; i < g.arc_offsets[a + 1]; ++i) {
-                const i32 r = g.arc_nodes[z(i)];
+            for (i32 p = g.arc_offsets[a]; p < g.arc_offsets[a + 1]; ++p) {
+                const i32 r = placed[z(p)] ? first + p : at_[z(g.arc_nodes[z(p)])];
                 if (arc.tail == kNone)
                     arc.head = r;
                 else
-                    next_[z(arc.tail)] = r, prev_[z(r)] = arc.tail;
+                    nodes_[z(arc.tail)].next = r, nodes_[z(r)].prev = arc.tail;
                 arc.tail = r;
-                arc.area += area_[z(r)];
+                arc.area += nodes_[z(r)].area;
             }
         }
     }
 
     void run(const ProgressFn& progress, SimplifyResult& result) {
         for (std::size_t a = 0; a < arcs_.size(); ++a) consider(static_cast<i32>(a));
-        const std::size_t initial = candidates_;
+        const std::size_t initial = pushed_;
         std::size_t done = 0;
         while (!heap_.empty()) {
             const std::uint64_t key = heap_.pop();
             const i32 a = static_cast<i32>(key & 0xffffffffu);
-            if (arcs_[z(a)].queued != key) continue;
-            arcs_[z(a)].queued = 0;
+            if (queued_[z(a)] != key) continue;
+            queued_[z(a)] = 0;
             if (!candidate(a)) continue;
             cancel(a, result);
             if ((++done & 0xfff) == 0 && initial > 0)
@@ -182,11 +245,16 @@ class Simplifier {
     }
 
   private:
+    struct Node {
+        double area = 0;  // its vertices' and its absorbed nodes' area
+        float value = 0;
+        i32 forward = kNone;             // the node that absorbed it
+        i32 prev = kNone, next = kNone;  // its neighbours in its arc's list
+    };
     struct Arc {
         std::array<i32, 2> end{kNone, kNone};  // {lower, upper}
         i32 head = kNone, tail = kNone;        // regular nodes, lower to upper
         double area = 0;                       // area of the regular nodes' vertices
-        std::uint64_t queued = 0;              // key of its live heap entry, 0 when none
         bool alive = true;
     };
     // Heap key: the persistence's order-preserving bits, then the arc id (ties by id).
@@ -195,19 +263,19 @@ class Simplifier {
                static_cast<std::uint32_t>(a);
     }
 
-    // Arcs below and above a node: its arcs ending there as the upper / lower end (down_ is
-    // updated wherever an arc end moves or an arc turns around).
-    i32 down(i32 n) const { return down_[z(n)]; }
-    i32 up(i32 n) const { return inc_.degree(n) - down_[z(n)]; }
+    // Arcs below and above a node: its arcs ending there as the upper / lower end (the
+    // incidence updates its count below wherever an arc end moves or an arc turns around).
+    i32 down(i32 n) const { return inc_.down(n); }
+    i32 up(i32 n) const { return inc_.degree(n) - inc_.down(n); }
     bool extremum(i32 n) const { return down(n) == 0 || up(n) == 0; }
     float persistence(i32 a) const {
         const Arc& arc = arcs_[z(a)];
-        return std::fabs(value_[z(arc.end[1])] - value_[z(arc.end[0])]);
+        return std::fabs(nodes_[z(arc.end[1])].value - nodes_[z(arc.end[0])].value);
     }
     double area_ratio(i32 a) const {
         const Arc& arc = arcs_[z(a)];
         double s = arc.area;
-        for (const i32 n : arc.end) s += area_[z(n)] / static_cast<double>(inc_.degree(n));
+        for (const i32 n : arc.end) s += nodes_[z(n)].area / static_cast<double>(inc_.degree(n));
         return s / total_area_;
     }
     bool multi(i32 a) const {
@@ -231,26 +299,25 @@ class Simplifier {
     }
     // (Re)queues arc a if it is a candidate; a queued entry with the same key is kept.
     void consider(i32 a) {
-        Arc& arc = arcs_[z(a)];
+        std::uint64_t& queued = queued_[z(a)];
         if (!candidate(a)) {
-            arc.queued = 0;
+            queued = 0;
             return;
         }
         const std::uint64_t key = key_of(persistence(a), a);
-        if (arc.queued == key) return;
-        arc.queued = key;
+        if (queued == key) return;
+        queued = key;
         heap_.push(key);
-        ++candidates_;
+        ++pushed_;
     }
 
     // Node n's vertices (and everything already forwarded to it) join `keep`.
     void absorb(i32 n, i32 keep) {
-        forward_[z(n)] = keep;
-        area_[z(keep)] += area_[z(n)];
-        critical_[z(n)] = false;
+        nodes_[z(n)].forward = keep;
+        nodes_[z(keep)].area += nodes_[z(n)].area;
     }
     void absorb_list(Arc& arc, i32 keep) {
-        for (i32 r = arc.head; r != kNone; r = next_[z(r)]) absorb(r, keep);
+        for (i32 r = arc.head; r != kNone; r = nodes_[z(r)].next) absorb(r, keep);
         arc.head = arc.tail = kNone;
         arc.area = 0;
     }
@@ -259,39 +326,39 @@ class Simplifier {
     // value range join keep, and the ends swap if the other end is now on the wrong side.
     void fit_arc(i32 b, i32 keep) {
         Arc& arc = arcs_[z(b)];
-        const float fk = value_[z(keep)];
+        const float fk = nodes_[z(keep)].value;
         if (arc.end[1] == keep) {
-            while (arc.tail != kNone && value_[z(arc.tail)] > fk) {
+            while (arc.tail != kNone && nodes_[z(arc.tail)].value > fk) {
                 const i32 r = arc.tail;
-                arc.tail = prev_[z(r)];
+                arc.tail = nodes_[z(r)].prev;
                 if (arc.tail == kNone)
                     arc.head = kNone;
                 else
-                    next_[z(arc.tail)] = kNone;
-                arc.area -= area_[z(r)];
+                    nodes_[z(arc.tail)].next = kNone;
+                arc.area -= nodes_[z(r)].area;
                 absorb(r, keep);
             }
-            if (value_[z(arc.end[0])] > fk) {
+            if (nodes_[z(arc.end[0])].value > fk) {
                 absorb_list(arc, keep);
-                ++down_[z(arc.end[0])];
-                --down_[z(keep)];
+                ++inc_.down(arc.end[0]);
+                --inc_.down(keep);
                 std::swap(arc.end[0], arc.end[1]);
             }
         } else {
-            while (arc.head != kNone && value_[z(arc.head)] < fk) {
+            while (arc.head != kNone && nodes_[z(arc.head)].value < fk) {
                 const i32 r = arc.head;
-                arc.head = next_[z(r)];
+                arc.head = nodes_[z(r)].next;
                 if (arc.head == kNone)
                     arc.tail = kNone;
                 else
-                    prev_[z(arc.head)] = kNone;
-                arc.area -= area_[z(r)];
+                    nodes_[z(arc.head)].prev = kNone;
+                arc.area -= nodes_[z(r)].area;
                 absorb(r, keep);
             }
-            if (value_[z(arc.end[1])] < fk) {
+            if (nodes_[z(arc.end[1])].value < fk) {
                 absorb_list(arc, keep);
-                --down_[z(arc.end[1])];
-                ++down_[z(keep)];
+                --inc_.down(arc.end[1]);
+                ++inc_.down(keep);
                 std::swap(arc.end[0], arc.end[1]);
             }
         }
@@ -304,12 +371,12 @@ class Simplifier {
         const bool lo_ext = down(lo) == 0, hi_ext = up(hi) == 0;
         i32 keep, gone;
         const i32 keep0 = lo_ext && hi_ext ? lo : (lo_ext ? hi : lo);
-        const double share_before = area_[z(keep0)] / static_cast<double>(inc_.degree(keep0));
+        const double share_before = nodes_[z(keep0)].area / static_cast<double>(inc_.degree(keep0));
         const bool ext_before = extremum(keep0);
         if (lo_ext && hi_ext) {
             keep = lo;
             gone = hi;
-            value_[z(keep)] = 0.5f * (value_[z(lo)] + value_[z(hi)]);
+            nodes_[z(keep)].value = 0.5f * (nodes_[z(lo)].value + nodes_[z(hi)].value);
             ++result.extremum_extremum;
         } else {
             keep = lo_ext ? hi : lo;
@@ -318,21 +385,22 @@ class Simplifier {
         }
         modified_[z(keep)] = 1;
         arc.alive = false;
-        inc_.unlink(2 * a);
-        inc_.unlink(2 * a + 1);
-        --down_[z(hi)];
+        inc_.unlink(a, lo);
+        inc_.unlink(a, hi);
+        --inc_.down(hi);
         absorb_list(arc, keep);
         absorb(gone, keep);
         std::vector<i32>& touched = touched_;
         inc_.arcs(gone, touched);
+        inc_.clear(gone);
         for (const i32 b : touched) {
             Arc& other = arcs_[z(b)];
-            inc_.move(inc_.slot(b, gone), keep);
+            inc_.link(b, keep);
             for (auto& e : other.end)
                 if (e == gone) e = keep;
-            down_[z(keep)] += other.end[1] == keep;
+            inc_.down(keep) += other.end[1] == keep;
         }
-        down_[z(gone)] = 0;
+        inc_.down(gone) = 0;
         if (lo_ext && hi_ext) {
             inc_.arcs(keep, all_);
             for (const i32 b : all_) fit_arc(b, keep);
@@ -343,7 +411,8 @@ class Simplifier {
         // value moved, it became an extremum, or its area share per arc went down. Arcs that
         // stopped being candidates are dropped when they reach the top of the heap.
         const double share_after =
-            inc_.degree(keep) == 0 ? 0.0 : area_[z(keep)] / static_cast<double>(inc_.degree(keep));
+            inc_.degree(keep) == 0 ? 0.0
+                                   : nodes_[z(keep)].area / static_cast<double>(inc_.degree(keep));
         if ((lo_ext && hi_ext) || extremum(keep) != ext_before || share_after < share_before)
             inc_.arcs(keep, touched);
 
@@ -355,22 +424,24 @@ class Simplifier {
             Arc& L = arcs_[z(lower)];
             Arc& U = arcs_[z(upper)];
             if (L.end[0] != U.end[1]) {
-                prev_[z(keep)] = L.tail;
-                next_[z(keep)] = U.head;
+                Node& k = nodes_[z(keep)];
+                k.prev = L.tail;
+                k.next = U.head;
                 if (L.tail == kNone)
                     L.head = keep;
                 else
-                    next_[z(L.tail)] = keep;
-                if (U.head != kNone) prev_[z(U.head)] = keep;
+                    nodes_[z(L.tail)].next = keep;
+                if (U.head != kNone) nodes_[z(U.head)].prev = keep;
                 L.tail = U.tail == kNone ? keep : U.tail;
-                L.area += area_[z(keep)] + U.area;
+                L.area += k.area + U.area;
                 const i32 q = U.end[1];
                 L.end[1] = q;
                 U.alive = false;
-                inc_.unlink(inc_.slot(upper, q));
-                inc_.unlink(inc_.slot(upper, keep));
-                inc_.move(inc_.slot(lower, keep), q);
-                down_[z(keep)] = 0;
+                inc_.unlink(upper, q);
+                inc_.unlink(upper, keep);
+                inc_.unlink(lower, keep);
+                inc_.link(lower, q);
+                inc_.down(keep) = 0;
                 critical_[z(keep)] = false;
                 touched.assign(1, lower);
                 inc_.for_each(L.end[0], [&](i32 b) {
@@ -383,31 +454,52 @@ class Simplifier {
 
     void output(SimplifyResult& result) {
         const std::size_t nn = g_.node_count();
-        auto root = [&](i32 n) {
-            i32 r = n;
-            while (forward_[z(r)] != kNone) r = forward_[z(r)];
-            while (forward_[z(n)] != kNone) {
-                const i32 nx = forward_[z(n)];
-                forward_[z(n)] = r;
+        // Forwarding chains end at the nodes that remain; shortened to one step each.
+        for (Node& node : nodes_) {
+            i32 r = node.forward;
+            if (r == kNone) continue;
+            while (nodes_[z(r)].forward != kNone) r = nodes_[z(r)].forward;
+            for (i32 n = node.forward; n != r;) {
+                const i32 nx = nodes_[z(n)].forward;
+                nodes_[z(n)].forward = r;
                 n = nx;
             }
-            return r;
-        };
-        std::vector<i32> new_id(nn, kNone);
+            node.forward = r;
+        }
+        // New ids, in the order of the old ones, by internal index.
+        std::vector<i32> new_id(nodes_.size(), kNone);
         i32 count = 0;
         for (std::size_t n = 0; n < nn; ++n)
-            if (forward_[n] == kNone) new_id[n] = count++;
+            if (nodes_[z(at_[n])].forward == kNone) new_id[z(at_[n])] = count++;
         ReebGraph& out = result.graph;
         out.node_values.resize(z(count));
         out.node_kinds.assign(z(count), NodeKind::regular);
         out.node_lower_links.assign(z(count), 1);
         out.node_upper_links.assign(z(count), 1);
         out.node_arcs.assign(z(count), kNone);
+        const i32 first = static_cast<i32>(critical_.size());
+        for (std::size_t n = 0; n < nn; ++n) {
+            const i32 i = at_[n];
+            const i32 nid = new_id[z(i)];
+            if (nid == kNone) continue;
+            out.node_values[z(nid)] = nodes_[z(i)].value;
+            if (i >= first || !critical_[z(i)]) continue;
+            const i32 d = down(i), u = up(i);
+            out.node_kinds[z(nid)] = d == 0   ? NodeKind::minimum
+                                     : u == 0 ? NodeKind::maximum
+                                              : NodeKind::saddle;
+            const bool unchanged = !modified_[z(i)];
+            out.node_lower_links[z(nid)] =
+                unchanged ? g_.node_lower_links[n] : static_cast<std::uint8_t>(std::min(d, 255));
+            out.node_upper_links[z(nid)] =
+                unchanged ? g_.node_upper_links[n] : static_cast<std::uint8_t>(std::min(u, 255));
+        }
         // Vertices: grouped by new node, in the order of their old nodes.
         std::vector<i32> size(z(count) + 1, 0);
         std::vector<i32> old_root(nn);
         for (std::size_t n = 0; n < nn; ++n) {
-            old_root[n] = new_id[z(root(static_cast<i32>(n)))];
+            const i32 i = at_[n], f = nodes_[z(i)].forward;
+            old_root[n] = new_id[z(f == kNone ? i : f)];
             size[z(old_root[n]) + 1] += g_.node_vertex_offsets[n + 1] - g_.node_vertex_offsets[n];
         }
         for (std::size_t i = 1; i < size.size(); ++i) size[i] += size[i - 1];
@@ -417,34 +509,20 @@ class Simplifier {
         result.field.resize(g_.vertex_nodes.size());
         for (std::size_t n = 0; n < nn; ++n) {
             const i32 nid = old_root[n];
+            const float value = out.node_values[z(nid)];
             for (i32 i = g_.node_vertex_offsets[n]; i < g_.node_vertex_offsets[n + 1]; ++i) {
                 const i32 v = g_.node_vertices[z(i)];
                 out.node_vertices[z(size[z(nid)]++)] = v;
                 out.vertex_nodes[z(v)] = nid;
+                result.field[z(v)] = value;
             }
         }
-        for (std::size_t n = 0; n < nn; ++n) {
-            if (new_id[n] == kNone) continue;
-            out.node_values[z(new_id[n])] = value_[n];
-            if (!critical_[n]) continue;
-            const i32 d = down(static_cast<i32>(n)), u = up(static_cast<i32>(n));
-            out.node_kinds[z(new_id[n])] = d == 0   ? NodeKind::minimum
-                                           : u == 0 ? NodeKind::maximum
-                                                    : NodeKind::saddle;
-            const bool unchanged = !modified_[n];
-            out.node_lower_links[z(new_id[n])] =
-                unchanged ? g_.node_lower_links[n] : static_cast<std::uint8_t>(std::min(d, 255));
-            out.node_upper_links[z(new_id[n])] =
-                unchanged ? g_.node_upper_links[n] : static_cast<std::uint8_t>(std::min(u, 255));
-        }
-        for (std::size_t v = 0; v < result.field.size(); ++v)
-            result.field[v] = out.node_values[z(out.vertex_nodes[v])];
         out.arc_offsets.assign(1, 0);
         for (const Arc& arc : arcs_) {
             if (!arc.alive) continue;
             const i32 id = static_cast<i32>(out.arcs.size());
             out.arcs.push_back({new_id[z(arc.end[0])], new_id[z(arc.end[1])]});
-            for (i32 r = arc.head; r != kNone; r = next_[z(r)]) {
+            for (i32 r = arc.head; r != kNone; r = nodes_[z(r)].next) {
                 out.arc_nodes.push_back(new_id[z(r)]);
                 out.node_arcs[z(new_id[z(r)])] = id;
             }
@@ -454,16 +532,16 @@ class Simplifier {
 
     const ReebGraph& g_;
     SimplifyOptions options_;
-    std::vector<float> value_;
-    std::vector<double> area_;
+    std::vector<i32> at_;  // the internal index of each node
+    std::vector<Node> nodes_;
+    std::vector<char> critical_, modified_;  // of the first nodes (the others are regular)
     double total_area_ = 0;
-    std::vector<i32> forward_, prev_, next_, down_;
-    std::vector<char> critical_, modified_;
     Incidence inc_;
     std::vector<i32> touched_, all_;
     std::vector<Arc> arcs_;
+    std::vector<std::uint64_t> queued_;  // key of each arc's live heap entry, 0 when none
     KeyQueue heap_;
-    std::size_t candidates_ = 0;  // keys pushed
+    std::size_t pushed_ = 0;
 };
 
 }  // namespace
