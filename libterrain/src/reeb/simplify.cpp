@@ -26,6 +26,10 @@ using detail::i32;
 using detail::kNone;
 using detail::z;
 
+// Passes that gather from or scatter to random places start fetching them this many steps
+// ahead.
+constexpr std::size_t kAhead = 16;
+
 // The queued arcs in a 4-ary min-heap of their keys (an arc's id is its key's low half), each
 // arc at most once: re-keying an arc moves its entry instead of leaving a stale one behind.
 class ArcQueue {
@@ -57,9 +61,25 @@ class ArcQueue {
         else
             down(z(i), last);
     }
+    // The root's hole goes down to a leaf along the smaller children, and the last entry
+    // comes up from there (it mostly belongs near the leaves).
     std::uint64_t pop() {
-        const std::uint64_t key = heap_.front();
-        erase(static_cast<i32>(arc(key)));
+        const std::uint64_t key = heap_.front(), last = heap_.back();
+        at_[arc(key)] = kNone;
+        heap_.pop_back();
+        const std::size_t n = heap_.size();
+        if (n == 0) return key;
+        std::size_t i = 0;
+        for (;;) {
+            const std::size_t c = 4 * i + 1;
+            if (c >= n) break;
+            std::size_t m = c;
+            for (std::size_t j = c + 1; j < std::min(c + 4, n); ++j)
+                if (heap_[j] < heap_[m]) m = j;
+            place(i, heap_[m]);
+            i = m;
+        }
+        up(i, last);
         return key;
     }
 
@@ -152,6 +172,13 @@ class Simplifier {
         std::vector<i32> scratch;
         i32 k = 0;
         for (std::size_t n = 0; n < nn; ++n) {
+            if (n + kAhead < nn) {
+                const std::size_t m = n + kAhead;
+                const i32 i = g.node_vertex_offsets[m];
+                if (!mesh.vertex_areas.empty() && i < g.node_vertex_offsets[m + 1])
+                    __builtin_prefetch(&mesh.vertex_areas[z(g.node_vertices[z(i)])]);
+                if (at_[m] >= 0) __builtin_prefetch(&reg_[z(at_[m])], 1);
+            }
             const double area = node_area(mesh, g, n, scratch);
             total_area_ += area;
             if (at_[n] < 0) {
@@ -187,6 +214,8 @@ class Simplifier {
         arena_.resize(z(offset));
         for (std::size_t a = 0; a < na; ++a) {
             Arc& arc = arcs_[a];
+            if (a + kAhead < na)
+                for (const i32 e : arcs_[a + kAhead].end) __builtin_prefetch(&crit_[z(e)], 1);
             for (const i32 e : arc.end) {
                 Crit& c = crit_[z(e)];
                 arena_[z(c.offset + c.size++)] = static_cast<i32>(a);
@@ -286,10 +315,14 @@ class Simplifier {
     // Arc a leaves node n (the newest of its entries there, for an arc with both ends at n).
     void unlink(i32 a, i32 n) {
         Crit& c = crit_[z(n)];
+        if (c.size == 1) {  // its only arc
+            c.size = 0;
+            return;
+        }
         const auto first = arena_.begin() + c.offset, last = first + c.size;
         auto it = last - 1;
         while (*it != a) --it;
-        std::copy(it + 1, last, it);
+        for (; it + 1 != last; ++it) *it = *(it + 1);
         --c.size;
     }
 
@@ -312,6 +345,7 @@ class Simplifier {
     bool multi(i32 a) const {
         const Arc& arc = arcs_[z(a)];
         const i32 n = degree(arc.end[0]) <= degree(arc.end[1]) ? arc.end[0] : arc.end[1];
+        if (degree(n) == 1) return false;  // a is its only arc
         bool found = false;
         for_each_arc(n, [&](i32 b) {
             if (b == a) return;
@@ -477,7 +511,8 @@ class Simplifier {
                 flags_[z(keep)] &= ~kCritical;
                 touched.assign(1, lower);
                 for_each_arc(L.end[0], [&](i32 b) {
-                    if (b != lower && arcs_[z(b)].end == L.end) touched.push_back(b);
+                    const auto& e = arcs_[z(b)].end;
+                    if (b != lower && e[0] == L.end[0] && e[1] == L.end[1]) touched.push_back(b);
                 });
             }
         }
@@ -509,6 +544,7 @@ class Simplifier {
         // node's new node (first -2 - the node that took it, for the absorbed ones).
         std::vector<std::array<i32, 2>> kept;  // {old node, internal index} by new id
         for (std::size_t n = 0; n < nn; ++n) {
+            if (n + kAhead < nn) __builtin_prefetch(&code[z(at_[n + kAhead])]);
             i32& c = code[z(at_[n])];
             if (c != kNone) {
                 at_[n] = -2 - c;
@@ -550,6 +586,11 @@ class Simplifier {
         out.node_vertices.resize(g_.node_vertices.size());
         out.vertex_nodes.resize(g_.vertex_nodes.size());
         for (std::size_t n = 0; n < nn; ++n) {
+            if (n + kAhead < nn) {
+                const i32 i = g_.node_vertex_offsets[n + kAhead];
+                if (i < g_.node_vertex_offsets[n + kAhead + 1])
+                    __builtin_prefetch(&out.vertex_nodes[z(g_.node_vertices[z(i)])], 1);
+            }
             const i32 nid = at_[n];
             for (i32 i = g_.node_vertex_offsets[n]; i < g_.node_vertex_offsets[n + 1]; ++i) {
                 const i32 v = g_.node_vertices[z(i)];
