@@ -1,11 +1,12 @@
 // Critical-node cancellation on a Reeb graph (docs/reeb.md). The graph is copied into a
-// mutable form laid out for few cache misses: critical nodes first (value, area, arc count and
-// their arcs' run in an arena, in one record), then the regular nodes in the order of the
-// arcs' lists, so that each list starts out contiguous; regular nodes in doubly linked lists
-// (one per arc, sorted by value); absorbed nodes forwarding to the node that took them.
-// Candidates wait in a priority queue keyed by (persistence, arc id), each arc at most once
-// (an arc that stops being a candidate leaves it, one whose key changes moves); a popped arc
-// is checked again before it is cancelled.
+// mutable form laid out for few cache misses: nodes renumbered, critical nodes first (one
+// 64-byte record each: value, area, arc counts and its arcs, up to 8 in the record, more in
+// a run of a shared arena), then the regular nodes in the order of the arcs' lists, so that
+// each list starts out contiguous; regular nodes in doubly linked lists (one per arc, sorted
+// by value); absorbed nodes forwarding to the node that took them. Candidates wait in a
+// priority queue (a 4-ary heap) keyed by (persistence, arc id), each arc at most once: an arc
+// that stops being a candidate leaves it, one whose key changes moves; a popped arc is
+// checked again before it is cancelled.
 
 #include "terrain/reeb/simplify.hpp"
 
@@ -206,9 +207,11 @@ class Simplifier {
         }
         i32 offset = 0;
         for (Crit& c : crit_) {
-            c.offset = offset;
-            c.room = c.size;
-            offset += c.size;
+            if (c.size > kInline) {
+                c.offset = offset;
+                c.room = c.size;
+                offset += c.size;
+            }
             c.size = 0;
         }
         arena_.resize(z(offset));
@@ -218,7 +221,7 @@ class Simplifier {
                 for (const i32 e : arcs_[a + kAhead].end) __builtin_prefetch(&crit_[z(e)], 1);
             for (const i32 e : arc.end) {
                 Crit& c = crit_[z(e)];
-                arena_[z(c.offset + c.size++)] = static_cast<i32>(a);
+                run(c)[c.size++] = static_cast<i32>(a);
             }
             for (i32 p = g.arc_offsets[a]; p < g.arc_offsets[a + 1]; ++p) {
                 const i32 r = placed[z(p)] ? first_ + p : at_[z(g.arc_nodes[z(p)])];
@@ -256,12 +259,15 @@ class Simplifier {
   private:
     // A critical node (one of the first first_): its record and its arcs, the newest last in
     // arena_[offset, offset + size), with room for `room` there.
-    struct Crit {
+    static constexpr i32 kInline = 8;
+    struct alignas(64) Crit {
         double area = 0;  // its vertices' and its absorbed nodes' area
         float value = 0;
         i32 forward = kNone;  // the node that absorbed it
-        i32 offset = 0, size = 0, room = 0;
-        i32 down = 0;  // its arcs whose upper end it is
+        i32 size = 0, room = kInline;
+        i32 down = 0;                    // its arcs whose upper end it is
+        i32 offset = 0;                  // its run in arena_ when room > kInline
+        std::array<i32, kInline> own{};  // its run while room == kInline
     };
     struct Reg {
         double area = 0;
@@ -290,11 +296,17 @@ class Simplifier {
     i32& prev(i32 n) { return n < first_ ? link_[z(n)][0] : reg_[z(n - first_)].prev; }
     i32& next(i32 n) { return n < first_ ? link_[z(n)][1] : reg_[z(n - first_)].next; }
 
+    // A critical node's arcs, the newest last: in its record while they fit, else in the arena.
+    i32* run(Crit& c) { return c.room == kInline ? c.own.data() : arena_.data() + c.offset; }
+    const i32* run(const Crit& c) const {
+        return c.room == kInline ? c.own.data() : arena_.data() + c.offset;
+    }
     // The arcs at a critical node, newest first.
     template <class F>
     void for_each_arc(i32 n, F&& f) const {
         const Crit& c = crit_[z(n)];
-        for (i32 i = c.offset + c.size - 1; i >= c.offset; --i) f(arena_[z(i)]);
+        const i32* r = run(c);
+        for (i32 i = c.size - 1; i >= 0; --i) f(r[i]);
     }
     void arcs_at(i32 n, std::vector<i32>& out) const {
         out.clear();
@@ -305,12 +317,12 @@ class Simplifier {
         Crit& c = crit_[z(n)];
         if (c.size == c.room) {
             const i32 offset = static_cast<i32>(arena_.size());
-            c.room = std::max(4, 2 * c.room);
-            arena_.resize(arena_.size() + z(c.room));
-            std::copy_n(arena_.begin() + c.offset, c.size, arena_.begin() + offset);
+            arena_.resize(arena_.size() + 2 * z(c.room));
+            std::copy_n(run(c), c.size, arena_.data() + offset);
             c.offset = offset;
+            c.room *= 2;
         }
-        arena_[z(c.offset + c.size++)] = a;
+        run(c)[c.size++] = a;
     }
     // Arc a leaves node n (the newest of its entries there, for an arc with both ends at n).
     void unlink(i32 a, i32 n) {
@@ -319,8 +331,8 @@ class Simplifier {
             c.size = 0;
             return;
         }
-        const auto first = arena_.begin() + c.offset, last = first + c.size;
-        auto it = last - 1;
+        i32* const last = run(c) + c.size;
+        i32* it = last - 1;
         while (*it != a) --it;
         for (; it + 1 != last; ++it) *it = *(it + 1);
         --c.size;
