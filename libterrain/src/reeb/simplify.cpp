@@ -521,8 +521,11 @@ class Simplifier {
                 link(lower, q);
                 k.down = 0;
                 flags_[z(keep)] &= ~kCritical;
+                // The arcs parallel to the merged one, found at its end with fewer arcs (the
+                // one multi() will look at too).
                 touched.assign(1, lower);
-                for_each_arc(L.end[0], [&](i32 b) {
+                const i32 m = degree(L.end[0]) <= degree(L.end[1]) ? L.end[0] : L.end[1];
+                for_each_arc(m, [&](i32 b) {
                     const auto& e = arcs_[z(b)].end;
                     if (b != lower && e[0] == L.end[0] && e[1] == L.end[1]) touched.push_back(b);
                 });
