@@ -243,11 +243,13 @@ class Simplifier {
         std::size_t done = 0;
         while (!heap_.empty()) {
             const i32 a = static_cast<i32>(heap_.pop() & 0xffffffffu);
-            if (!heap_.empty())  // the next arc, fetched while this one is handled
-                __builtin_prefetch(&arcs_[static_cast<std::uint32_t>(heap_.top())]);
+            // The next arc is fetched while this one is handled, and its ends after that.
+            const std::size_t next = heap_.empty() ? z(a) : static_cast<std::uint32_t>(heap_.top());
+            __builtin_prefetch(&arcs_[next]);
             queued_[z(a)] = 0;
             if (!candidate(a)) continue;
             cancel(a, result);
+            for (const i32 e : arcs_[next].end) __builtin_prefetch(&crit_[z(e)]);
             if ((++done & 0xfff) == 0 && initial > 0)
                 report_progress(progress, std::min(0.9, 0.9 * done / static_cast<double>(initial)),
                                 "simplify");
