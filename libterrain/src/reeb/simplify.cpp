@@ -238,7 +238,11 @@ class Simplifier {
     }
 
     void run(const ProgressFn& progress, SimplifyResult& result) {
-        for (std::size_t a = 0; a < arcs_.size(); ++a) consider(static_cast<i32>(a));
+        for (std::size_t a = 0; a < arcs_.size(); ++a) {
+            if (a + kAhead < arcs_.size())
+                for (const i32 e : arcs_[a + kAhead].end) __builtin_prefetch(&crit_[z(e)]);
+            consider(static_cast<i32>(a));
+        }
         const std::size_t initial = pushed_;
         std::size_t done = 0;
         while (!heap_.empty()) {
