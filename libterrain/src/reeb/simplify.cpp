@@ -263,8 +263,8 @@ class Simplifier {
     }
 
   private:
-    // A critical node (one of the first first_): its record and its arcs, the newest last in
-    // arena_[offset, offset + size), with room for `room` there.
+    // A critical node (one of the first first_), in one cache line: its fields and its `size`
+    // arcs, the newest last, with room for `room` (see run()).
     static constexpr i32 kInline = 8;
     struct alignas(64) Crit {
         double area = 0;  // its vertices' and its absorbed nodes' area
@@ -275,6 +275,7 @@ class Simplifier {
         i32 offset = 0;                  // its run in arena_ when room > kInline
         std::array<i32, kInline> own{};  // its run while room == kInline
     };
+    static_assert(sizeof(Crit) == 64);
     struct Reg {
         double area = 0;
         float value = 0;
