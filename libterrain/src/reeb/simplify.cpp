@@ -1,16 +1,19 @@
 // Critical-node cancellation on a Reeb graph (docs/reeb.md). The graph is copied into a
-// mutable form: each node's arcs in a linked list of arc ends, regular nodes in doubly linked
-// lists (one per arc, sorted by value), absorbed nodes forwarding to the node that took them.
-// Candidates wait in a min-heap keyed by (persistence, arc id) with lazy deletion: each arc
-// remembers the key of its live entry, entries with another key are stale and skipped, and a
-// popped arc is checked again before it is cancelled.
+// mutable form laid out for few cache misses: nodes renumbered, critical nodes first (one
+// 64-byte record each: value, area, arc counts and its arcs, up to 8 in the record, more in
+// a run of a shared arena), then the regular nodes in the order of the arcs' lists, so that
+// each list starts out contiguous; regular nodes in doubly linked lists (one per arc, sorted
+// by value); absorbed nodes forwarding to the node that took them. Candidates wait in a
+// priority queue (a 4-ary heap) keyed by (persistence, arc id), each arc at most once: an arc
+// that stops being a candidate leaves it, one whose key changes moves; a popped arc is
+// checked again before it is cancelled.
 
 #include "terrain/reeb/simplify.hpp"
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cmath>
-#include <queue>
 #include <string>
 
 #include "../core/indices.hpp"
@@ -24,53 +27,96 @@ using detail::i32;
 using detail::kNone;
 using detail::z;
 
-// The arcs at each node as doubly linked lists of arc ends (slot 2a and 2a+1 of arc a), so
-// that moving an arc end from one node to another allocates nothing.
-class Incidence {
+// Passes that gather from or scatter to random places start fetching them this many steps
+// ahead.
+constexpr std::size_t kAhead = 16;
+
+// The queued arcs in a 4-ary min-heap of their keys (an arc's id is its key's low half), each
+// arc at most once: re-keying an arc moves its entry instead of leaving a stale one behind.
+class ArcQueue {
   public:
-    void init(std::size_t nodes, std::size_t arcs) {
-        head_.assign(nodes, kNone);
-        degree_.assign(nodes, 0);
-        next_.assign(2 * arcs, kNone);
-        prev_.assign(2 * arcs, kNone);
-        owner_.assign(2 * arcs, kNone);
+    void init(std::size_t arcs) { at_.assign(arcs, kNone); }
+    bool empty() const { return heap_.empty(); }
+    std::uint64_t top() const { return heap_.front(); }
+    // Queues arc `key & 0xffffffff` with this key, or moves it there.
+    void set(std::uint64_t key) {
+        const std::size_t a = arc(key);
+        if (at_[a] == kNone) {
+            heap_.push_back(key);
+            up(heap_.size() - 1, key);
+        } else if (key < heap_[z(at_[a])]) {
+            up(z(at_[a]), key);
+        } else {
+            down(z(at_[a]), key);
+        }
     }
-    void link(i32 slot, i32 node) {
-        owner_[z(slot)] = node;
-        prev_[z(slot)] = kNone;
-        next_[z(slot)] = head_[z(node)];
-        if (head_[z(node)] != kNone) prev_[z(head_[z(node)])] = slot;
-        head_[z(node)] = slot;
-        ++degree_[z(node)];
-    }
-    void unlink(i32 slot) {
-        const i32 node = owner_[z(slot)], p = prev_[z(slot)], n = next_[z(slot)];
-        if (p != kNone)
-            next_[z(p)] = n;
+    void erase(i32 a) {
+        const i32 i = at_[z(a)];
+        if (i == kNone) return;
+        at_[z(a)] = kNone;
+        const std::uint64_t last = heap_.back();
+        heap_.pop_back();
+        if (z(i) == heap_.size()) return;
+        if (last < heap_[z(i)])
+            up(z(i), last);
         else
-            head_[z(node)] = n;
-        if (n != kNone) prev_[z(n)] = p;
-        --degree_[z(node)];
-        owner_[z(slot)] = kNone;
+            down(z(i), last);
     }
-    void move(i32 slot, i32 node) {
-        unlink(slot);
-        link(slot, node);
-    }
-    // The slot of arc a's end at node n.
-    i32 slot(i32 a, i32 n) const { return owner_[z(2 * a)] == n ? 2 * a : 2 * a + 1; }
-    i32 degree(i32 n) const { return degree_[z(n)]; }
-    template <class F>
-    void for_each(i32 n, F&& f) const {
-        for (i32 sl = head_[z(n)]; sl != kNone; sl = next_[z(sl)]) f(sl / 2);
-    }
-    void arcs(i32 n, std::vector<i32>& out) const {
-        out.clear();
-        for_each(n, [&](i32 a) { out.push_back(a); });
+    // The root's hole goes down to a leaf along the smaller children, and the last entry
+    // comes up from there (it mostly belongs near the leaves).
+    std::uint64_t pop() {
+        const std::uint64_t key = heap_.front(), last = heap_.back();
+        at_[arc(key)] = kNone;
+        heap_.pop_back();
+        const std::size_t n = heap_.size();
+        if (n == 0) return key;
+        std::size_t i = 0;
+        for (;;) {
+            const std::size_t c = 4 * i + 1;
+            if (c >= n) break;
+            std::size_t m = c;
+            for (std::size_t j = c + 1; j < std::min(c + 4, n); ++j)
+                if (heap_[j] < heap_[m]) m = j;
+            place(i, heap_[m]);
+            i = m;
+        }
+        up(i, last);
+        return key;
     }
 
   private:
-    std::vector<i32> head_, degree_, next_, prev_, owner_;
+    static std::size_t arc(std::uint64_t key) { return static_cast<std::uint32_t>(key); }
+    void place(std::size_t i, std::uint64_t key) {
+        heap_[i] = key;
+        at_[arc(key)] = static_cast<i32>(i);
+    }
+    // Puts `key` at slot i or above (below) it, moving the entries in its way.
+    void up(std::size_t i, std::uint64_t key) {
+        while (i > 0) {
+            const std::size_t parent = (i - 1) / 4;
+            if (heap_[parent] <= key) break;
+            place(i, heap_[parent]);
+            i = parent;
+        }
+        place(i, key);
+    }
+    void down(std::size_t i, std::uint64_t key) {
+        const std::size_t n = heap_.size();
+        for (;;) {
+            const std::size_t c = 4 * i + 1;
+            if (c >= n) break;
+            std::size_t m = c;
+            for (std::size_t j = c + 1; j < std::min(c + 4, n); ++j)
+                if (heap_[j] < heap_[m]) m = j;
+            if (key <= heap_[m]) break;
+            place(i, heap_[m]);
+            i = m;
+        }
+        place(i, key);
+    }
+
+    std::vector<std::uint64_t> heap_;
+    std::vector<i32> at_;  // each arc's slot in heap_, kNone when not queued
 };
 
 std::vector<double> node_areas(const TriangleMesh& mesh, const ReebGraph& g) {
@@ -80,55 +126,134 @@ std::vector<double> node_areas(const TriangleMesh& mesh, const ReebGraph& g) {
     return area;
 }
 
+// The summed area of node n's vertices, added in increasing vertex order (as a sweep over
+// the vertices would add them).
+double node_area(const TriangleMesh& mesh, const ReebGraph& g, std::size_t n,
+                 std::vector<i32>& scratch) {
+    const i32* v = g.node_vertices.data() + g.node_vertex_offsets[n];
+    const std::size_t count = z(g.node_vertex_offsets[n + 1] - g.node_vertex_offsets[n]);
+    if (!std::is_sorted(v, v + count)) {
+        scratch.assign(v, v + count);
+        std::sort(scratch.begin(), scratch.end());
+        v = scratch.data();
+    }
+    double s = 0;
+    for (std::size_t i = 0; i < count; ++i)
+        s += mesh.vertex_areas.empty() ? 1.0 : mesh.vertex_areas[z(v[i])];
+    return s;
+}
+
+// Nodes are numbered anew: first the nodes that are in no arc's list (the critical ones, the
+// only possible arc ends), in their order, then the listed regular nodes in the order of
+// arc_nodes.
 class Simplifier {
   public:
     Simplifier(const TriangleMesh& mesh, const ReebGraph& g, const SimplifyOptions& options)
         : g_(g), options_(options) {
-        const std::size_t nn = g.node_count(), na = g.arc_count();
-        value_ = g.node_values;
-        area_ = node_areas(mesh, g);
+        const std::size_t nn = g.node_count(), na = g.arc_count(), nl = g.arc_nodes.size();
+        // at_[n]: arc ends marked, the other regular nodes of the lists by their position in
+        // arc_nodes (`placed` says which positions hold their node); then the new numbers.
+        constexpr i32 kEnd = -2;
+        at_.assign(nn, kNone);
+        for (const auto& e : g.arcs) at_[z(e[0])] = at_[z(e[1])] = kEnd;
+        std::vector<char> placed(nl, 0);
+        for (std::size_t p = 0; p < nl; ++p) {
+            const i32 r = g.arc_nodes[p];
+            if (at_[z(r)] != kNone || g.node_kinds[z(r)] != NodeKind::regular) continue;
+            at_[z(r)] = static_cast<i32>(p);
+            placed[p] = 1;
+        }
+        first_ = 0;
+        for (const i32 i : at_) first_ += i < 0;
+        crit_.resize(z(first_));
+        link_.resize(z(first_));
+        flags_.resize(z(first_));
+        reg_.resize(nl);
         total_area_ = 0;
-        for (const double a : area_) total_area_ += a;
+        std::vector<i32> scratch;
+        i32 k = 0;
+        for (std::size_t n = 0; n < nn; ++n) {
+            if (n + kAhead < nn) {
+                const std::size_t m = n + kAhead;
+                const i32 i = g.node_vertex_offsets[m];
+                if (!mesh.vertex_areas.empty() && i < g.node_vertex_offsets[m + 1])
+                    __builtin_prefetch(&mesh.vertex_areas[z(g.node_vertices[z(i)])]);
+                if (at_[m] >= 0) __builtin_prefetch(&reg_[z(at_[m])], 1);
+            }
+            const double area = node_area(mesh, g, n, scratch);
+            total_area_ += area;
+            if (at_[n] < 0) {
+                crit_[z(k)].area = area;
+                crit_[z(k)].value = g.node_values[n];
+                flags_[z(k)] = g.node_kinds[n] != NodeKind::regular ? kCritical : 0;
+                at_[n] = k++;
+            } else {
+                reg_[z(at_[n])].area = area;
+                reg_[z(at_[n])].value = g.node_values[n];
+                at_[n] += first_;
+            }
+        }
         if (total_area_ <= 0) total_area_ = 1;
-        forward_.assign(nn, kNone);
-        critical_.resize(nn);
-        modified_.assign(nn, 0);
-        for (std::size_t n = 0; n < nn; ++n) critical_[n] = g.node_kinds[n] != NodeKind::regular;
-        prev_.assign(nn, kNone);
-        next_.assign(nn, kNone);
-        inc_.init(nn, na);
-        down_.assign(nn, 0);
+        // Arc a joins its lower then its upper end, a in order (as linking one by one would).
         arcs_.resize(na);
+        queued_.assign(na, 0);
+        heap_.init(na);
         for (std::size_t a = 0; a < na; ++a) {
             Arc& arc = arcs_[a];
-            arc.end = g.arcs[a];
-            inc_.link(static_cast<i32>(2 * a), arc.end[0]);
-            inc_.link(static_cast<i32>(2 * a + 1), arc.end[1]);
-            ++down_[z(arc.end[1])];
-            for (i32 i = g.arc_offsets[a]; i < g.arc_offsets[a + 1]; ++i) {
-                const i32 r = g.arc_nodes[z(i)];
-                if (arc.tail == kNone)
+            arc.end = {at_[z(g.arcs[a][0])], at_[z(g.arcs[a][1])]};
+            ++crit_[z(arc.end[0])].size;
+            ++crit_[z(arc.end[1])].size;
+            ++crit_[z(arc.end[1])].down;
+        }
+        i32 offset = 0;
+        for (Crit& c : crit_) {
+            if (c.size > kInline) {
+                c.offset = offset;
+                c.room = c.size;
+                offset += c.size;
+            }
+            c.size = 0;
+        }
+        arena_.resize(z(offset));
+        for (std::size_t a = 0; a < na; ++a) {
+            Arc& arc = arcs_[a];
+            if (a + kAhead < na)
+                for (const i32 e : arcs_[a + kAhead].end) __builtin_prefetch(&crit_[z(e)], 1);
+            for (const i32 e : arc.end) {
+                Crit& c = crit_[z(e)];
+                run(c)[c.size++] = static_cast<i32>(a);
+            }
+            for (i32 p = g.arc_offsets[a]; p < g.arc_offsets[a + 1]; ++p) {
+                const i32 r = placed[z(p)] ? first_ + p : at_[z(g.arc_nodes[z(p)])];
+                if (arc.tail == kNone) {
                     arc.head = r;
-                else
-                    next_[z(arc.tail)] = r, prev_[z(r)] = arc.tail;
+                } else {
+                    next(arc.tail) = r;
+                    prev(r) = arc.tail;
+                }
                 arc.tail = r;
-                arc.area += area_[z(r)];
+                arc.area += area(r);
             }
         }
     }
 
     void run(const ProgressFn& progress, SimplifyResult& result) {
-        for (std::size_t a = 0; a < arcs_.size(); ++a) consider(static_cast<i32>(a));
-        const std::size_t initial = heap_.size();
+        for (std::size_t a = 0; a < arcs_.size(); ++a) {
+            if (a + kAhead < arcs_.size())
+                for (const i32 e : arcs_[a + kAhead].end) __builtin_prefetch(&crit_[z(e)]);
+            consider(static_cast<i32>(a));
+        }
+        const std::size_t initial = pushed_;
         std::size_t done = 0;
         while (!heap_.empty()) {
-            const std::uint64_t key = heap_.top();
-            heap_.pop();
-            const i32 a = static_cast<i32>(key & 0xffffffffu);
-            if (arcs_[z(a)].queued != key) continue;
-            arcs_[z(a)].queued = 0;
+            const i32 a = static_cast<i32>(heap_.pop() & 0xffffffffu);
+            // The next arc is fetched while this one is handled, and its ends after that.
+            const std::size_t next = heap_.empty() ? z(a) : static_cast<std::uint32_t>(heap_.top());
+            __builtin_prefetch(&arcs_[next]);
+            queued_[z(a)] = 0;
             if (!candidate(a)) continue;
             cancel(a, result);
+            for (const i32 e : arcs_[next].end) __builtin_prefetch(&crit_[z(e)]);
             if ((++done & 0xfff) == 0 && initial > 0)
                 report_progress(progress, std::min(0.9, 0.9 * done / static_cast<double>(initial)),
                                 "simplify");
@@ -138,43 +263,110 @@ class Simplifier {
     }
 
   private:
+    // A critical node (one of the first first_), in one cache line: its fields and its `size`
+    // arcs, the newest last, with room for `room` (see run()).
+    static constexpr i32 kInline = 8;
+    struct alignas(64) Crit {
+        double area = 0;  // its vertices' and its absorbed nodes' area
+        float value = 0;
+        i32 forward = kNone;  // the node that absorbed it
+        i32 size = 0, room = kInline;
+        i32 down = 0;                    // its arcs whose upper end it is
+        i32 offset = 0;                  // its run in arena_ when room > kInline
+        std::array<i32, kInline> own{};  // its run while room == kInline
+    };
+    static_assert(sizeof(Crit) == 64);
+    struct Reg {
+        double area = 0;
+        float value = 0;
+        i32 forward = kNone;
+        i32 prev = kNone, next = kNone;  // its neighbours in its arc's list
+    };
     struct Arc {
         std::array<i32, 2> end{kNone, kNone};  // {lower, upper}
         i32 head = kNone, tail = kNone;        // regular nodes, lower to upper
         double area = 0;                       // area of the regular nodes' vertices
-        std::uint64_t queued = 0;              // key of its live heap entry, 0 when none
         bool alive = true;
     };
+    static constexpr char kCritical = 1, kModified = 2;
     // Heap key: the persistence's order-preserving bits, then the arc id (ties by id).
     static std::uint64_t key_of(float persistence, i32 a) {
         return (std::uint64_t{std::bit_cast<std::uint32_t>(persistence)} << 32) |
                static_cast<std::uint32_t>(a);
     }
 
-    // Arcs below and above a node: its arcs ending there as the upper / lower end.
-    i32 down(i32 n) const { return down_[z(n)]; }
-    i32 up(i32 n) const { return inc_.degree(n) - down_[z(n)]; }
-    void recount(i32 n) {
-        i32 d = 0;
-        inc_.for_each(n, [&](i32 a) { d += arcs_[z(a)].end[1] == n; });
-        down_[z(n)] = d;
+    // Any node's fields (critical nodes keep their list neighbours in link_, used once they
+    // become regular).
+    double& area(i32 n) { return n < first_ ? crit_[z(n)].area : reg_[z(n - first_)].area; }
+    float value(i32 n) const { return n < first_ ? crit_[z(n)].value : reg_[z(n - first_)].value; }
+    i32& forward(i32 n) { return n < first_ ? crit_[z(n)].forward : reg_[z(n - first_)].forward; }
+    i32& prev(i32 n) { return n < first_ ? link_[z(n)][0] : reg_[z(n - first_)].prev; }
+    i32& next(i32 n) { return n < first_ ? link_[z(n)][1] : reg_[z(n - first_)].next; }
+
+    // A critical node's arcs, the newest last: in its record while they fit, else in the arena.
+    i32* run(Crit& c) { return c.room == kInline ? c.own.data() : arena_.data() + c.offset; }
+    const i32* run(const Crit& c) const {
+        return c.room == kInline ? c.own.data() : arena_.data() + c.offset;
     }
+    // The arcs at a critical node, newest first.
+    template <class F>
+    void for_each_arc(i32 n, F&& f) const {
+        const Crit& c = crit_[z(n)];
+        const i32* r = run(c);
+        for (i32 i = c.size - 1; i >= 0; --i) f(r[i]);
+    }
+    void arcs_at(i32 n, std::vector<i32>& out) const {
+        out.clear();
+        for_each_arc(n, [&](i32 a) { out.push_back(a); });
+    }
+    // Arc a joins node n; a full run moves to the arena's end with twice the room.
+    void link(i32 a, i32 n) {
+        Crit& c = crit_[z(n)];
+        if (c.size == c.room) {
+            const i32 offset = static_cast<i32>(arena_.size());
+            arena_.resize(arena_.size() + 2 * z(c.room));
+            std::copy_n(run(c), c.size, arena_.data() + offset);
+            c.offset = offset;
+            c.room *= 2;
+        }
+        run(c)[c.size++] = a;
+    }
+    // Arc a leaves node n (the newest of its entries there, for an arc with both ends at n).
+    void unlink(i32 a, i32 n) {
+        Crit& c = crit_[z(n)];
+        if (c.size == 1) {  // its only arc
+            c.size = 0;
+            return;
+        }
+        i32* const last = run(c) + c.size;
+        i32* it = last - 1;
+        while (*it != a) --it;
+        for (; it + 1 != last; ++it) *it = *(it + 1);
+        --c.size;
+    }
+
+    // Arcs below and above a critical node: its arcs ending there as the upper / lower end
+    // (`down` is updated wherever an arc end moves or an arc turns around).
+    i32 degree(i32 n) const { return crit_[z(n)].size; }
+    i32 down(i32 n) const { return crit_[z(n)].down; }
+    i32 up(i32 n) const { return crit_[z(n)].size - crit_[z(n)].down; }
     bool extremum(i32 n) const { return down(n) == 0 || up(n) == 0; }
     float persistence(i32 a) const {
         const Arc& arc = arcs_[z(a)];
-        return std::fabs(value_[z(arc.end[1])] - value_[z(arc.end[0])]);
+        return std::fabs(crit_[z(arc.end[1])].value - crit_[z(arc.end[0])].value);
     }
     double area_ratio(i32 a) const {
         const Arc& arc = arcs_[z(a)];
         double s = arc.area;
-        for (const i32 n : arc.end) s += area_[z(n)] / static_cast<double>(inc_.degree(n));
+        for (const i32 n : arc.end) s += crit_[z(n)].area / static_cast<double>(degree(n));
         return s / total_area_;
     }
     bool multi(i32 a) const {
         const Arc& arc = arcs_[z(a)];
-        const i32 n = inc_.degree(arc.end[0]) <= inc_.degree(arc.end[1]) ? arc.end[0] : arc.end[1];
+        const i32 n = degree(arc.end[0]) <= degree(arc.end[1]) ? arc.end[0] : arc.end[1];
+        if (degree(n) == 1) return false;  // a is its only arc
         bool found = false;
-        inc_.for_each(n, [&](i32 b) {
+        for_each_arc(n, [&](i32 b) {
             if (b == a) return;
             const auto& e = arcs_[z(b)].end;
             found |= (e[0] == arc.end[0] && e[1] == arc.end[1]) ||
@@ -189,27 +381,29 @@ class Simplifier {
         if (multi(a)) return false;
         return persistence(a) < options_.persistence || area_ratio(a) < options_.area_ratio / 100.0;
     }
-    // (Re)queues arc a if it is a candidate; a queued entry with the same key is kept.
+    // Queues arc a with its current key if it is a candidate, else takes it out of the
+    // queue. (queued_ is 0 when the arc is not queued, so that an arc 0 of persistence 0
+    // stays out of the queue unless it was queued before.)
     void consider(i32 a) {
-        Arc& arc = arcs_[z(a)];
+        std::uint64_t& queued = queued_[z(a)];
         if (!candidate(a)) {
-            arc.queued = 0;
+            queued = 0;
+            heap_.erase(a);
             return;
         }
         const std::uint64_t key = key_of(persistence(a), a);
-        if (arc.queued == key) return;
-        arc.queued = key;
-        heap_.push(key);
+        if (queued == key) return;
+        queued = key;
+        heap_.set(key);
+        ++pushed_;
     }
-
-    // Node n's vertices (and everything already forwarded to it) join `keep`.
+    // Node n's vertices (and everything already forwarded to it) join the critical node keep.
     void absorb(i32 n, i32 keep) {
-        forward_[z(n)] = keep;
-        area_[z(keep)] += area_[z(n)];
-        critical_[z(n)] = false;
+        forward(n) = keep;
+        crit_[z(keep)].area += area(n);
     }
     void absorb_list(Arc& arc, i32 keep) {
-        for (i32 r = arc.head; r != kNone; r = next_[z(r)]) absorb(r, keep);
+        for (i32 r = arc.head; r != kNone; r = next(r)) absorb(r, keep);
         arc.head = arc.tail = kNone;
         arc.area = 0;
     }
@@ -218,37 +412,39 @@ class Simplifier {
     // value range join keep, and the ends swap if the other end is now on the wrong side.
     void fit_arc(i32 b, i32 keep) {
         Arc& arc = arcs_[z(b)];
-        const float fk = value_[z(keep)];
+        const float fk = crit_[z(keep)].value;
         if (arc.end[1] == keep) {
-            while (arc.tail != kNone && value_[z(arc.tail)] > fk) {
+            while (arc.tail != kNone && value(arc.tail) > fk) {
                 const i32 r = arc.tail;
-                arc.tail = prev_[z(r)];
+                arc.tail = prev(r);
                 if (arc.tail == kNone)
                     arc.head = kNone;
                 else
-                    next_[z(arc.tail)] = kNone;
-                arc.area -= area_[z(r)];
+                    next(arc.tail) = kNone;
+                arc.area -= area(r);
                 absorb(r, keep);
             }
-            if (value_[z(arc.end[0])] > fk) {
+            if (crit_[z(arc.end[0])].value > fk) {
                 absorb_list(arc, keep);
-                ++down_[z(arc.end[0])];
+                ++crit_[z(arc.end[0])].down;
+                --crit_[z(keep)].down;
                 std::swap(arc.end[0], arc.end[1]);
             }
         } else {
-            while (arc.head != kNone && value_[z(arc.head)] < fk) {
+            while (arc.head != kNone && value(arc.head) < fk) {
                 const i32 r = arc.head;
-                arc.head = next_[z(r)];
+                arc.head = next(r);
                 if (arc.head == kNone)
                     arc.tail = kNone;
                 else
-                    prev_[z(arc.head)] = kNone;
-                arc.area -= area_[z(r)];
+                    prev(arc.head) = kNone;
+                arc.area -= area(r);
                 absorb(r, keep);
             }
-            if (value_[z(arc.end[1])] < fk) {
+            if (crit_[z(arc.end[1])].value < fk) {
                 absorb_list(arc, keep);
-                --down_[z(arc.end[1])];
+                --crit_[z(arc.end[1])].down;
+                ++crit_[z(keep)].down;
                 std::swap(arc.end[0], arc.end[1]);
             }
         }
@@ -261,77 +457,84 @@ class Simplifier {
         const bool lo_ext = down(lo) == 0, hi_ext = up(hi) == 0;
         i32 keep, gone;
         const i32 keep0 = lo_ext && hi_ext ? lo : (lo_ext ? hi : lo);
-        const double share_before = area_[z(keep0)] / static_cast<double>(inc_.degree(keep0));
+        const double share_before = crit_[z(keep0)].area / static_cast<double>(degree(keep0));
         const bool ext_before = extremum(keep0);
         if (lo_ext && hi_ext) {
             keep = lo;
             gone = hi;
-            value_[z(keep)] = 0.5f * (value_[z(lo)] + value_[z(hi)]);
+            crit_[z(keep)].value = 0.5f * (crit_[z(lo)].value + crit_[z(hi)].value);
             ++result.extremum_extremum;
         } else {
             keep = lo_ext ? hi : lo;
             gone = lo_ext ? lo : hi;
             ++result.saddle_extremum;
         }
-        modified_[z(keep)] = 1;
+        Crit& k = crit_[z(keep)];
+        flags_[z(keep)] |= kModified;
         arc.alive = false;
-        inc_.unlink(2 * a);
-        inc_.unlink(2 * a + 1);
-        --down_[z(hi)];
+        unlink(a, lo);
+        unlink(a, hi);
+        --crit_[z(hi)].down;
         absorb_list(arc, keep);
         absorb(gone, keep);
         std::vector<i32>& touched = touched_;
-        inc_.arcs(gone, touched);
+        arcs_at(gone, touched);
+        crit_[z(gone)].size = 0;
+        crit_[z(gone)].down = 0;
         for (const i32 b : touched) {
             Arc& other = arcs_[z(b)];
-            inc_.move(inc_.slot(b, gone), keep);
+            link(b, keep);
             for (auto& e : other.end)
                 if (e == gone) e = keep;
+            k.down += other.end[1] == keep;
         }
-        down_[z(gone)] = 0;
         if (lo_ext && hi_ext) {
-            inc_.arcs(keep, all_);
+            arcs_at(keep, all_);
             for (const i32 b : all_) fit_arc(b, keep);
         } else {
             for (const i32 b : touched) fit_arc(b, keep);
         }
-        recount(keep);
         // keep's other arcs need a new look only if they may have become candidates: its
         // value moved, it became an extremum, or its area share per arc went down. Arcs that
         // stopped being candidates are dropped when they reach the top of the heap.
         const double share_after =
-            inc_.degree(keep) == 0 ? 0.0 : area_[z(keep)] / static_cast<double>(inc_.degree(keep));
+            degree(keep) == 0 ? 0.0 : k.area / static_cast<double>(degree(keep));
         if ((lo_ext && hi_ext) || extremum(keep) != ext_before || share_after < share_before)
-            inc_.arcs(keep, touched);
+            arcs_at(keep, touched);
 
         // A node left with one arc below and one above becomes regular: its arcs merge.
-        if (inc_.degree(keep) == 2 && down(keep) == 1 && up(keep) == 1) {
-            inc_.arcs(keep, all_);
+        if (degree(keep) == 2 && down(keep) == 1 && up(keep) == 1) {
+            arcs_at(keep, all_);
             i32 lower = all_[0], upper = all_[1];
             if (arcs_[z(lower)].end[1] != keep) std::swap(lower, upper);
             Arc& L = arcs_[z(lower)];
             Arc& U = arcs_[z(upper)];
             if (L.end[0] != U.end[1]) {
-                prev_[z(keep)] = L.tail;
-                next_[z(keep)] = U.head;
+                prev(keep) = L.tail;
+                next(keep) = U.head;
                 if (L.tail == kNone)
                     L.head = keep;
                 else
-                    next_[z(L.tail)] = keep;
-                if (U.head != kNone) prev_[z(U.head)] = keep;
+                    next(L.tail) = keep;
+                if (U.head != kNone) prev(U.head) = keep;
                 L.tail = U.tail == kNone ? keep : U.tail;
-                L.area += area_[z(keep)] + U.area;
+                L.area += k.area + U.area;
                 const i32 q = U.end[1];
                 L.end[1] = q;
                 U.alive = false;
-                inc_.unlink(inc_.slot(upper, q));
-                inc_.unlink(inc_.slot(upper, keep));
-                inc_.move(inc_.slot(lower, keep), q);
-                down_[z(keep)] = 0;
-                critical_[z(keep)] = false;
+                unlink(upper, q);
+                unlink(upper, keep);
+                unlink(lower, keep);
+                link(lower, q);
+                k.down = 0;
+                flags_[z(keep)] &= ~kCritical;
+                // The arcs parallel to the merged one, found at its end with fewer arcs (the
+                // one multi() will look at too).
                 touched.assign(1, lower);
-                inc_.for_each(L.end[0], [&](i32 b) {
-                    if (b != lower && arcs_[z(b)].end == L.end) touched.push_back(b);
+                const i32 m = degree(L.end[0]) <= degree(L.end[1]) ? L.end[0] : L.end[1];
+                for_each_arc(m, [&](i32 b) {
+                    const auto& e = arcs_[z(b)].end;
+                    if (b != lower && e[0] == L.end[0] && e[1] == L.end[1]) touched.push_back(b);
                 });
             }
         }
@@ -339,71 +542,97 @@ class Simplifier {
     }
 
     void output(SimplifyResult& result) {
-        const std::size_t nn = g_.node_count();
-        auto root = [&](i32 n) {
-            i32 r = n;
-            while (forward_[z(r)] != kNone) r = forward_[z(r)];
-            while (forward_[z(n)] != kNone) {
-                const i32 nx = forward_[z(n)];
-                forward_[z(n)] = r;
+        const std::size_t nn = g_.node_count(), nl = reg_.size();
+        // code[i]: for an absorbed node, the critical node that finally took it (nodes are
+        // only absorbed into critical nodes); for a remaining node, -2 - its new id.
+        std::vector<i32> code(z(first_) + nl);
+        for (std::size_t k = 0; k < z(first_); ++k) code[k] = crit_[k].forward;
+        for (std::size_t k = 0; k < z(first_); ++k) {
+            i32 r = code[k];
+            if (r == kNone) continue;
+            while (code[z(r)] != kNone) r = code[z(r)];
+            for (i32 n = code[k]; n != r;) {
+                const i32 nx = code[z(n)];
+                code[z(n)] = r;
                 n = nx;
             }
-            return r;
-        };
-        std::vector<i32> new_id(nn, kNone);
-        i32 count = 0;
-        for (std::size_t n = 0; n < nn; ++n)
-            if (forward_[n] == kNone) new_id[n] = count++;
-        ReebGraph& out = result.graph;
-        out.node_values.resize(z(count));
-        out.node_kinds.assign(z(count), NodeKind::regular);
-        out.node_lower_links.assign(z(count), 1);
-        out.node_upper_links.assign(z(count), 1);
-        out.node_arcs.assign(z(count), kNone);
-        // Vertices: grouped by new node, in the order of their old nodes.
-        std::vector<i32> size(z(count) + 1, 0);
-        std::vector<i32> old_root(nn);
-        for (std::size_t n = 0; n < nn; ++n) {
-            old_root[n] = new_id[z(root(static_cast<i32>(n)))];
-            size[z(old_root[n]) + 1] += g_.node_vertex_offsets[n + 1] - g_.node_vertex_offsets[n];
+            code[k] = r;
         }
+        for (std::size_t p = 0; p < nl; ++p) {
+            const i32 f = reg_[p].forward;
+            code[z(first_) + p] = f == kNone || code[z(f)] == kNone ? f : code[z(f)];
+        }
+        // The remaining nodes are numbered in the order of the old ones; at_ takes each old
+        // node's new node (first -2 - the node that took it, for the absorbed ones).
+        std::vector<std::array<i32, 2>> kept;  // {old node, internal index} by new id
+        for (std::size_t n = 0; n < nn; ++n) {
+            if (n + kAhead < nn) __builtin_prefetch(&code[z(at_[n + kAhead])]);
+            i32& c = code[z(at_[n])];
+            if (c != kNone) {
+                at_[n] = -2 - c;
+                continue;
+            }
+            c = -2 - static_cast<i32>(kept.size());
+            kept.push_back({static_cast<i32>(n), at_[n]});
+            at_[n] = -2 - c;
+        }
+        const std::size_t count = kept.size();
+        std::vector<i32> size(count + 1, 0);
+        for (std::size_t n = 0; n < nn; ++n) {
+            if (at_[n] < 0) at_[n] = -2 - code[z(-2 - at_[n])];
+            size[z(at_[n]) + 1] += g_.node_vertex_offsets[n + 1] - g_.node_vertex_offsets[n];
+        }
+        ReebGraph& out = result.graph;
+        out.node_values.resize(count);
+        out.node_kinds.assign(count, NodeKind::regular);
+        out.node_lower_links.assign(count, 1);
+        out.node_upper_links.assign(count, 1);
+        out.node_arcs.assign(count, kNone);
+        for (std::size_t nid = 0; nid < count; ++nid) {
+            const auto [n, i] = kept[nid];
+            out.node_values[nid] = value(i);
+            if (i >= first_ || !(flags_[z(i)] & kCritical)) continue;
+            const i32 d = down(i), u = up(i);
+            out.node_kinds[nid] = d == 0   ? NodeKind::minimum
+                                  : u == 0 ? NodeKind::maximum
+                                           : NodeKind::saddle;
+            const bool unchanged = !(flags_[z(i)] & kModified);
+            out.node_lower_links[nid] =
+                unchanged ? g_.node_lower_links[z(n)] : static_cast<std::uint8_t>(std::min(d, 255));
+            out.node_upper_links[nid] =
+                unchanged ? g_.node_upper_links[z(n)] : static_cast<std::uint8_t>(std::min(u, 255));
+        }
+        // Vertices: grouped by new node, in the order of their old nodes.
         for (std::size_t i = 1; i < size.size(); ++i) size[i] += size[i - 1];
         out.node_vertex_offsets = size;
         out.node_vertices.resize(g_.node_vertices.size());
         out.vertex_nodes.resize(g_.vertex_nodes.size());
-        result.field.resize(g_.vertex_nodes.size());
         for (std::size_t n = 0; n < nn; ++n) {
-            const i32 nid = old_root[n];
+            if (n + kAhead < nn) {
+                const i32 i = g_.node_vertex_offsets[n + kAhead];
+                if (i < g_.node_vertex_offsets[n + kAhead + 1])
+                    __builtin_prefetch(&out.vertex_nodes[z(g_.node_vertices[z(i)])], 1);
+            }
+            const i32 nid = at_[n];
             for (i32 i = g_.node_vertex_offsets[n]; i < g_.node_vertex_offsets[n + 1]; ++i) {
                 const i32 v = g_.node_vertices[z(i)];
                 out.node_vertices[z(size[z(nid)]++)] = v;
                 out.vertex_nodes[z(v)] = nid;
             }
         }
-        for (std::size_t n = 0; n < nn; ++n) {
-            if (new_id[n] == kNone) continue;
-            out.node_values[z(new_id[n])] = value_[n];
-            if (!critical_[n]) continue;
-            const i32 d = down(static_cast<i32>(n)), u = up(static_cast<i32>(n));
-            out.node_kinds[z(new_id[n])] = d == 0   ? NodeKind::minimum
-                                           : u == 0 ? NodeKind::maximum
-                                                    : NodeKind::saddle;
-            const bool unchanged = !modified_[n];
-            out.node_lower_links[z(new_id[n])] =
-                unchanged ? g_.node_lower_links[n] : static_cast<std::uint8_t>(std::min(d, 255));
-            out.node_upper_links[z(new_id[n])] =
-                unchanged ? g_.node_upper_links[n] : static_cast<std::uint8_t>(std::min(u, 255));
-        }
+        result.field.resize(g_.vertex_nodes.size());
         for (std::size_t v = 0; v < result.field.size(); ++v)
             result.field[v] = out.node_values[z(out.vertex_nodes[v])];
+        const auto new_id = [&](i32 i) { return -2 - code[z(i)]; };
         out.arc_offsets.assign(1, 0);
         for (const Arc& arc : arcs_) {
             if (!arc.alive) continue;
             const i32 id = static_cast<i32>(out.arcs.size());
-            out.arcs.push_back({new_id[z(arc.end[0])], new_id[z(arc.end[1])]});
-            for (i32 r = arc.head; r != kNone; r = next_[z(r)]) {
-                out.arc_nodes.push_back(new_id[z(r)]);
-                out.node_arcs[z(new_id[z(r)])] = id;
+            out.arcs.push_back({new_id(arc.end[0]), new_id(arc.end[1])});
+            for (i32 r = arc.head; r != kNone; r = next(r)) {
+                const i32 nid = new_id(r);
+                out.arc_nodes.push_back(nid);
+                out.node_arcs[z(nid)] = id;
             }
             out.arc_offsets.push_back(static_cast<i32>(out.arc_nodes.size()));
         }
@@ -411,15 +640,19 @@ class Simplifier {
 
     const ReebGraph& g_;
     SimplifyOptions options_;
-    std::vector<float> value_;
-    std::vector<double> area_;
+    std::vector<i32> at_;  // each node's new number
+    i32 first_ = 0;        // critical nodes: 0 .. first_ - 1
+    std::vector<Crit> crit_;
+    std::vector<std::array<i32, 2>> link_;  // prev and next of critical nodes
+    std::vector<char> flags_;               // kCritical, kModified, of critical nodes
+    std::vector<Reg> reg_;                  // node first_ + i is reg_[i]
+    std::vector<i32> arena_;
     double total_area_ = 0;
-    std::vector<i32> forward_, prev_, next_, down_;
-    std::vector<char> critical_, modified_;
-    Incidence inc_;
     std::vector<i32> touched_, all_;
     std::vector<Arc> arcs_;
-    std::priority_queue<std::uint64_t, std::vector<std::uint64_t>, std::greater<>> heap_;
+    std::vector<std::uint64_t> queued_;  // key of each queued arc, 0 for the others
+    ArcQueue heap_;
+    std::size_t pushed_ = 0;
 };
 
 }  // namespace
