@@ -454,31 +454,40 @@ std::vector<LinkReps> link_components(const TriangleMesh& mesh, const ReebGraph&
                                       std::vector<char>& general) {
     const std::size_t nv = mesh.vertex_count(), nn = g.node_count();
     const auto& node = g.vertex_nodes;
+    // starts[0..1]: lower runs' first vertices, starts[2..3]: upper runs'; runs[0], runs[1]:
+    // how many lower and upper runs were seen.
     struct Star {
-        std::array<i32, 2> lower_starts, upper_starts;
-        std::uint8_t triangles, lower_edges, upper_edges, lower_runs, upper_runs;
+        std::array<i32, 4> starts;
+        std::uint8_t triangles, lower_edges, upper_edges;
+        std::array<std::uint8_t, 2> runs;
     };
-    std::vector<Star> stars(nv, Star{{kNone, kNone}, {kNone, kNone}, 0, 0, 0, 0, 0});
+    std::vector<Star> stars(nv, Star{{kNone, kNone, kNone, kNone}, 0, 0, 0, {0, 0}});
     for (const auto& t : mesh.triangles) {
-        const i32 n0 = node[z(t[0])], n1 = node[z(t[1])], n2 = node[z(t[2])];
-        // Corner v of node n sees the link step a -> b (counter-clockwise round v).
-        auto add = [&](i32 v, i32 n, i32 a, i32 b) {
-            Star& s = stars[z(v)];
-            ++s.triangles;
-            s.lower_edges += (n > a) & (n > b);
-            s.upper_edges += (n < a) & (n < b);
-            // Without branches: the steps' directions are unpredictable.
-            const bool down = (a > n) & (b < n), up = (a < n) & (b > n);
-            i32& ls = s.lower_starts[s.lower_runs & 1];
-            ls = down ? b : ls;
-            s.lower_runs += down;
-            i32& us = s.upper_starts[s.upper_runs & 1];
-            us = up ? b : us;
-            s.upper_runs += up;
-        };
-        add(t[0], n0, n1, n2);
-        add(t[1], n1, n2, n0);
-        add(t[2], n2, n0, n1);
+        const std::array<i32, 3> n{node[z(t[0])], node[z(t[1])], node[z(t[2])]};
+        for (const i32 c : t) ++stars[z(c)].triangles;
+        if (n[0] != n[1] && n[1] != n[2] && n[0] != n[2]) {
+            // The highest corner sees a lower link edge, the lowest an upper one; going round
+            // the middle corner counter-clockwise, the step a -> b crosses its value: b starts
+            // a lower run when a is above, an upper run when a is below. No branches: the
+            // orders are unpredictable.
+            const int hi = n[0] > n[1] ? (n[0] > n[2] ? 0 : 2) : (n[1] > n[2] ? 1 : 2);
+            const int lo = n[0] < n[1] ? (n[0] < n[2] ? 0 : 2) : (n[1] < n[2] ? 1 : 2);
+            const int mid = 3 - hi - lo, a = mid == 2 ? 0 : mid + 1, b = 3 - mid - a;
+            ++stars[z(t[z(hi)])].lower_edges;
+            ++stars[z(t[z(lo)])].upper_edges;
+            Star& s = stars[z(t[z(mid)])];
+            const int side = n[z(a)] > n[z(mid)] ? 0 : 1;
+            s.starts[z(2 * side + (s.runs[z(side)] & 1))] = n[z(b)];
+            ++s.runs[z(side)];
+            continue;
+        }
+        // Two corners in one node (a plateau): the third sees an edge of its lower or upper
+        // link; the plateau's corners see an edge touching their node, which does not count.
+        for (int k = 0; k < 3; ++k) {
+            const i32 m = n[z(k)], p = n[z((k + 1) % 3)], q = n[z((k + 2) % 3)];
+            stars[z(t[z(k)])].lower_edges += (m > p) & (m > q);
+            stars[z(t[z(k)])].upper_edges += (m < p) & (m < q);
+        }
     }
     std::vector<LinkReps> reps(nn);
     general.assign(nn, 0);
@@ -513,8 +522,8 @@ std::vector<LinkReps> link_components(const TriangleMesh& mesh, const ReebGraph&
             if (count == 2 && runs == 2) return starts;
             return std::array<i32, 2>{kSeveral, kNone};
         };
-        reps[z(n)] = {side(lower, some_below, s.lower_runs, s.lower_starts),
-                      side(upper, some_above, s.upper_runs, s.upper_starts)};
+        reps[z(n)] = {side(lower, some_below, s.runs[0], {s.starts[0], s.starts[1]}),
+                      side(upper, some_above, s.runs[1], {s.starts[2], s.starts[3]})};
     }
     return reps;
 }
