@@ -7,10 +7,12 @@
 #include "support/test_meshes.hpp"
 #include "support/test_support.hpp"
 #include "terrain/core/error.hpp"
+#include "terrain/field/shape_index.hpp"
 #include "terrain/field/vertex_field.hpp"
 #include "terrain/io/read_dem.hpp"
 #include "terrain/mesh/dem_to_mesh.hpp"
 #include "terrain/reeb/simplify.hpp"
+#include "terrain/synth/crater_field.hpp"
 
 using namespace terrain;
 
@@ -105,6 +107,24 @@ TEST_CASE("The rewritten field rebuilds into the same critical nodes", "[simplif
     const auto noise = test::noise_field(torus.vertex_count(), 11);
     const auto r = simplified(torus, noise, 30, 5);
     CHECK(critical_nodes(reeb::build_reeb_graph(torus, r.field)) == critical_nodes(r.graph));
+}
+
+TEST_CASE("Arcs turned around elsewhere: their far nodes become regular or extrema", "[simplify]") {
+    // A cancellation moves the kept node's value; an arc of it whose far node is now on the
+    // other side turns around, and that far node may be left with one arc below and one
+    // above (it must become regular) or become an extremum (its arcs are new candidates).
+    // This 300x300 synthetic tile meets the first case at area ratio 0.5 %.
+    synth::VestaTileOptions options;
+    options.width = options.height = 300;
+    const Dem dem = synth::generate_vesta_tile(options);
+    const auto mesh = mesh::dem_to_mesh(dem);
+    const auto si = field::shape_index_field(mesh);
+    for (const auto& [p, a] :
+         std::vector<std::pair<double, double>>{{0, 0.1}, {0, 0.5}, {10, 0.1}, {10, 0.5}, {0, 2}}) {
+        INFO("persistence " << p << " area ratio " << a);
+        const auto r = simplified(mesh, si, p, a);  // checks the graph
+        CHECK(critical_nodes(reeb::build_reeb_graph(mesh, r.field)) == critical_nodes(r.graph));
+    }
 }
 
 TEST_CASE("Loops survive any thresholds", "[simplify]") {

@@ -14,6 +14,8 @@
 #include <array>
 #include <bit>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <string>
 
 #include "../core/indices.hpp"
@@ -196,7 +198,7 @@ class Simplifier {
         if (total_area_ <= 0) total_area_ = 1;
         // Arc a joins its lower then its upper end, a in order (as linking one by one would).
         arcs_.resize(na);
-        queued_.assign(na, 0);
+        queued_.assign(na, kNotQueued);
         heap_.init(na);
         for (std::size_t a = 0; a < na; ++a) {
             Arc& arc = arcs_[a];
@@ -250,9 +252,9 @@ class Simplifier {
             // The next arc is fetched while this one is handled, and its ends after that.
             const std::size_t next = heap_.empty() ? z(a) : static_cast<std::uint32_t>(heap_.top());
             __builtin_prefetch(&arcs_[next]);
-            queued_[z(a)] = 0;
+            queued_[z(a)] = kNotQueued;
             if (!candidate(a)) continue;
-            cancel(a, result);
+            cancel(redirect(a), result);
             for (const i32 e : arcs_[next].end) __builtin_prefetch(&crit_[z(e)]);
             if ((++done & 0xfff) == 0 && initial > 0)
                 report_progress(progress, std::min(0.9, 0.9 * done / static_cast<double>(initial)),
@@ -289,6 +291,7 @@ class Simplifier {
         bool alive = true;
     };
     static constexpr char kCritical = 1, kModified = 2;
+    static constexpr std::uint64_t kNotQueued = ~std::uint64_t{0};  // above any key
     // Heap key: the persistence's order-preserving bits, then the arc id (ties by id).
     static std::uint64_t key_of(float persistence, i32 a) {
         return (std::uint64_t{std::bit_cast<std::uint32_t>(persistence)} << 32) |
@@ -382,12 +385,11 @@ class Simplifier {
         return persistence(a) < options_.persistence || area_ratio(a) < options_.area_ratio / 100.0;
     }
     // Queues arc a with its current key if it is a candidate, else takes it out of the
-    // queue. (queued_ is 0 when the arc is not queued, so that an arc 0 of persistence 0
-    // stays out of the queue unless it was queued before.)
+    // queue.
     void consider(i32 a) {
         std::uint64_t& queued = queued_[z(a)];
         if (!candidate(a)) {
-            queued = 0;
+            queued = kNotQueued;
             heap_.erase(a);
             return;
         }
@@ -428,6 +430,7 @@ class Simplifier {
                 absorb_list(arc, keep);
                 ++crit_[z(arc.end[0])].down;
                 --crit_[z(keep)].down;
+                turned_.push_back(arc.end[0]);
                 std::swap(arc.end[0], arc.end[1]);
             }
         } else {
@@ -445,30 +448,100 @@ class Simplifier {
                 absorb_list(arc, keep);
                 --crit_[z(arc.end[1])].down;
                 ++crit_[z(keep)].down;
+                turned_.push_back(arc.end[1]);
                 std::swap(arc.end[0], arc.end[1]);
             }
         }
         if (arc.head == kNone) arc.area = 0;
     }
 
+    // A critical node left with one arc below and one above becomes regular: its arcs merge
+    // into the lower one (unless they would close on themselves). The merged arc and the arcs
+    // parallel to it go to `out`; returns whether n became regular.
+    bool regularize(i32 n, std::vector<i32>& out) {
+        if (degree(n) != 2 || down(n) != 1) return false;
+        arcs_at(n, all_);
+        i32 lower = all_[0], upper = all_[1];
+        if (arcs_[z(lower)].end[1] != n) std::swap(lower, upper);
+        Arc& L = arcs_[z(lower)];
+        Arc& U = arcs_[z(upper)];
+        if (L.end[0] == U.end[1]) return false;
+        Crit& k = crit_[z(n)];
+        prev(n) = L.tail;
+        next(n) = U.head;
+        if (L.tail == kNone)
+            L.head = n;
+        else
+            next(L.tail) = n;
+        if (U.head != kNone) prev(U.head) = n;
+        L.tail = U.tail == kNone ? n : U.tail;
+        L.area += k.area + U.area;
+        const i32 q = U.end[1];
+        L.end[1] = q;
+        U.alive = false;
+        unlink(upper, q);
+        unlink(upper, n);
+        unlink(lower, n);
+        link(lower, q);
+        k.down = 0;
+        flags_[z(n)] &= ~kCritical;
+        // The arcs parallel to the merged one, found at its end with fewer arcs (the one
+        // multi() will look at too).
+        out.push_back(lower);
+        const i32 m = degree(L.end[0]) <= degree(L.end[1]) ? L.end[0] : L.end[1];
+        for_each_arc(m, [&](i32 b) {
+            const auto& e = arcs_[z(b)].end;
+            if (b != lower && e[0] == L.end[0] && e[1] == L.end[1]) out.push_back(b);
+        });
+        return true;
+    }
+
+    // The arc to cancel for candidate a. A degenerate extremum (several arcs) paired with a
+    // saddle while another saddle next to it lies closer in value goes to the closer one:
+    // keeping the farther one would turn the closer one's arc around, and flattening the
+    // extremum to the farther value would cut across the closer saddle's branches (the
+    // rewritten field would then disagree with the graph).
+    i32 redirect(i32 a) const {
+        const Arc& arc = arcs_[z(a)];
+        const i32 lo = arc.end[0], hi = arc.end[1];
+        const bool lo_ext = down(lo) == 0, hi_ext = up(hi) == 0;
+        if (lo_ext == hi_ext) return a;  // two extrema: their own rules
+        const i32 ext = lo_ext ? lo : hi;
+        if (degree(ext) < 2) return a;
+        const float fe = crit_[z(ext)].value;
+        i32 best = a;
+        float best_gap = std::fabs(crit_[z(lo_ext ? hi : lo)].value - fe);
+        for_each_arc(ext, [&](i32 b) {
+            const auto& e = arcs_[z(b)].end;
+            const i32 other = e[0] == ext ? e[1] : e[0];
+            const float gap = std::fabs(crit_[z(other)].value - fe);
+            if (gap < best_gap && !extremum(other) && !multi(b)) {
+                best = b;
+                best_gap = gap;
+            }
+        });
+        return best;
+    }
+
     void cancel(i32 a, SimplifyResult& result) {
+        turned_.clear();
         Arc& arc = arcs_[z(a)];
         const i32 lo = arc.end[0], hi = arc.end[1];
         const bool lo_ext = down(lo) == 0, hi_ext = up(hi) == 0;
-        i32 keep, gone;
-        const i32 keep0 = lo_ext && hi_ext ? lo : (lo_ext ? hi : lo);
-        const double share_before = crit_[z(keep0)].area / static_cast<double>(degree(keep0));
-        const bool ext_before = extremum(keep0);
-        if (lo_ext && hi_ext) {
-            keep = lo;
-            gone = hi;
-            crit_[z(keep)].value = 0.5f * (crit_[z(lo)].value + crit_[z(hi)].value);
-            ++result.extremum_extremum;
-        } else {
-            keep = lo_ext ? hi : lo;
-            gone = lo_ext ? lo : hi;
-            ++result.saddle_extremum;
-        }
+        // Two extrema: they meet at the midpoint of their values, unless one of them has no
+        // other arc and the other has more (a degenerate extremum, also a saddle): then the
+        // first is absorbed into the second, which keeps its value, as a saddle would. The
+        // midpoint there would move the degenerate extremum and turn its other arcs around,
+        // and the rewritten field would no longer match the graph.
+        const bool both = lo_ext && hi_ext;
+        const bool midpoint = both && (degree(lo) == 1) == (degree(hi) == 1);
+        i32 keep = lo;  // the midpoint, or a saddle (or degenerate extremum) below
+        if (!midpoint && (both ? degree(lo) == 1 : lo_ext)) keep = hi;
+        const i32 gone = keep == lo ? hi : lo;
+        const double share_before = crit_[z(keep)].area / static_cast<double>(degree(keep));
+        const bool ext_before = extremum(keep);
+        if (midpoint) crit_[z(keep)].value = 0.5f * (crit_[z(lo)].value + crit_[z(hi)].value);
+        ++(both ? result.extremum_extremum : result.saddle_extremum);
         Crit& k = crit_[z(keep)];
         flags_[z(keep)] |= kModified;
         arc.alive = false;
@@ -488,7 +561,7 @@ class Simplifier {
                 if (e == gone) e = keep;
             k.down += other.end[1] == keep;
         }
-        if (lo_ext && hi_ext) {
+        if (midpoint) {
             arcs_at(keep, all_);
             for (const i32 b : all_) fit_arc(b, keep);
         } else {
@@ -499,43 +572,21 @@ class Simplifier {
         // stopped being candidates are dropped when they reach the top of the heap.
         const double share_after =
             degree(keep) == 0 ? 0.0 : k.area / static_cast<double>(degree(keep));
-        if ((lo_ext && hi_ext) || extremum(keep) != ext_before || share_after < share_before)
+        if (midpoint || extremum(keep) != ext_before || share_after < share_before)
             arcs_at(keep, touched);
 
-        // A node left with one arc below and one above becomes regular: its arcs merge.
-        if (degree(keep) == 2 && down(keep) == 1 && up(keep) == 1) {
-            arcs_at(keep, all_);
-            i32 lower = all_[0], upper = all_[1];
-            if (arcs_[z(lower)].end[1] != keep) std::swap(lower, upper);
-            Arc& L = arcs_[z(lower)];
-            Arc& U = arcs_[z(upper)];
-            if (L.end[0] != U.end[1]) {
-                prev(keep) = L.tail;
-                next(keep) = U.head;
-                if (L.tail == kNone)
-                    L.head = keep;
-                else
-                    next(L.tail) = keep;
-                if (U.head != kNone) prev(U.head) = keep;
-                L.tail = U.tail == kNone ? keep : U.tail;
-                L.area += k.area + U.area;
-                const i32 q = U.end[1];
-                L.end[1] = q;
-                U.alive = false;
-                unlink(upper, q);
-                unlink(upper, keep);
-                unlink(lower, keep);
-                link(lower, q);
-                k.down = 0;
-                flags_[z(keep)] &= ~kCritical;
-                // The arcs parallel to the merged one, found at its end with fewer arcs (the
-                // one multi() will look at too).
-                touched.assign(1, lower);
-                const i32 m = degree(L.end[0]) <= degree(L.end[1]) ? L.end[0] : L.end[1];
-                for_each_arc(m, [&](i32 b) {
-                    const auto& e = arcs_[z(b)].end;
-                    if (b != lower && e[0] == L.end[0] && e[1] == L.end[1]) touched.push_back(b);
-                });
+        merged_.clear();
+        if (regularize(keep, merged_)) touched.swap(merged_);
+        // An arc turned around moves one arc end at its far node from above to below or back:
+        // that node may now be regular, or an extremum whose arcs are new candidates.
+        for (const i32 n : turned_) {
+            if (degree(n) == 0) continue;
+            flags_[z(n)] |= kModified;
+            merged_.clear();
+            if (regularize(n, merged_)) {
+                touched.insert(touched.end(), merged_.begin(), merged_.end());
+            } else {
+                for_each_arc(n, [&](i32 b) { touched.push_back(b); });
             }
         }
         for (const i32 b : touched) consider(b);
@@ -648,9 +699,10 @@ class Simplifier {
     std::vector<Reg> reg_;                  // node first_ + i is reg_[i]
     std::vector<i32> arena_;
     double total_area_ = 0;
-    std::vector<i32> touched_, all_;
+    std::vector<i32> touched_, all_, merged_;
+    std::vector<i32> turned_;  // far ends of the arcs fit_arc turned around
     std::vector<Arc> arcs_;
-    std::vector<std::uint64_t> queued_;  // key of each queued arc, 0 for the others
+    std::vector<std::uint64_t> queued_;  // key of each queued arc, kNotQueued for the others
     ArcQueue heap_;
     std::size_t pushed_ = 0;
 };
