@@ -77,27 +77,44 @@ void compute_reeb(SegmentJob& job, const ProgressFn& progress) {
     job.add_time("reeb", since(t0));
 }
 
-ScaleResult segment_scale(const SegmentJob& job, const SegmentOptionValues& values,
-                          const ProgressFn& progress) {
+namespace {
+
+// Regions grown on a simplified graph (cost auto: graph for DEMs, standard for meshes).
+ScaleResult grow_scale(const SegmentJob& job, const SegmentOptionValues& values,
+                       const reeb::SimplifyResult& simplified, double simplify_seconds,
+                       const ProgressFn& progress) {
     ScaleResult out;
-    auto t0 = clock::now();
-    const auto simplified = reeb::simplify(job.input.mesh, job.graph, values.simplify,
-                                           scaled_progress(progress, 0, 0.3));
     out.after = reeb::summarize(simplified.graph);
-    out.simplify_seconds = since(t0);
-    t0 = clock::now();
+    out.simplify_seconds = simplify_seconds;
+    const auto t0 = clock::now();
     segment::GrowOptions grow = values.grow;
     grow.cost = values.cost == "auto"
                     ? (job.input.dem ? segment::GrowCost::graph : segment::GrowCost::standard)
                     : segment::parse_grow_cost(values.cost);
-    out.segmentation = segment::grow_regions(job.input.mesh, simplified.graph, grow,
-                                             scaled_progress(progress, 0.3, 1));
+    out.segmentation = segment::grow_regions(job.input.mesh, simplified.graph, grow, progress);
     out.grow_seconds = since(t0);
     return out;
 }
 
+}  // namespace
+
+ScaleResult segment_scale(const SegmentJob& job, const SegmentOptionValues& values,
+                          const ProgressFn& progress) {
+    const auto t0 = clock::now();
+    const auto simplified = reeb::simplify(job.input.mesh, job.graph, values.simplify,
+                                           scaled_progress(progress, 0, 0.3));
+    return grow_scale(job, values, simplified, since(t0), scaled_progress(progress, 0.3, 1));
+}
+
 void segment_once(SegmentJob& job, const SegmentOptionValues& values, const ProgressFn& progress) {
-    auto result = segment_scale(job, values, progress);
+    // One scale only: the simplification takes the graph and frees what it no longer needs,
+    // which lowers the peak memory.
+    const auto t0 = clock::now();
+    const auto simplified = reeb::simplify(job.input.mesh, std::move(job.graph), values.simplify,
+                                           scaled_progress(progress, 0, 0.3));
+    const double seconds = since(t0);
+    job.graph = reeb::ReebGraph();
+    auto result = grow_scale(job, values, simplified, seconds, scaled_progress(progress, 0.3, 1));
     job.segmentation = std::move(result.segmentation);
     job.after = result.after;
     job.add_time("simplify", result.simplify_seconds);

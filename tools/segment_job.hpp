@@ -69,7 +69,8 @@ struct ScaleResult {
 // standard for meshes). Reads the job only, so scales can run side by side.
 ScaleResult segment_scale(const SegmentJob& job, const SegmentOptionValues& values,
                           const ProgressFn& progress = {});
-// segment_scale into the job (segmentation, after, timings).
+// segment_scale into the job (segmentation, after, timings); takes job.graph, which is
+// empty afterwards.
 void segment_once(SegmentJob& job, const SegmentOptionValues& values, const ProgressFn& progress);
 // Every output of one segmentation into `dir`; returns the file names written. With
 // `deferred_preview`, preview.png is only rendered, for write_deferred_preview.

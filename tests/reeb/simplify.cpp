@@ -168,6 +168,18 @@ TEST_CASE("Simplification is deterministic and leaves no candidate", "[simplify]
     const auto b = simplified(s.mesh, s.si, 10, 0.5);
     CHECK(a.field == b.field);
     CHECK(a.graph.arcs == b.graph.arcs);
+    // Handing the graph over (it is freed as soon as it is copied) changes nothing.
+    reeb::SimplifyOptions o;
+    o.persistence = 10;
+    o.area_ratio = 0.5;
+    auto taken = reeb::build_reeb_graph(s.mesh, s.si);
+    const auto c = reeb::simplify(s.mesh, std::move(taken), o);
+    CHECK(c.field == a.field);
+    CHECK(c.graph.arcs == a.graph.arcs);
+    CHECK(c.graph.arc_nodes == a.graph.arc_nodes);
+    CHECK(c.graph.node_vertices == a.graph.node_vertices);
+    CHECK(c.graph.node_lower_links == a.graph.node_lower_links);
+    CHECK(taken.arcs.empty());
     // No arc with an extremum end (and no parallel twin) is left below the thresholds.
     const auto m = reeb::arc_metrics(s.mesh, a.graph);
     const auto inc = reeb::node_arcs(a.graph);

@@ -19,6 +19,7 @@
 #include <string>
 
 #include "../core/indices.hpp"
+#include "../core/release.hpp"
 #include "terrain/core/error.hpp"
 
 namespace terrain::reeb {
@@ -38,6 +39,10 @@ constexpr std::size_t kAhead = 16;
 class ArcQueue {
   public:
     void init(std::size_t arcs) { at_.assign(arcs, kNone); }
+    void release() {
+        detail::release(at_);
+        detail::release(heap_);
+    }
     bool empty() const { return heap_.empty(); }
     std::uint64_t top() const { return heap_.front(); }
     // Queues arc `key & 0xffffffff` with this key, or moves it there.
@@ -260,6 +265,8 @@ class Simplifier {
                 report_progress(progress, std::min(0.9, 0.9 * done / static_cast<double>(initial)),
                                 "simplify");
         }
+        heap_.release();  // the output is the peak of memory: the queue is done
+        detail::release(queued_);
         output(result);
         report_progress(progress, 1.0, "simplify");
     }
@@ -744,6 +751,23 @@ SimplifyResult simplify(const TriangleMesh& mesh, const ReebGraph& graph,
         throw Error("simplify", "the graph was not built on this mesh");
     SimplifyResult result;
     Simplifier(mesh, graph, options).run(progress, result);
+    return result;
+}
+
+SimplifyResult simplify(const TriangleMesh& mesh, ReebGraph&& graph, const SimplifyOptions& options,
+                        const ProgressFn& progress) {
+    check_simplify_options(options);
+    if (graph.vertex_nodes.size() != mesh.vertex_count())
+        throw Error("simplify", "the graph was not built on this mesh");
+    SimplifyResult result;
+    Simplifier simplifier(mesh, graph, options);
+    // The working copy holds the arcs now; the output reads only the vertex lists and links.
+    detail::release(graph.arcs);
+    detail::release(graph.arc_offsets);
+    detail::release(graph.arc_nodes);
+    detail::release(graph.node_arcs);
+    detail::release(graph.node_kinds);
+    simplifier.run(progress, result);
     return result;
 }
 
