@@ -78,15 +78,7 @@ class ArcQueue {
         const std::size_t n = heap_.size();
         if (n == 0) return key;
         std::size_t i = 0;
-        for (;;) {
-            const std::size_t c = 4 * i + 1;
-            if (c >= n) break;
-            std::size_t m = c;
-            for (std::size_t j = c + 1; j < std::min(c + 4, n); ++j)
-                if (heap_[j] < heap_[m]) m = j;
-            place(i, heap_[m]);
-            i = m;
-        }
+        for (std::size_t m; (m = smallest_child(i)) != 0; i = m) place(i, heap_[m]);
         up(i, last);
         return key;
     }
@@ -108,18 +100,18 @@ class ArcQueue {
         place(i, key);
     }
     void down(std::size_t i, std::uint64_t key) {
-        const std::size_t n = heap_.size();
-        for (;;) {
-            const std::size_t c = 4 * i + 1;
-            if (c >= n) break;
-            std::size_t m = c;
-            for (std::size_t j = c + 1; j < std::min(c + 4, n); ++j)
-                if (heap_[j] < heap_[m]) m = j;
-            if (key <= heap_[m]) break;
+        for (std::size_t m; (m = smallest_child(i)) != 0 && heap_[m] < key; i = m)
             place(i, heap_[m]);
-            i = m;
-        }
         place(i, key);
+    }
+    // The slot of i's smallest child, 0 when it has none.
+    std::size_t smallest_child(std::size_t i) const {
+        const std::size_t c = 4 * i + 1, n = heap_.size();
+        if (c >= n) return 0;
+        std::size_t m = c;
+        for (std::size_t j = c + 1; j < std::min(c + 4, n); ++j)
+            if (heap_[j] < heap_[m]) m = j;
+        return m;
     }
 
     std::vector<std::uint64_t> heap_;
