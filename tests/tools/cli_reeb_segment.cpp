@@ -106,7 +106,7 @@ TEST_CASE("terrain segment writes every output, complete or not at all", "[cli][
     const long regions = counts.GetLong("regions");
     CHECK(counts.GetLong("vertices") == 4096);
     CHECK(counts.GetLong("faces") == 2 * 63 * 63);
-    CHECK(counts.GetLong("boundary_edges") == 4 * 63);  // the square's rim
+    CHECK(counts.GetLong("boundary_edges") == 4 * 63);   // the square's rim
     CHECK(counts.GetLong("euler_characteristic") == 1);  // a disk
     CHECK(regions >= 1);
     CHECK(run.GetRoot().GetObj("parameters").GetString("cost") == "graph");
@@ -211,7 +211,8 @@ TEST_CASE("terrain segment on a constant field, a mostly-NoData DEM and a mesh f
 TEST_CASE("OpenImageIO is loaded only to write images, from its module", "[cli][segment]") {
     const auto dir = terrain::test::scratch_dir("cli_image_module");
     const auto dem = vesta_crop(dir);
-    // The program alone, away from the build tree: no module where it looks.
+    // The program away from the build tree's bin layout still finds the module (the build
+    // directory is the last place it looks).
     const auto bin = dir / "moved" / "bin";
     fs::create_directories(bin);
     const auto program = bin / "terrain";
@@ -221,17 +222,28 @@ TEST_CASE("OpenImageIO is loaded only to write images, from its module", "[cli][
     fs::remove_all(out);
     auto r =
         terrain::test::run_program(program.string(), {"segment", dem, "-o", out.string(), "-q"});
+    INFO(r.err);
+    CHECK(r.status == 0);
+    CHECK(fs::file_size(out / "preview.png") > 1000);
+    // TERRAIN_OIIO_MODULE, when set, is the only place: a wrong path is one clear line, and
+    // nothing is written.
+    const auto missing = dir / "seg_missing";
+    fs::remove_all(missing);
+    r = terrain::test::run_program(program.string(), {"segment", dem, "-o", missing.string(), "-q"},
+                                   {"TERRAIN_OIIO_MODULE=" + (dir / "no_such_module.so").string()});
     CHECK(r.status == 1);
     CHECK(std::count(r.err.begin(), r.err.end(), '\n') == 1);
     CHECK_THAT(r.err,
                Contains("libterrain_oiio.so was not found") && Contains("TERRAIN_OIIO_MODULE"));
-    CHECK_FALSE(fs::exists(out));  // outputs complete or not at all
-    // Named by the environment, the module writes the preview.
-    r = terrain::test::run_program(program.string(), {"segment", dem, "-o", out.string(), "-q"},
+    CHECK_FALSE(fs::exists(missing));
+    // Named by the variable, the module writes the preview.
+    const auto named = dir / "seg_named";
+    fs::remove_all(named);
+    r = terrain::test::run_program(program.string(), {"segment", dem, "-o", named.string(), "-q"},
                                    {std::string("TERRAIN_OIIO_MODULE=") + TERRAIN_OIIO_MODULE});
     INFO(r.err);
     CHECK(r.status == 0);
-    CHECK(fs::file_size(out / "preview.png") > 1000);
+    CHECK(fs::file_size(named / "preview.png") > 1000);
     // Not a module: a clear error.
     r = terrain::test::run_program(program.string(),
                                    {"segment", dem, "-o", (dir / "seg2").string(), "-q"},

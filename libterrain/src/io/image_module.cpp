@@ -24,12 +24,15 @@ struct Module {
     std::string error;  // why it could not be loaded
 };
 
-// Places to look, in order: $TERRAIN_OIIO_MODULE; beside the executable as installed
-// (bin/../<libdir>/terrain) and as built (build/<dir>/../lib/terrain); the install directory.
+// Places to look: $TERRAIN_OIIO_MODULE alone when it is set; else, in order, beside the
+// executable as installed
+// (bin/../<libdir>/terrain) and as built (build/<dir>/../lib/terrain); the install directory;
+// the build directory (programs built deeper in the tree, such as the benchmarks).
 std::vector<std::string> candidates() {
     namespace fs = std::filesystem;
     std::vector<std::string> out;
-    if (const char* env = std::getenv("TERRAIN_OIIO_MODULE"); env && *env) out.push_back(env);
+    if (const char* env = std::getenv("TERRAIN_OIIO_MODULE"); env && *env)
+        return {env};  // set: the only place
     std::error_code ec;
     const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
     if (!ec) {
@@ -38,6 +41,7 @@ std::vector<std::string> candidates() {
         out.push_back((dir / ".." / "lib" / "terrain" / kModule).lexically_normal().string());
     }
     out.push_back((fs::path(TERRAIN_MODULE_INSTALL_DIR) / kModule).string());
+    out.push_back((fs::path(TERRAIN_MODULE_BUILD_DIR) / kModule).string());
     out.erase(std::unique(out.begin(), out.end()), out.end());
     return out;
 }
