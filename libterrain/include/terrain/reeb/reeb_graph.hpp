@@ -115,8 +115,10 @@ struct ReebOptions {
 // graph of any field on it is a tree.
 bool reeb_is_tree(const TriangleMesh& mesh);
 
-// The Reeb graph of `field` (one value per mesh vertex, no NaN) on a 2-manifold mesh. Both
-// algorithms give the same graph. Deterministic: ties between equal values that are not
+// The Reeb graph of `field` (one value per mesh vertex, no NaN) on a consistently oriented
+// 2-manifold mesh, as dem_to_mesh and read_mesh make them (the contour tree reads each
+// vertex's link in counter-clockwise order; the sweep checks the orientation and throws).
+// Both algorithms give the same graph. Deterministic: ties between equal values that are not
 // adjacent are broken by vertex index. Throws terrain::Error when the field has the wrong size
 // or NaN values, or when the contour tree is asked for on a mesh with loops.
 ReebGraph build_reeb_graph(const TriangleMesh& mesh, const std::vector<float>& field,
