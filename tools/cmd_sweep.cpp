@@ -141,7 +141,13 @@ int run_sweep(int argc, char** argv) {
             }
             io::write_label_stack(*dem, bands, descriptions, d + "labels.tif", false);
             files.push_back("labels.tif");
-            // The GeoPackage's layers one after the other, the GeoJSON files beside them.
+            // Each scale polygonized once; then the GeoPackage's layers one after the other,
+            // the GeoJSON files beside them.
+            std::vector<io::RegionPolygons> polygons(scales.size());
+            tbb::parallel_for(std::size_t{0}, scales.size(), [&](std::size_t i) {
+                polygons[i] =
+                    io::polygonize_regions(*dem, bands[i], scales[i].regions.regions.size());
+            });
             tbb::parallel_invoke(
                 [&] {
                     for (std::size_t i = 0; i < scales.size(); ++i) {
@@ -149,13 +155,13 @@ int run_sweep(int argc, char** argv) {
                         gpkg.driver = "GPKG";
                         gpkg.layer = "regions_" + scales[i].name;
                         gpkg.append_layer = true;
-                        io::write_region_polygons(*dem, bands[i], scales[i].regions,
+                        io::write_region_polygons(*dem, polygons[i], scales[i].regions,
                                                   d + "regions.gpkg", false, gpkg);
                     }
                 },
                 [&] {
                     tbb::parallel_for(std::size_t{0}, scales.size(), [&](std::size_t i) {
-                        io::write_region_polygons(*dem, bands[i], scales[i].regions,
+                        io::write_region_polygons(*dem, polygons[i], scales[i].regions,
                                                   d + "regions_" + scales[i].name + ".geojson",
                                                   false);
                     });

@@ -265,6 +265,23 @@ TEST_CASE("regions.gpkg keeps the DEM's full CRS, the same bytes every run",
         CHECK(e.path().filename() == "regions.gpkg");
     }
     CHECK(files == 1);
+    // Polygonized once, written twice: the same bytes as the direct writes, and the shared
+    // polygons are left as they were (GeoJSON moves its copy to lon/lat).
+    const auto shared = io::polygonize_regions(t.dem, t.pixels, t.graph.regions.size());
+    CHECK(shared.region_count() == t.graph.regions.size());
+    const auto direct_json = (dir / "direct.geojson").string();
+    io::write_region_polygons(t.dem, t.pixels, t.graph, direct_json, false);
+    const auto shared_json = (dir / "shared.geojson").string();
+    io::write_region_polygons(t.dem, shared, t.graph, shared_json, false);
+    CHECK(test::file_bytes(shared_json) == test::file_bytes(direct_json));
+    const auto shared_gpkg = (dir / "shared.gpkg").string();
+    io::write_region_polygons(t.dem, shared, t.graph, shared_gpkg, false, options);
+    CHECK(test::file_bytes(shared_gpkg) == first);
+    std::filesystem::remove(direct_json);
+    std::filesystem::remove(shared_json);
+    std::filesystem::remove(shared_gpkg);
+    const auto fewer = io::polygonize_regions(t.dem, t.pixels, t.graph.regions.size() - 1);
+    CHECK_THROWS_AS(io::write_region_polygons(t.dem, fewer, t.graph, shared_json, false), Error);
     // A shapefile: its .dbf header carries a fixed date (2000-01-01), not today's.
     options.driver = "ESRI Shapefile";
     const auto shp = (dir / "regions.shp").string();

@@ -199,14 +199,11 @@ std::vector<std::string> write_ogr(GDALDriver& driver, const std::string& temp,
     return files;
 }
 
-}  // namespace
-
-void write_region_polygons(const Dem& dem, const std::vector<std::uint32_t>& pixels,
-                           const segment::RegionGraph& graph, const std::string& path,
-                           bool overwrite, const RegionPolygonOptions& options) {
-    check_grid_size(dem, pixels.size());
+// The driver for `options` (nullptr for GeoJSON, written by hand), after the checks made
+// before any work: a vector driver that creates files, one layer for GeoJSON, the path.
+GDALDriver* polygon_driver(const std::string& path, bool overwrite,
+                           const RegionPolygonOptions& options) {
     ensure_gdal_registered();
-    const GdalErrorCapture errors;
     const bool geojson = options.driver == "GeoJSON";
     GDALDriver* driver = nullptr;
     if (!geojson) {
@@ -220,7 +217,15 @@ void write_region_polygons(const Dem& dem, const std::vector<std::uint32_t>& pix
     if (options.append_layer && geojson)
         throw Error("write", "GeoJSON holds one layer; use GPKG for one layer per scale");
     if (!options.append_layer || !std::filesystem::exists(path)) check_output_path(path, overwrite);
-    auto polygons = polygonize(dem, pixels, graph.regions.size(), errors);
+    return driver;
+}
+
+// Writes the polygons (taken: their rings are changed in place).
+void write_polygons(const Dem& dem, std::vector<Geometry> polygons,
+                    const segment::RegionGraph& graph, const std::string& path, bool overwrite,
+                    const RegionPolygonOptions& options, GDALDriver* driver,
+                    const GdalErrorCapture& errors) {
+    const bool geojson = driver == nullptr;
     std::optional<LonLatFrame> frame;
     if (!dem.crs_wkt.empty() && (geojson || options.lonlat)) frame.emplace(dem, "write");
     for (auto& g : polygons)
@@ -254,6 +259,55 @@ void write_region_polygons(const Dem& dem, const std::vector<std::uint32_t>& pix
         commit_dataset(output, files, overwrite);
         temporary.release();
     }
+}
+
+}  // namespace
+
+struct RegionPolygons::Impl {
+    std::vector<Geometry> geometries;  // by region id - 1; null for a region with no pixel
+};
+RegionPolygons::RegionPolygons() : impl_(std::make_unique<Impl>()) {}
+RegionPolygons::RegionPolygons(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+RegionPolygons::~RegionPolygons() = default;
+RegionPolygons::RegionPolygons(RegionPolygons&&) noexcept = default;
+RegionPolygons& RegionPolygons::operator=(RegionPolygons&&) noexcept = default;
+std::size_t RegionPolygons::region_count() const {
+    return impl_->geometries.size();
+}
+
+RegionPolygons polygonize_regions(const Dem& dem, const std::vector<std::uint32_t>& pixels,
+                                  std::size_t region_count) {
+    check_grid_size(dem, pixels.size());
+    ensure_gdal_registered();
+    const GdalErrorCapture errors;
+    auto impl = std::make_unique<RegionPolygons::Impl>();
+    impl->geometries = polygonize(dem, pixels, region_count, errors);
+    return RegionPolygons(std::move(impl));
+}
+
+void write_region_polygons(const Dem& dem, const std::vector<std::uint32_t>& pixels,
+                           const segment::RegionGraph& graph, const std::string& path,
+                           bool overwrite, const RegionPolygonOptions& options) {
+    check_grid_size(dem, pixels.size());
+    GDALDriver* driver = polygon_driver(path, overwrite, options);
+    const GdalErrorCapture errors;
+    write_polygons(dem, polygonize(dem, pixels, graph.regions.size(), errors), graph, path,
+                   overwrite, options, driver, errors);
+}
+
+void write_region_polygons(const Dem& dem, const RegionPolygons& polygons,
+                           const segment::RegionGraph& graph, const std::string& path,
+                           bool overwrite, const RegionPolygonOptions& options) {
+    if (polygons.region_count() != graph.regions.size())
+        throw Error("write", "the polygons were made for " +
+                                 std::to_string(polygons.region_count()) +
+                                 " regions, the graph has " + std::to_string(graph.regions.size()));
+    GDALDriver* driver = polygon_driver(path, overwrite, options);
+    const GdalErrorCapture errors;
+    std::vector<Geometry> copy;
+    copy.reserve(polygons.region_count());
+    for (const auto& g : polygons.impl().geometries) copy.emplace_back(g ? g->clone() : nullptr);
+    write_polygons(dem, std::move(copy), graph, path, overwrite, options, driver, errors);
 }
 
 }  // namespace terrain::io

@@ -8,6 +8,7 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -42,6 +43,33 @@ struct RegionPolygonOptions {
 // only at corners; null when it has no pixel) made with GDALPolygonize, with the region's
 // properties. A DEM without CRS gives its map (geotransform) coordinates.
 void write_region_polygons(const Dem& dem, const std::vector<std::uint32_t>& pixels,
+                           const segment::RegionGraph& graph, const std::string& path,
+                           bool overwrite, const RegionPolygonOptions& options = {});
+
+// The region polygons of one labelling (GDALPolygonize, in the DEM's map coordinates), made
+// once to be written to several files: terrain sweep writes each scale to a GeoPackage layer
+// and to GeoJSON. Writers copy what they change, so several may read one set at once.
+class RegionPolygons {
+  public:
+    RegionPolygons();
+    ~RegionPolygons();
+    RegionPolygons(RegionPolygons&&) noexcept;
+    RegionPolygons& operator=(RegionPolygons&&) noexcept;
+    std::size_t region_count() const;
+
+    struct Impl;
+    const Impl& impl() const { return *impl_; }
+
+  private:
+    explicit RegionPolygons(std::unique_ptr<Impl> impl);
+    std::unique_ptr<Impl> impl_;
+    friend RegionPolygons polygonize_regions(const Dem&, const std::vector<std::uint32_t>&,
+                                             std::size_t);
+};
+RegionPolygons polygonize_regions(const Dem& dem, const std::vector<std::uint32_t>& pixels,
+                                  std::size_t region_count);
+// write_region_polygons from polygons made before (for the labelling the graph describes).
+void write_region_polygons(const Dem& dem, const RegionPolygons& polygons,
                            const segment::RegionGraph& graph, const std::string& path,
                            bool overwrite, const RegionPolygonOptions& options = {});
 
