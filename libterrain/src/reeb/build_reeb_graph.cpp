@@ -309,10 +309,9 @@ void order_events(const TriangleMesh& mesh, const std::vector<float>& field, Ree
     }
     detail::release(tied);
     const bool any_plateau = !rep.empty();
-    if (any_plateau)
+    if (any_plateau) {
         for (std::size_t v = 0; v < nv; ++v) rep[v] = root(static_cast<i32>(v));
-    // Equal values: plateaus together, ordered by their lowest vertex.
-    if (any_plateau)
+        // Equal values: plateaus together, ordered by their lowest vertex.
         for (std::size_t i = 0; i < nv;) {
             std::size_t j = i + 1;
             while (j < nv && same_value(keys[i], keys[j])) ++j;
@@ -325,6 +324,7 @@ void order_events(const TriangleMesh& mesh, const std::vector<float>& field, Ree
                           });
             i = j;
         }
+    }
     auto same_event = [&](std::uint64_t a, std::uint64_t b) {
         return any_plateau && same_value(a, b) && rep[z(vertex(a))] == rep[z(vertex(b))];
     };
@@ -611,6 +611,18 @@ bool contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& prog
         // are fetched early (and, from those, their parents').
         constexpr std::size_t kAhead = 16;
         auto prefetch = [&](i32 x) { __builtin_prefetch(&uf[z(x >= 0 && z(x) < nn ? x : 0)]); };
+        // Component c (a root) joins the component of event e whose root is cur, by rank (the
+        // higher rank has the lower `up`); returns the new root.
+        auto join = [&](i32 cur, i32 c, i32 e) {
+            parent[z(uf[z(c)].head)] = e;
+            ++kids[z(e)][side];
+            const bool cur_higher = uf[z(cur)].up <= uf[z(c)].up;
+            const i32 hi = cur_higher ? cur : c, lo = cur_higher ? c : cur;
+            if (uf[z(hi)].up == uf[z(lo)].up) --uf[z(hi)].up;
+            uf[z(lo)].up = hi;
+            uf[z(hi)].head = e;
+            return hi;
+        };
         std::vector<i32> roots;
         for (std::size_t k = 0; k < nn; ++k) {
             if (k + kAhead < nn) {
@@ -636,15 +648,7 @@ bool contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& prog
                 root.up -= root.up == -1;  // rank 0 -> 1
                 if (rep[1] < 0) continue;
                 const i32 o = find_short(rep[1]);
-                if (o == c) continue;
-                // A second component joins here.
-                parent[z(uf[z(o)].head)] = e;
-                kids[z(e)][side] = 2;
-                const bool c_higher = uf[z(c)].up <= uf[z(o)].up;
-                const i32 hi = c_higher ? c : o, lo = c_higher ? o : c;
-                if (uf[z(hi)].up == uf[z(lo)].up) --uf[z(hi)].up;
-                uf[z(lo)].up = hi;
-                uf[z(hi)].head = e;
+                if (o != c) join(c, o, e);  // a second component joins here
                 continue;
             }
             uf[z(e)] = {-1, e};
@@ -662,16 +666,7 @@ bool contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& prog
                 }
             }
             i32 cur = e;
-            for (const i32 c : roots) {
-                parent[z(uf[z(c)].head)] = e;
-                ++kids[z(e)][side];
-                i32 r = cur, o = c;
-                if (uf[z(r)].up > uf[z(o)].up) std::swap(r, o);  // r has the higher rank
-                if (uf[z(r)].up == uf[z(o)].up) --uf[z(r)].up;
-                uf[z(o)].up = r;
-                uf[z(r)].head = e;
-                cur = r;
-            }
+            for (const i32 c : roots) cur = join(cur, c, e);
         }
     };
     tbb::parallel_invoke([&] { sweep(true, jp); }, [&] { sweep(false, sp); });
