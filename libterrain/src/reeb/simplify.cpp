@@ -581,12 +581,7 @@ class Simplifier {
         for (const i32 n : turned_) {
             if (degree(n) == 0) continue;
             flags_[z(n)] |= kModified;
-            merged_.clear();
-            if (regularize(n, merged_)) {
-                touched.insert(touched.end(), merged_.begin(), merged_.end());
-            } else {
-                for_each_arc(n, [&](i32 b) { touched.push_back(b); });
-            }
+            if (!regularize(n, touched)) for_each_arc(n, [&](i32 b) { touched.push_back(b); });
         }
         for (const i32 b : touched) consider(b);
     }
