@@ -17,6 +17,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <string>
+#include <utility>
 
 #include "../core/indices.hpp"
 #include "../core/release.hpp"
@@ -34,17 +35,43 @@ using detail::z;
 // ahead.
 constexpr std::size_t kAhead = 16;
 
-// The queued arcs in a 4-ary min-heap of their keys (an arc's id is its key's low half), each
-// arc at most once: re-keying an arc moves its entry instead of leaving a stale one behind.
+// Queued arcs by key (persistence bits, then the arc id in the low half), in two parts: the
+// first candidates, sorted once and read in order (most of them are cancelled with the key
+// they started with), and a 4-ary min-heap for the keys set later, each arc at most once there
+// (re-keying moves its entry). An arc re-keyed or dropped leaves its sorted entry behind: the
+// caller, who knows each arc's current key, skips such entries.
 class ArcQueue {
   public:
+    static constexpr std::uint64_t kEmpty = ~std::uint64_t{0};  // above any key
+
     void init(std::size_t arcs) { at_.assign(arcs, kNone); }
     void release() {
         detail::release(at_);
         detail::release(heap_);
+        detail::release(sorted_);
     }
-    bool empty() const { return heap_.empty(); }
-    std::uint64_t top() const { return heap_.front(); }
+    // The first candidates, in any order, then sorted by seal().
+    void seed(std::uint64_t key) { sorted_.push_back(key); }
+    void seal() {
+        // Seeded in increasing arc order: a stable sort of the high halves sorts the keys.
+        std::vector<std::uint64_t> tmp(sorted_.size());
+        for (const int shift : {32, 43, 54}) {
+            std::array<std::size_t, 2048> count{};
+            for (const std::uint64_t k : sorted_) ++count[(k >> shift) & 2047];
+            std::size_t sum = 0;
+            for (std::size_t& c : count) sum += std::exchange(c, sum);
+            for (const std::uint64_t k : sorted_) tmp[count[(k >> shift) & 2047]++] = k;
+            sorted_.swap(tmp);
+        }
+        next_ = 0;
+    }
+    // The next sorted entry (kEmpty after the last), and the one `ahead` places further.
+    std::uint64_t sorted_front() const { return next_ < sorted_.size() ? sorted_[next_] : kEmpty; }
+    std::uint64_t sorted_ahead(std::size_t ahead) const {
+        return next_ + ahead < sorted_.size() ? sorted_[next_ + ahead] : kEmpty;
+    }
+    void skip_sorted() { ++next_; }
+    std::uint64_t top() const { return heap_.empty() ? kEmpty : heap_.front(); }
     // Queues arc `key & 0xffffffff` with this key, or moves it there.
     void set(std::uint64_t key) {
         const std::size_t a = arc(key);
@@ -115,7 +142,9 @@ class ArcQueue {
     }
 
     std::vector<std::uint64_t> heap_;
-    std::vector<i32> at_;  // each arc's slot in heap_, kNone when not queued
+    std::vector<i32> at_;  // each arc's slot in heap_, kNone when not there
+    std::vector<std::uint64_t> sorted_;
+    std::size_t next_ = 0;  // sorted_[next_ ..] are still to come
 };
 
 std::vector<double> node_areas(const TriangleMesh& mesh, const ReebGraph& g) {
@@ -158,15 +187,18 @@ class Simplifier {
         std::vector<char> placed(nl, 0);
         for (std::size_t p = 0; p < nl; ++p) {
             const i32 r = g.arc_nodes[p];
-            if (at_[z(r)] != kNone || g.node_kinds[z(r)] != NodeKind::regular) continue;
+            // (A critical node in a list keeps its neighbours in its record, which an arc end
+            // needs for its arcs.)
+            if (at_[z(r)] != kNone)
+                throw Error("simplify", "the graph is not valid: node " + std::to_string(r) +
+                                            " is an arc end or in two arcs' lists");
+            if (g.node_kinds[z(r)] != NodeKind::regular) continue;
             at_[z(r)] = static_cast<i32>(p);
             placed[p] = 1;
         }
         first_ = 0;
         for (const i32 i : at_) first_ += i < 0;
         crit_.resize(z(first_));
-        link_.resize(z(first_));
-        flags_.resize(z(first_));
         reg_.resize(nl);
         total_area_ = 0;
         std::vector<i32> scratch;
@@ -184,7 +216,7 @@ class Simplifier {
             if (at_[n] < 0) {
                 crit_[z(k)].area = area;
                 crit_[z(k)].value = g.node_values[n];
-                flags_[z(k)] = g.node_kinds[n] != NodeKind::regular ? kCritical : 0;
+                crit_[z(k)].flags = g.node_kinds[n] != NodeKind::regular ? kCritical : 0;
                 at_[n] = k++;
             } else {
                 reg_[z(at_[n])].area = area;
@@ -193,35 +225,19 @@ class Simplifier {
             }
         }
         if (total_area_ <= 0) total_area_ = 1;
-        // Arc a joins its lower then its upper end, a in order (as linking one by one would).
+        // Arc a joins its lower then its upper end, a in order.
         arcs_.resize(na);
-        queued_.assign(na, kNotQueued);
-        heap_.init(na);
-        for (std::size_t a = 0; a < na; ++a) {
-            Arc& arc = arcs_[a];
-            arc.end = {at_[z(g.arcs[a][0])], at_[z(g.arcs[a][1])]};
-            ++crit_[z(arc.end[0])].size;
-            ++crit_[z(arc.end[1])].size;
-            ++crit_[z(arc.end[1])].down;
-        }
-        i32 offset = 0;
-        for (Crit& c : crit_) {
-            if (c.size > kInline) {
-                c.offset = offset;
-                c.room = c.size;
-                offset += c.size;
-            }
-            c.size = 0;
-        }
-        arena_.resize(z(offset));
+        queue_.init(na);
         for (std::size_t a = 0; a < na; ++a) {
             Arc& arc = arcs_[a];
             if (a + kAhead < na)
-                for (const i32 e : arcs_[a + kAhead].end) __builtin_prefetch(&crit_[z(e)], 1);
-            for (const i32 e : arc.end) {
-                Crit& c = crit_[z(e)];
-                run(c)[c.size++] = static_cast<i32>(a);
-            }
+                for (const i32 e : g.arcs[a + kAhead]) __builtin_prefetch(&at_[z(e)]);
+            if (a + kAhead / 2 < na)
+                for (const i32 e : g.arcs[a + kAhead / 2])
+                    __builtin_prefetch(&crit_[z(at_[z(e)])], 1);
+            arc.end = {at_[z(g.arcs[a][0])], at_[z(g.arcs[a][1])]};
+            for (const i32 e : arc.end) link(static_cast<i32>(a), e);
+            ++crit_[z(arc.end[1])].down;
             for (i32 p = g.arc_offsets[a]; p < g.arc_offsets[a + 1]; ++p) {
                 const i32 r = placed[z(p)] ? first_ + p : at_[z(g.arc_nodes[z(p)])];
                 if (arc.tail == kNone) {
@@ -240,16 +256,27 @@ class Simplifier {
         for (std::size_t a = 0; a < arcs_.size(); ++a) {
             if (a + kAhead < arcs_.size())
                 for (const i32 e : arcs_[a + kAhead].end) __builtin_prefetch(&crit_[z(e)]);
-            consider(static_cast<i32>(a));
+            if (!candidate(static_cast<i32>(a))) continue;
+            const std::uint64_t key = key_of(persistence(static_cast<i32>(a)), static_cast<i32>(a));
+            arcs_[a].queued = static_cast<std::uint32_t>(key >> 32);
+            queue_.seed(key);
+            ++pushed_;
         }
+        queue_.seal();
         const std::size_t initial = pushed_;
         std::size_t done = 0;
-        while (!heap_.empty()) {
-            const i32 a = static_cast<i32>(heap_.pop() & 0xffffffffu);
-            // The next arc is fetched while this one is handled, and its ends after that.
-            const std::size_t next = heap_.empty() ? z(a) : static_cast<std::uint32_t>(heap_.top());
+        for (std::uint64_t key; (key = take()) != ArcQueue::kEmpty;) {
+            const i32 a = static_cast<i32>(key & 0xffffffffu);
+            // The sorted entries ahead are fetched, their arcs first, then their ends; the
+            // heap's top arc is fetched while this one is handled, its ends after that.
+            const std::uint64_t far = queue_.sorted_ahead(kAhead), near = queue_.sorted_ahead(4);
+            if (far != ArcQueue::kEmpty) __builtin_prefetch(&arcs_[far & 0xffffffffu]);
+            if (near != ArcQueue::kEmpty)
+                for (const i32 e : arcs_[near & 0xffffffffu].end) __builtin_prefetch(&crit_[z(e)]);
+            const std::uint64_t top = queue_.top();
+            const std::size_t next = top == ArcQueue::kEmpty ? z(a) : z(top & 0xffffffffu);
             __builtin_prefetch(&arcs_[next]);
-            queued_[z(a)] = kNotQueued;
+            arcs_[z(a)].queued = kNotQueued;
             if (!candidate(a)) continue;
             cancel(redirect(a), result);
             for (const i32 e : arcs_[next].end) __builtin_prefetch(&crit_[z(e)]);
@@ -257,24 +284,27 @@ class Simplifier {
                 report_progress(progress, std::min(0.9, 0.9 * done / static_cast<double>(initial)),
                                 "simplify");
         }
-        heap_.release();  // the output is the peak of memory: the queue is done
-        detail::release(queued_);
+        queue_.release();  // the output is the peak of memory: the queue is done
         output(result);
         report_progress(progress, 1.0, "simplify");
     }
 
   private:
     // A critical node (one of the first first_), in one cache line: its fields and its `size`
-    // arcs, the newest last, with room for `room` (see run()).
+    // arcs, the newest last, with room for kInline << shift (see run()).
     static constexpr i32 kInline = 8;
     struct alignas(64) Crit {
         double area = 0;  // its vertices' and its absorbed nodes' area
         float value = 0;
         i32 forward = kNone;  // the node that absorbed it
-        i32 size = 0, room = kInline;
-        i32 down = 0;                    // its arcs whose upper end it is
-        i32 offset = 0;                  // its run in arena_ when room > kInline
-        std::array<i32, kInline> own{};  // its run while room == kInline
+        i32 size = 0;
+        i32 down = 0;            // its arcs whose upper end it is
+        i32 offset = 0;          // its run in arena_ when shift > 0
+        std::uint8_t shift = 0;  // room for kInline << shift arcs
+        std::uint8_t flags = 0;  // kCritical, kModified
+        // Its run while shift == 0; once it is regular (no arcs), its previous and next node
+        // in its arc's list.
+        std::array<i32, kInline> own{};
     };
     static_assert(sizeof(Crit) == 64);
     struct Reg {
@@ -287,28 +317,28 @@ class Simplifier {
         std::array<i32, 2> end{kNone, kNone};  // {lower, upper}
         i32 head = kNone, tail = kNone;        // regular nodes, lower to upper
         double area = 0;                       // area of the regular nodes' vertices
+        std::uint32_t queued = kNotQueued;     // its key's high half while queued
         bool alive = true;
     };
-    static constexpr char kCritical = 1, kModified = 2;
-    static constexpr std::uint64_t kNotQueued = ~std::uint64_t{0};  // above any key
+    static constexpr std::uint8_t kCritical = 1, kModified = 2;
+    static constexpr std::uint32_t kNotQueued = ~std::uint32_t{0};  // no persistence's bits
     // Heap key: the persistence's order-preserving bits, then the arc id (ties by id).
     static std::uint64_t key_of(float persistence, i32 a) {
         return (std::uint64_t{std::bit_cast<std::uint32_t>(persistence)} << 32) |
                static_cast<std::uint32_t>(a);
     }
 
-    // Any node's fields (critical nodes keep their list neighbours in link_, used once they
-    // become regular).
+    // Any node's fields (a critical node's list neighbours are used once it is regular).
     double& area(i32 n) { return n < first_ ? crit_[z(n)].area : reg_[z(n - first_)].area; }
     float value(i32 n) const { return n < first_ ? crit_[z(n)].value : reg_[z(n - first_)].value; }
     i32& forward(i32 n) { return n < first_ ? crit_[z(n)].forward : reg_[z(n - first_)].forward; }
-    i32& prev(i32 n) { return n < first_ ? link_[z(n)][0] : reg_[z(n - first_)].prev; }
-    i32& next(i32 n) { return n < first_ ? link_[z(n)][1] : reg_[z(n - first_)].next; }
+    i32& prev(i32 n) { return n < first_ ? crit_[z(n)].own[0] : reg_[z(n - first_)].prev; }
+    i32& next(i32 n) { return n < first_ ? crit_[z(n)].own[1] : reg_[z(n - first_)].next; }
 
     // A critical node's arcs, the newest last: in its record while they fit, else in the arena.
-    i32* run(Crit& c) { return c.room == kInline ? c.own.data() : arena_.data() + c.offset; }
+    i32* run(Crit& c) { return c.shift == 0 ? c.own.data() : arena_.data() + c.offset; }
     const i32* run(const Crit& c) const {
-        return c.room == kInline ? c.own.data() : arena_.data() + c.offset;
+        return c.shift == 0 ? c.own.data() : arena_.data() + c.offset;
     }
     // The arcs at a critical node, newest first.
     template <class F>
@@ -324,12 +354,12 @@ class Simplifier {
     // Arc a joins node n; a full run moves to the arena's end with twice the room.
     void link(i32 a, i32 n) {
         Crit& c = crit_[z(n)];
-        if (c.size == c.room) {
+        if (c.size == kInline << c.shift) {
             const i32 offset = static_cast<i32>(arena_.size());
-            arena_.resize(arena_.size() + 2 * z(c.room));
+            arena_.resize(arena_.size() + 2 * z(c.size));
             std::copy_n(run(c), c.size, arena_.data() + offset);
             c.offset = offset;
-            c.room *= 2;
+            ++c.shift;
         }
         run(c)[c.size++] = a;
     }
@@ -386,17 +416,39 @@ class Simplifier {
     // Queues arc a with its current key if it is a candidate, else takes it out of the
     // queue.
     void consider(i32 a) {
-        std::uint64_t& queued = queued_[z(a)];
+        std::uint32_t& queued = arcs_[z(a)].queued;
         if (!candidate(a)) {
             queued = kNotQueued;
-            heap_.erase(a);
+            queue_.erase(a);
             return;
         }
         const std::uint64_t key = key_of(persistence(a), a);
-        if (queued == key) return;
-        queued = key;
-        heap_.set(key);
+        if (queued == key >> 32) return;
+        queued = static_cast<std::uint32_t>(key >> 32);
+        queue_.set(key);
         ++pushed_;
+    }
+    // The smallest current key queued, taken out (entries left behind are dropped on the way);
+    // kEmpty when none is left.
+    std::uint64_t take() {
+        const auto current = [&](std::uint64_t key) {
+            return arcs_[key & 0xffffffffu].queued == key >> 32;
+        };
+        for (;;) {
+            std::uint64_t s = queue_.sorted_front();
+            while (s != ArcQueue::kEmpty && !current(s)) {
+                queue_.skip_sorted();
+                s = queue_.sorted_front();
+            }
+            const std::uint64_t h = queue_.top();
+            if (s == ArcQueue::kEmpty && h == ArcQueue::kEmpty) return ArcQueue::kEmpty;
+            if (s < h) {
+                queue_.skip_sorted();
+                return s;
+            }
+            queue_.pop();
+            if (current(h)) return h;  // else the twin of a sorted entry already taken
+        }
     }
     // Node n's vertices (and everything already forwarded to it) join the critical node keep.
     void absorb(i32 n, i32 keep) {
@@ -466,6 +518,9 @@ class Simplifier {
         Arc& U = arcs_[z(upper)];
         if (L.end[0] == U.end[1]) return false;
         Crit& k = crit_[z(n)];
+        k.size = 0;  // its two arcs leave it, and its record takes its list neighbours
+        k.down = 0;
+        k.flags &= ~kCritical;
         prev(n) = L.tail;
         next(n) = U.head;
         if (L.tail == kNone)
@@ -479,11 +534,7 @@ class Simplifier {
         L.end[1] = q;
         U.alive = false;
         unlink(upper, q);
-        unlink(upper, n);
-        unlink(lower, n);
         link(lower, q);
-        k.down = 0;
-        flags_[z(n)] &= ~kCritical;
         // The arcs parallel to the merged one, found at its end with fewer arcs (the one
         // multi() will look at too).
         out.push_back(lower);
@@ -542,7 +593,7 @@ class Simplifier {
         if (midpoint) crit_[z(keep)].value = 0.5f * (crit_[z(lo)].value + crit_[z(hi)].value);
         ++(both ? result.extremum_extremum : result.saddle_extremum);
         Crit& k = crit_[z(keep)];
-        flags_[z(keep)] |= kModified;
+        crit_[z(keep)].flags |= kModified;
         arc.alive = false;
         unlink(a, lo);
         unlink(a, hi);
@@ -580,7 +631,7 @@ class Simplifier {
         // that node may now be regular, or an extremum whose arcs are new candidates.
         for (const i32 n : turned_) {
             if (degree(n) == 0) continue;
-            flags_[z(n)] |= kModified;
+            crit_[z(n)].flags |= kModified;
             if (!regularize(n, touched)) for_each_arc(n, [&](i32 b) { touched.push_back(b); });
         }
         for (const i32 b : touched) consider(b);
@@ -636,12 +687,12 @@ class Simplifier {
         for (std::size_t nid = 0; nid < count; ++nid) {
             const auto [n, i] = kept[nid];
             out.node_values[nid] = value(i);
-            if (i >= first_ || !(flags_[z(i)] & kCritical)) continue;
+            if (i >= first_ || !(crit_[z(i)].flags & kCritical)) continue;
             const i32 d = down(i), u = up(i);
             out.node_kinds[nid] = d == 0   ? NodeKind::minimum
                                   : u == 0 ? NodeKind::maximum
                                            : NodeKind::saddle;
-            const bool unchanged = !(flags_[z(i)] & kModified);
+            const bool unchanged = !(crit_[z(i)].flags & kModified);
             out.node_lower_links[nid] =
                 unchanged ? g_.node_lower_links[z(n)] : static_cast<std::uint8_t>(std::min(d, 255));
             out.node_upper_links[nid] =
@@ -688,16 +739,13 @@ class Simplifier {
     std::vector<i32> at_;  // each node's new number
     i32 first_ = 0;        // critical nodes: 0 .. first_ - 1
     std::vector<Crit> crit_;
-    std::vector<std::array<i32, 2>> link_;  // prev and next of critical nodes
-    std::vector<char> flags_;               // kCritical, kModified, of critical nodes
-    std::vector<Reg> reg_;                  // node first_ + i is reg_[i]
+    std::vector<Reg> reg_;  // node first_ + i is reg_[i]
     std::vector<i32> arena_;
     double total_area_ = 0;
     std::vector<i32> touched_, all_, merged_;
     std::vector<i32> turned_;  // far ends of the arcs fit_arc turned around
     std::vector<Arc> arcs_;
-    std::vector<std::uint64_t> queued_;  // key of each queued arc, kNotQueued for the others
-    ArcQueue heap_;
+    ArcQueue queue_;
     std::size_t pushed_ = 0;
 };
 
