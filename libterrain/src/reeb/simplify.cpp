@@ -1,12 +1,13 @@
 // Critical-node cancellation on a Reeb graph (docs/reeb.md). The graph is copied into a
 // mutable form laid out for few cache misses: nodes renumbered, critical nodes first (one
-// 64-byte record each: value, area, arc counts and its arcs, up to 8 in the record, more in
-// a run of a shared arena), then the regular nodes in the order of the arcs' lists, so that
-// each list starts out contiguous; regular nodes in doubly linked lists (one per arc, sorted
-// by value); absorbed nodes forwarding to the node that took them. Candidates wait in a
-// priority queue (a 4-ary heap) keyed by (persistence, arc id), each arc at most once: an arc
-// that stops being a candidate leaves it, one whose key changes moves; a popped arc is
-// checked again before it is cancelled.
+// 64-byte record each: value, area, flags, arc counts and its arcs, up to 8 in the record,
+// more in a run of a shared arena), then the regular nodes in the order of the arcs' lists,
+// so that each list starts out contiguous; regular nodes in doubly linked lists (one per arc,
+// sorted by value). A list absorbed whole is never walked: its area moves at once and its
+// nodes learn where they went in the output, through sets of lists (see Arc). Candidates are
+// keyed by (persistence, arc id): the first ones sorted once and read in order, later keys in
+// a 4-ary heap; an arc whose key changes or that stops being a candidate leaves its old
+// entry behind, and a taken arc is checked again before it is cancelled.
 
 #include "terrain/reeb/simplify.hpp"
 
@@ -227,6 +228,8 @@ class Simplifier {
         if (total_area_ <= 0) total_area_ = 1;
         // Arc a joins its lower then its upper end, a in order.
         arcs_.resize(na);
+        set_parent_.assign(na, kNone);
+        set_fate_.assign(na, kNone);
         queue_.init(na);
         for (std::size_t a = 0; a < na; ++a) {
             Arc& arc = arcs_[a];
@@ -238,8 +241,10 @@ class Simplifier {
             arc.end = {at_[z(g.arcs[a][0])], at_[z(g.arcs[a][1])]};
             for (const i32 e : arc.end) link(static_cast<i32>(a), e);
             ++crit_[z(arc.end[1])].down;
+            arc.set = static_cast<i32>(a);
             for (i32 p = g.arc_offsets[a]; p < g.arc_offsets[a + 1]; ++p) {
                 const i32 r = placed[z(p)] ? first_ + p : at_[z(g.arc_nodes[z(p)])];
+                forward(r) = -2 - arc.set;
                 if (arc.tail == kNone) {
                     arc.head = r;
                 } else {
@@ -307,19 +312,26 @@ class Simplifier {
         std::array<i32, kInline> own{};
     };
     static_assert(sizeof(Crit) == 64);
+    // A node's `forward`: the critical node that absorbed it; for a node in a list, -2 - the
+    // set of its list (see Arc::set); kNone for a critical node.
     struct Reg {
         double area = 0;
         float value = 0;
         i32 forward = kNone;
         i32 prev = kNone, next = kNone;  // its neighbours in its arc's list
     };
+    // An arc's regular nodes form a set: at first the arc's own (named by its id); an arc
+    // merged into another joins its set; a list absorbed whole gives its set a fate, the node
+    // that took it, and its arc a new set. Lists are thus absorbed at once, and the nodes
+    // learn their fate in the output.
     struct Arc {
         std::array<i32, 2> end{kNone, kNone};  // {lower, upper}
         i32 head = kNone, tail = kNone;        // regular nodes, lower to upper
         double area = 0;                       // area of the regular nodes' vertices
         std::uint32_t queued = kNotQueued;     // its key's high half while queued
-        bool alive = true;
+        i32 set = kNone;                       // its nodes' set; kNone once the arc is gone
     };
+    static_assert(sizeof(Arc) == 32);
     static constexpr std::uint8_t kCritical = 1, kModified = 2;
     static constexpr std::uint32_t kNotQueued = ~std::uint32_t{0};  // no persistence's bits
     // Heap key: the persistence's order-preserving bits, then the arc id (ties by id).
@@ -408,7 +420,7 @@ class Simplifier {
     }
     bool candidate(i32 a) const {
         const Arc& arc = arcs_[z(a)];
-        if (!arc.alive) return false;
+        if (arc.set == kNone) return false;
         if (!extremum(arc.end[0]) && !extremum(arc.end[1])) return false;
         if (multi(a)) return false;
         return persistence(a) < options_.persistence || area_ratio(a) < options_.area_ratio / 100.0;
@@ -455,8 +467,18 @@ class Simplifier {
         forward(n) = keep;
         crit_[z(keep)].area += area(n);
     }
-    void absorb_list(Arc& arc, i32 keep) {
-        for (i32 r = arc.head; r != kNone; r = next(r)) absorb(r, keep);
+    // The regular nodes of an arc join keep, their area at once (the output tells them);
+    // the arc, if it lives on, starts a new set.
+    void absorb_list(Arc& arc, i32 keep, bool lives) {
+        if (arc.head != kNone) {
+            crit_[z(keep)].area += arc.area;
+            set_fate_[z(arc.set)] = keep;
+            if (lives) {
+                arc.set = static_cast<i32>(set_fate_.size());
+                set_fate_.push_back(kNone);
+                set_parent_.push_back(kNone);
+            }
+        }
         arc.head = arc.tail = kNone;
         arc.area = 0;
     }
@@ -478,7 +500,7 @@ class Simplifier {
                 absorb(r, keep);
             }
             if (crit_[z(arc.end[0])].value > fk) {
-                absorb_list(arc, keep);
+                absorb_list(arc, keep, true);
                 ++crit_[z(arc.end[0])].down;
                 --crit_[z(keep)].down;
                 turned_.push_back(arc.end[0]);
@@ -496,7 +518,7 @@ class Simplifier {
                 absorb(r, keep);
             }
             if (crit_[z(arc.end[1])].value < fk) {
-                absorb_list(arc, keep);
+                absorb_list(arc, keep, true);
                 --crit_[z(arc.end[1])].down;
                 ++crit_[z(keep)].down;
                 turned_.push_back(arc.end[1]);
@@ -521,6 +543,7 @@ class Simplifier {
         k.size = 0;  // its two arcs leave it, and its record takes its list neighbours
         k.down = 0;
         k.flags &= ~kCritical;
+        k.forward = -2 - L.set;
         prev(n) = L.tail;
         next(n) = U.head;
         if (L.tail == kNone)
@@ -532,7 +555,8 @@ class Simplifier {
         L.area += k.area + U.area;
         const i32 q = U.end[1];
         L.end[1] = q;
-        U.alive = false;
+        set_parent_[z(U.set)] = L.set;
+        U.set = kNone;
         unlink(upper, q);
         link(lower, q);
         // The arcs parallel to the merged one, found at its end with fewer arcs (the one
@@ -594,11 +618,11 @@ class Simplifier {
         ++(both ? result.extremum_extremum : result.saddle_extremum);
         Crit& k = crit_[z(keep)];
         crit_[z(keep)].flags |= kModified;
-        arc.alive = false;
         unlink(a, lo);
         unlink(a, hi);
         --crit_[z(hi)].down;
-        absorb_list(arc, keep);
+        absorb_list(arc, keep, false);
+        arc.set = kNone;
         absorb(gone, keep);
         std::vector<i32>& touched = touched_;
         arcs_at(gone, touched);
@@ -641,8 +665,21 @@ class Simplifier {
         const std::size_t nn = g_.node_count(), nl = reg_.size();
         // code[i]: for an absorbed node, the critical node that finally took it (nodes are
         // only absorbed into critical nodes); for a remaining node, -2 - its new id.
+        // A listed node's forward: the fate of its set's root (kNone for a list still there).
+        const auto fate = [&](i32 f) {
+            if (f > -2) return f;
+            const i32 set = -2 - f;
+            i32 root = set;
+            while (set_parent_[z(root)] != kNone) root = set_parent_[z(root)];
+            for (i32 s = set; s != root;) {
+                const i32 up = set_parent_[z(s)];
+                set_parent_[z(s)] = root;
+                s = up;
+            }
+            return set_fate_[z(root)];
+        };
         std::vector<i32> code(z(first_) + nl);
-        for (std::size_t k = 0; k < z(first_); ++k) code[k] = crit_[k].forward;
+        for (std::size_t k = 0; k < z(first_); ++k) code[k] = fate(crit_[k].forward);
         for (std::size_t k = 0; k < z(first_); ++k) {
             i32 r = code[k];
             if (r == kNone) continue;
@@ -655,7 +692,7 @@ class Simplifier {
             code[k] = r;
         }
         for (std::size_t p = 0; p < nl; ++p) {
-            const i32 f = reg_[p].forward;
+            const i32 f = fate(reg_[p].forward);
             code[z(first_) + p] = f == kNone || code[z(f)] == kNone ? f : code[z(f)];
         }
         // The remaining nodes are numbered in the order of the old ones; at_ takes each old
@@ -722,7 +759,7 @@ class Simplifier {
         const auto new_id = [&](i32 i) { return -2 - code[z(i)]; };
         out.arc_offsets.assign(1, 0);
         for (const Arc& arc : arcs_) {
-            if (!arc.alive) continue;
+            if (arc.set == kNone) continue;
             const i32 id = static_cast<i32>(out.arcs.size());
             out.arcs.push_back({new_id(arc.end[0]), new_id(arc.end[1])});
             for (i32 r = arc.head; r != kNone; r = next(r)) {
@@ -743,7 +780,9 @@ class Simplifier {
     std::vector<i32> arena_;
     double total_area_ = 0;
     std::vector<i32> touched_, all_, merged_;
-    std::vector<i32> turned_;  // far ends of the arcs fit_arc turned around
+    std::vector<i32> turned_;      // far ends of the arcs fit_arc turned around
+    std::vector<i32> set_parent_;  // of each set, kNone for a root (an arc's current set)
+    std::vector<i32> set_fate_;    // of each root set: the node that absorbed it, or kNone
     std::vector<Arc> arcs_;
     ArcQueue queue_;
     std::size_t pushed_ = 0;
