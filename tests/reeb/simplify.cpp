@@ -206,3 +206,20 @@ TEST_CASE("Simplification thresholds are checked", "[simplify]") {
     o.area_ratio = std::nan("");
     CHECK_THROWS_AS(reeb::simplify(mesh, g, o), Error);
 }
+
+TEST_CASE("Simplification refuses a graph whose lists hold arc ends or shared nodes",
+          "[simplify]") {
+    const auto mesh = test::plate_mesh(12, 10, 0);
+    const auto g = reeb::build_reeb_graph(mesh, test::noise_field(mesh.vertex_count(), 3));
+    std::vector<std::size_t> listed;  // arcs with regular nodes
+    for (std::size_t a = 0; a < g.arc_count(); ++a)
+        if (g.arc_offsets[a] < g.arc_offsets[a + 1]) listed.push_back(a);
+    REQUIRE(listed.size() >= 2);
+    REQUIRE_NOTHROW(reeb::simplify(mesh, g, {}));
+    auto end_in_list = g;
+    end_in_list.arc_nodes[end_in_list.arc_offsets[listed[0]]] = g.arcs[listed[0]][0];
+    CHECK_THROWS_WITH(reeb::simplify(mesh, end_in_list, {}), Catch::Contains("not valid"));
+    auto shared = g;
+    shared.arc_nodes[shared.arc_offsets[listed[1]]] = g.arc_nodes[g.arc_offsets[listed[0]]];
+    CHECK_THROWS_WITH(reeb::simplify(mesh, shared, {}), Catch::Contains("not valid"));
+}
