@@ -148,6 +148,18 @@ class ArcQueue {
     std::size_t next_ = 0;  // sorted_[next_ ..] are still to come
 };
 
+// The root of x in a forest of parent links (kNone at a root); the path is compressed.
+i32 find_root(std::vector<i32>& parent, i32 x) {
+    i32 root = x;
+    while (parent[z(root)] != kNone) root = parent[z(root)];
+    while (x != root) {
+        const i32 up = parent[z(x)];
+        parent[z(x)] = root;
+        x = up;
+    }
+    return root;
+}
+
 std::vector<double> node_areas(const TriangleMesh& mesh, const ReebGraph& g) {
     std::vector<double> area(g.node_count(), 0.0);
     for (std::size_t v = 0; v < g.vertex_nodes.size(); ++v)
@@ -262,9 +274,7 @@ class Simplifier {
             if (a + kAhead < arcs_.size())
                 for (const i32 e : arcs_[a + kAhead].end) __builtin_prefetch(&crit_[z(e)]);
             if (!candidate(static_cast<i32>(a))) continue;
-            const std::uint64_t key = key_of(persistence(static_cast<i32>(a)), static_cast<i32>(a));
-            arcs_[a].queued = static_cast<std::uint32_t>(key >> 32);
-            queue_.seed(key);
+            queue_.seed(mark_queued(static_cast<i32>(a)));
             ++pushed_;
         }
         queue_.seal();
@@ -428,17 +438,24 @@ class Simplifier {
     // Queues arc a with its current key if it is a candidate, else takes it out of the
     // queue.
     void consider(i32 a) {
-        std::uint32_t& queued = arcs_[z(a)].queued;
         if (!candidate(a)) {
-            queued = kNotQueued;
+            arcs_[z(a)].queued = kNotQueued;
             queue_.erase(a);
             return;
         }
-        const std::uint64_t key = key_of(persistence(a), a);
-        if (queued == key >> 32) return;
-        queued = static_cast<std::uint32_t>(key >> 32);
+        const std::uint64_t key = mark_queued(a);
+        if (key == ArcQueue::kEmpty) return;
         queue_.set(key);
         ++pushed_;
+    }
+    // Records arc a as queued with its current key and returns the key; kEmpty if it was
+    // queued with that key already.
+    std::uint64_t mark_queued(i32 a) {
+        const std::uint64_t key = key_of(persistence(a), a);
+        std::uint32_t& queued = arcs_[z(a)].queued;
+        if (queued == key >> 32) return ArcQueue::kEmpty;
+        queued = static_cast<std::uint32_t>(key >> 32);
+        return key;
     }
     // The smallest current key queued, taken out (entries left behind are dropped on the way);
     // kEmpty when none is left.
@@ -617,7 +634,7 @@ class Simplifier {
         if (midpoint) crit_[z(keep)].value = 0.5f * (crit_[z(lo)].value + crit_[z(hi)].value);
         ++(both ? result.extremum_extremum : result.saddle_extremum);
         Crit& k = crit_[z(keep)];
-        crit_[z(keep)].flags |= kModified;
+        k.flags |= kModified;
         unlink(a, lo);
         unlink(a, hi);
         --crit_[z(hi)].down;
@@ -667,30 +684,12 @@ class Simplifier {
         // only absorbed into critical nodes); for a remaining node, -2 - its new id.
         // A listed node's forward: the fate of its set's root (kNone for a list still there).
         const auto fate = [&](i32 f) {
-            if (f > -2) return f;
-            const i32 set = -2 - f;
-            i32 root = set;
-            while (set_parent_[z(root)] != kNone) root = set_parent_[z(root)];
-            for (i32 s = set; s != root;) {
-                const i32 up = set_parent_[z(s)];
-                set_parent_[z(s)] = root;
-                s = up;
-            }
-            return set_fate_[z(root)];
+            return f > -2 ? f : set_fate_[z(find_root(set_parent_, -2 - f))];
         };
         std::vector<i32> code(z(first_) + nl);
         for (std::size_t k = 0; k < z(first_); ++k) code[k] = fate(crit_[k].forward);
-        for (std::size_t k = 0; k < z(first_); ++k) {
-            i32 r = code[k];
-            if (r == kNone) continue;
-            while (code[z(r)] != kNone) r = code[z(r)];
-            for (i32 n = code[k]; n != r;) {
-                const i32 nx = code[z(n)];
-                code[z(n)] = r;
-                n = nx;
-            }
-            code[k] = r;
-        }
+        for (std::size_t k = 0; k < z(first_); ++k)
+            if (code[k] != kNone) code[k] = find_root(code, code[k]);
         for (std::size_t p = 0; p < nl; ++p) {
             const i32 f = fate(reg_[p].forward);
             code[z(first_) + p] = f == kNone || code[z(f)] == kNone ? f : code[z(f)];
