@@ -7,6 +7,7 @@
 
 #include "cli.hpp"
 #include "terrain/core/version.hpp"
+#include "terrain/io/dependency_versions.hpp"
 
 namespace terrain::cli {
 int run_info(int argc, char** argv);

@@ -13,6 +13,7 @@
 #include "terrain/core/error.hpp"
 #include "terrain/core/json_writer.hpp"
 #include "terrain/core/version.hpp"
+#include "terrain/io/dependency_versions.hpp"
 #include "terrain/io/segment_outputs.hpp"
 
 namespace terrain::cli {

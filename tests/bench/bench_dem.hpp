@@ -4,8 +4,8 @@
 
 #include <cmath>
 
-#include "terrain/core/body.hpp"
 #include "terrain/core/dem.hpp"
+#include "terrain/geo/georeference.hpp"
 
 namespace terrain::bench {
 
@@ -13,9 +13,9 @@ inline Dem utm_hills(int n) {
     Dem dem;
     dem.width = dem.height = n;
     dem.crs_wkt = "EPSG:32611";
-    dem.body = body_from_crs(dem.crs_wkt);
     dem.transform = {400000, 30, 0, 3800000, 0, -30};
     dem.has_transform = true;
+    geo::georeference(dem);
     dem.values.resize(std::size_t(n) * n);
     for (int r = 0; r < n; ++r)
         for (int c = 0; c < n; ++c)

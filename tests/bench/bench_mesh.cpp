@@ -9,7 +9,7 @@
 #include <cstdlib>
 #include <string>
 
-#include "terrain/core/body.hpp"
+#include "terrain/geo/georeference.hpp"
 #include "terrain/mesh/dem_to_mesh.hpp"
 
 using namespace terrain;
@@ -20,9 +20,9 @@ Dem synthetic(int n, const std::string& crs, const GeoTransform& transform, doub
     Dem dem;
     dem.width = dem.height = n;
     dem.crs_wkt = crs;
-    dem.body = body_from_crs(crs);
     dem.transform = transform;
     dem.has_transform = true;
+    geo::georeference(dem);
     dem.elevation = base > 0 ? ElevationKind::radius : ElevationKind::height;
     dem.values.resize(std::size_t(n) * n);
     for (int r = 0; r < n; ++r)

@@ -12,6 +12,7 @@
 #include <cstdlib>
 
 #include "terrain/field/shape_index.hpp"
+#include "terrain/geo/georeference.hpp"
 #include "terrain/mesh/dem_to_mesh.hpp"
 #include "terrain/reeb/reeb_graph.hpp"
 #include "terrain/reeb/simplify.hpp"
@@ -51,7 +52,8 @@ double best_of(int runs, F&& f, double* cpu) {
 int main(int argc, char** argv) {
     synth::VestaTileOptions options;
     options.width = options.height = argc > 1 ? std::atoi(argv[1]) : 1000;
-    const Dem dem = synth::generate_vesta_tile(options);
+    Dem dem = synth::generate_vesta_tile(options);
+    geo::georeference(dem);
     const auto mesh = mesh::dem_to_mesh(dem);
     const auto field = field::shape_index_field(mesh);
     const double nv = static_cast<double>(mesh.vertex_count());

@@ -11,6 +11,7 @@
 
 #include "support/test_support.hpp"
 #include "terrain/core/error.hpp"
+#include "terrain/geo/georeference.hpp"
 #include "terrain/io/read_dem.hpp"
 #include "terrain/mesh/dem_to_mesh.hpp"
 
@@ -28,7 +29,7 @@ Dem grid_dem(int w, int h, double pixel, F f) {
     dem.height = h;
     dem.transform = {0, pixel, 0, 0, 0, -pixel};
     dem.has_transform = true;
-    dem.body = body_from_crs("");
+    geo::georeference(dem);
     for (int r = 0; r < h; ++r)
         for (int c = 0; c < w; ++c) dem.values.push_back(f(c, r));
     return dem;
@@ -212,12 +213,9 @@ TEST_CASE("dem_to_mesh: a lon/lat grid has the same shape in the body and map fr
     Dem dem;
     dem.width = dem.height = 40;
     dem.crs_wkt = "EPSG:4326";
-    {
-        const auto body = body_from_crs(dem.crs_wkt);
-        dem.body = body;
-    }
     dem.transform = {7.0, 0.001, 0, 45.02, 0, -0.001};
     dem.has_transform = true;
+    geo::georeference(dem);
     for (int r = 0; r < 40; ++r)
         for (int c = 0; c < 40; ++c) {
             const double x = (c - 19.5) * 78.8, y = (r - 19.5) * 111.1;
@@ -296,9 +294,9 @@ TEST_CASE("dem_to_mesh: the same hill on a lon/lat grid and on a UTM grid has th
     lonlat.width = 50;
     lonlat.height = 36;
     lonlat.crs_wkt = "EPSG:4326";
-    lonlat.body = body_from_crs(lonlat.crs_wkt);
     lonlat.transform = {lon0 - 0.025, 0.001, 0, lat0 + 0.018, 0, -0.001};
     lonlat.has_transform = true;
+    geo::georeference(lonlat);
     for (int r = 0; r < lonlat.height; ++r)
         for (int c = 0; c < lonlat.width; ++c) {
             const auto p = lonlat.map_xy(c + 0.5, r + 0.5);
@@ -314,9 +312,9 @@ TEST_CASE("dem_to_mesh: the same hill on a lon/lat grid and on a UTM grid has th
     Dem utm;
     utm.width = utm.height = 52;
     utm.crs_wkt = "EPSG:32632";
-    utm.body = body_from_crs(utm.crs_wkt);
     utm.transform = {x0 - 26 * 75.0, 75, 0, y0 + 26 * 75.0, 0, -75};
     utm.has_transform = true;
+    geo::georeference(utm);
     for (int r = 0; r < utm.height; ++r)
         for (int c = 0; c < utm.width; ++c) {
             const auto p = utm.map_xy(c + 0.5, r + 0.5);

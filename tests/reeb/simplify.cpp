@@ -9,6 +9,7 @@
 #include "terrain/core/error.hpp"
 #include "terrain/field/shape_index.hpp"
 #include "terrain/field/vertex_field.hpp"
+#include "terrain/geo/georeference.hpp"
 #include "terrain/io/read_dem.hpp"
 #include "terrain/mesh/dem_to_mesh.hpp"
 #include "terrain/reeb/simplify.hpp"
@@ -116,7 +117,8 @@ TEST_CASE("Arcs turned around elsewhere: their far nodes become regular or extre
     // This 300x300 synthetic tile meets the first case at area ratio 0.5 %.
     synth::VestaTileOptions options;
     options.width = options.height = 300;
-    const Dem dem = synth::generate_vesta_tile(options);
+    Dem dem = synth::generate_vesta_tile(options);
+    geo::georeference(dem);
     const auto mesh = mesh::dem_to_mesh(dem);
     const auto si = field::shape_index_field(mesh);
     for (const auto& [p, a] :

@@ -10,6 +10,7 @@
 #include <memory>
 
 #include "terrain/field/vertex_field.hpp"
+#include "terrain/geo/georeference.hpp"
 #include "terrain/mesh/dem_to_mesh.hpp"
 
 namespace terrain::test {
@@ -24,6 +25,7 @@ Dem crop(const Dem& dem, int col0, int row0, int width, int height) {
     out.values.clear();
     for (int r = row0; r < row0 + height; ++r)
         for (int c = col0; c < col0 + width; ++c) out.values.push_back(dem.at(c, r));
+    geo::georeference(out);  // a smaller grid: another extent
     return out;
 }
 

@@ -12,6 +12,7 @@
 
 #include "gdal_support.hpp"
 #include "terrain/core/error.hpp"
+#include "terrain/geo/georeference.hpp"
 
 namespace terrain::io {
 
@@ -65,7 +66,7 @@ Dem read_dem(const std::string& path, const ReadDemOptions& options, const Progr
         if (srs->exportToWkt(&wkt, wkt_options) == OGRERR_NONE && wkt) dem.crs_wkt = wkt;
         CPLFree(wkt);
     }
-    dem.body = body_from_crs(dem.crs_wkt);
+    geo::georeference(dem);  // the body, and where the pixels lie on it
 
     GDALRasterBand* band = dataset->GetRasterBand(options.band);
     int has_scale = 0, has_offset = 0;

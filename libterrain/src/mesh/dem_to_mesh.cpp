@@ -1,8 +1,6 @@
 #include "terrain/mesh/dem_to_mesh.hpp"
 
-#include <ogr_spatialref.h>
 #include <tbb/blocked_range.h>
-#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <GeographicLib/Geocentric.hpp>
 #include <GeographicLib/LocalCartesian.hpp>
@@ -14,9 +12,7 @@
 #include <numbers>
 
 #include "../core/release.hpp"
-#include "../io/gdal_support.hpp"
 #include "terrain/core/error.hpp"
-#include "terrain/io/describe_dem.hpp"
 
 namespace terrain::mesh {
 namespace {
@@ -24,31 +20,21 @@ namespace {
 constexpr double kDegree = std::numbers::pi / 180.0;
 using Triangle = std::array<std::int32_t, 3>;
 
-// The shared transformation, or an error saying why there is none.
-io::LonLatTransform make_lonlat(const std::string& crs) {
-    auto t = io::make_lonlat_transform(crs);
-    if (!t.to_lonlat)
-        throw Error("mesh", "cannot transform the DEM's CRS to longitude/latitude on its body");
-    return t;
-}
-
-bool crs_is(const std::string& wkt, bool geographic) {
-    OGRSpatialReference srs;
-    if (srs.SetFromUserInput(wkt.c_str()) != OGRERR_NONE) return false;
-    return geographic ? srs.IsGeographic() : srs.IsProjected();
-}
-
-double crs_linear_unit(const std::string& wkt) {
-    OGRSpatialReference srs;
-    if (srs.SetFromUserInput(wkt.c_str()) != OGRERR_NONE) return 1.0;
-    return srs.IsProjected() ? srs.GetLinearUnits() : 1.0;
+// The DEM's georeference, or an error saying how to get one.
+const GridGeoref& georef_of(const Dem& dem) {
+    if (!dem.georef_current())
+        throw Error("mesh", "'" + dem.source +
+                                "' has no georeference for its CRS and grid; read it with "
+                                "io::read_dem or call geo::georeference(dem)");
+    return dem.georef;
 }
 
 }  // namespace
 
 MeshFrame default_frame(const Dem& dem) {
     if (dem.crs_wkt.empty()) return MeshFrame::map;
-    if (dem.body.name == "Earth" && crs_is(dem.crs_wkt, false)) return MeshFrame::map;
+    if (dem.body.name == "Earth" && georef_of(dem).kind == CrsKind::projected)
+        return MeshFrame::map;
     return MeshFrame::body;
 }
 
@@ -60,20 +46,22 @@ TriangleMesh dem_to_mesh(const Dem& dem, const DemToMeshOptions& options,
         throw Error("mesh", "'" + dem.source +
                                 "' has no CRS, so it has no body to place it on; use --frame map");
     const int W = dem.width, H = dem.height;
-    const bool geographic_crs = !dem.crs_wkt.empty() && crs_is(dem.crs_wkt, true);
+    const GridGeoref& geo = georef_of(dem);
+    const bool geographic_crs = geo.kind == CrsKind::geographic;
     const bool need_lonlat = frame == MeshFrame::body || geographic_crs;
+    const LonLatMapping* lonlat = nullptr;  // null: map coordinates are lon/lat already
+    if (need_lonlat && !geographic_crs) {
+        if (!geo.lonlat)
+            throw Error("mesh", "cannot transform the DEM's CRS to longitude/latitude on its body");
+        lonlat = geo.lonlat.get();
+    }
 
     // A global grid closes in the body frame: seam, and pole rows whose outer edge is a pole.
     bool wrap = false;
     std::array<bool, 2> pole{false, false};
-    if (frame == MeshFrame::body && options.close_global) {
-        const auto d = io::describe_dem(dem);
-        wrap = d.global_longitude;
-        if (wrap) {
-            const double row_degrees = (d.lat_max - d.lat_min) / H;
-            pole[0] = d.lat_max > 90.0 - 0.25 * row_degrees;
-            pole[1] = d.lat_min < -90.0 + 0.25 * row_degrees;
-        }
+    if (frame == MeshFrame::body && options.close_global && geo.global_longitude) {
+        wrap = true;
+        pole = geo.pole_row;
     }
 
     TriangleMesh mesh;
@@ -110,10 +98,11 @@ TriangleMesh dem_to_mesh(const Dem& dem, const DemToMeshOptions& options,
     if (count < 3) throw Error("mesh", "'" + dem.source + "' has fewer than 3 valid pixels");
     report_progress(progress, 0.05, "mesh");
 
-    // Positions in double, per row in parallel (one PROJ transformation per thread).
+    // Positions in double, per row in parallel (the mapping keeps one PROJ transformation per
+    // thread).
     std::vector<std::array<double, 3>> xyz(static_cast<std::size_t>(count));
     const double a = dem.body.semi_major_axis, f = dem.body.flattening;
-    const double unit = dem.crs_wkt.empty() ? 1.0 : crs_linear_unit(dem.crs_wkt);
+    const double unit = geo.linear_unit_m;
     std::unique_ptr<GeographicLib::Geocentric> earth;
     if (need_lonlat) earth = std::make_unique<GeographicLib::Geocentric>(a, f);
     std::unique_ptr<GeographicLib::LocalCartesian> tangent;
@@ -122,25 +111,17 @@ TriangleMesh dem_to_mesh(const Dem& dem, const DemToMeshOptions& options,
         tangent =
             std::make_unique<GeographicLib::LocalCartesian>(centre[1], centre[0], 0.0, *earth);
     }
-    tbb::enumerable_thread_specific<std::unique_ptr<io::LonLatTransform>> transforms;
     std::vector<std::uint8_t> failed(static_cast<std::size_t>(H), 0);
     tbb::parallel_for(tbb::blocked_range<int>(0, H, 8), [&](const tbb::blocked_range<int>& rows) {
-        io::LonLatTransform* tr = nullptr;
-        if (need_lonlat && !geographic_crs) {
-            auto& local = transforms.local();
-            if (!local) local = std::make_unique<io::LonLatTransform>(make_lonlat(dem.crs_wkt));
-            tr = local.get();
-        }
         std::vector<double> lon(W), lat(W);
-        std::vector<int> ok(W, 1);
+        std::vector<std::uint8_t> ok(W, 1);
         for (int row = rows.begin(); row < rows.end(); ++row) {
             for (int col = 0; col < W; ++col) {
                 const auto xy = dem.map_xy(col + 0.5, row + 0.5);
                 lon[col] = xy[0];
                 lat[col] = xy[1];
             }
-            if (tr && !tr->to_lonlat->Transform(W, lon.data(), lat.data(), nullptr, ok.data()))
-                std::fill(ok.begin(), ok.end(), 0);
+            if (lonlat) lonlat->to_lonlat(std::size_t(W), lon.data(), lat.data(), ok.data());
             for (int col = 0; col < W; ++col) {
                 const auto p = dem.index(col, row);
                 const auto v = vertex_of[p];

@@ -8,7 +8,6 @@
 #include <cmath>
 #include <numbers>
 
-#include "../io/gdal_support.hpp"
 #include "terrain/core/error.hpp"
 
 namespace terrain::segment {
@@ -18,12 +17,8 @@ constexpr double kDegree = std::numbers::pi / 180.0;
 constexpr int kStride = 16;
 
 // Longitudes/latitudes of map points, in place; throws when one fails.
-void to_lonlat(io::LonLatTransform& t, std::vector<double>& x, std::vector<double>& y) {
-    std::vector<int> ok(x.size(), 0);
-    bool good = t.to_lonlat->Transform(x.size(), x.data(), y.data(), nullptr, ok.data());
-    for (std::size_t i = 0; good && i < x.size(); ++i)
-        good = ok[i] && std::isfinite(x[i]) && std::isfinite(y[i]);
-    if (!good)
+void to_lonlat(const LonLatMapping& t, std::vector<double>& x, std::vector<double>& y) {
+    if (!t.to_lonlat(x.size(), x.data(), y.data()))
         throw Error("segment",
                     "some pixel corners of the DEM have no longitude/latitude on its body, so "
                     "their areas are unknown; crop the DEM to its projection's valid area");
@@ -59,11 +54,13 @@ PixelAreas::PixelAreas(const Dem& dem) {
         constant_ = std::abs(t[1] * t[5] - t[2] * t[4]);
         return;
     }
-    io::ensure_gdal_registered();
-    const io::GdalErrorCapture quiet;
-    auto lonlat = io::make_lonlat_transform(dem.crs_wkt);
-    if (!lonlat.to_lonlat)
+    if (!dem.georef_current())
+        throw Error("segment",
+                    "the DEM has no georeference for its CRS and grid; call "
+                    "geo::georeference(dem)");
+    if (!dem.georef.lonlat)
         throw Error("segment", "cannot transform the DEM's CRS to longitude/latitude");
+    const LonLatMapping& lonlat = *dem.georef.lonlat;
     const int W = dem.width, H = dem.height;
     const double a = dem.body.semi_major_axis, f = dem.body.flattening;
 

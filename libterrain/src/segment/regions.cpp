@@ -6,7 +6,6 @@
 #include <string>
 #include <unordered_map>
 
-#include "../io/lonlat_frame.hpp"
 #include "pixel_areas.hpp"
 #include "terrain/core/error.hpp"
 #include "terrain/mesh/dem_to_mesh.hpp"
@@ -149,11 +148,15 @@ void set_points(RegionGraph& graph, const TriangleMesh& mesh, const Dem* dem) {
     }
     graph.point_frame = PointFrame::map;
     if (!dem->crs_wkt.empty()) {
-        const io::LonLatFrame frame(*dem, "segment");
-        if (!frame.transform(x.size(), x.data(), y.data()))
+        if (!dem->georef_current() || !dem->georef.output_lonlat)
+            throw Error("segment",
+                        "the DEM has no longitude/latitude on its body (no "
+                        "georeference for its CRS and grid, or no transformation)");
+        const LonLatMapping& frame = *dem->georef.output_lonlat;
+        if (!frame.to_lonlat(x.size(), x.data(), y.data()))
             throw Error("segment", "a region's point has no longitude/latitude on the body");
         graph.point_frame = PointFrame::lonlat;
-        graph.point_crs_wkt = frame.wkt();
+        graph.point_crs_wkt = frame.lonlat_crs_wkt();
     }
     for (std::size_t i = 0; i < graph.regions.size(); ++i) {
         graph.regions[i].point[0] = x[i];

@@ -1,6 +1,7 @@
 #pragma once
-// The body a DEM lies on (Earth, Moon, Mars, Vesta, ...) and its reference ellipsoid,
-// identified from the raster's CRS. See docs/bodies-and-elevation.md.
+// The body a DEM lies on (Earth, Moon, Mars, Vesta, ...) and its reference ellipsoid. The geo
+// layer identifies it from the raster's CRS (terrain/geo/body.hpp). See
+// docs/bodies-and-elevation.md.
 
 #include <string>
 
@@ -16,14 +17,8 @@ struct Body {
     bool is_local_grid() const { return !has_crs; }
 };
 
-// The body described by a CRS given as WKT (any flavour GDAL reads, including the WKT GDAL
-// builds from PDS labels) or any other definition OGRSpatialReference::SetFromUserInput
-// accepts ("EPSG:4326", "IAU_2015:30100", "ESRI:104903"). Empty text: a local metric grid.
-// Throws terrain::Error when the text is not a CRS.
+// Compatibility: geo::body_from_crs (terrain/geo/body.hpp), defined by the geo layer. Kept
+// until the last caller outside geo/ and io/ moves to it.
 Body body_from_crs(const std::string& crs_definition);
-
-// The canonical body name for a datum/ellipsoid/CRS name and semi-major axis:
-// known names first ("D_MOON", "Mars_2000_IAU_IAG", "VESTA"), then the radius.
-std::string identify_body_name(const std::string& names, double semi_major_axis);
 
 }  // namespace terrain

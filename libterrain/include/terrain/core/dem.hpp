@@ -1,6 +1,7 @@
 #pragma once
 // A DEM grid as read from a raster: values in metres with scale/offset applied, NoData as
-// NaN, the GDAL geotransform and CRS, the body, and whether values are radii or heights.
+// NaN, the GDAL geotransform and CRS, the body, whether values are radii or heights, and the
+// georeference the geo layer computed from the CRS (terrain/geo/georeference.hpp).
 
 #include <array>
 #include <cmath>
@@ -9,16 +10,13 @@
 #include <vector>
 
 #include "terrain/core/body.hpp"
+#include "terrain/core/georef.hpp"
 
 namespace terrain {
 
 enum class ElevationKind { height, radius };
 
 const char* to_string(ElevationKind kind);
-
-// GDAL's affine geotransform: x = t[0] + col*t[1] + row*t[2], y = t[3] + col*t[4] + row*t[5],
-// with (col,row) = (0,0) the top-left corner of the top-left pixel.
-using GeoTransform = std::array<double, 6>;
 
 struct Dem {
     int width = 0;
@@ -32,6 +30,13 @@ struct Dem {
     std::vector<double> values;      // row-major, width*height, NaN = NoData
     std::string source;              // the path it was read from
     int band = 1;
+    // Set by io::read_dem, or by geo::georeference(dem) for a grid made in memory; a grid
+    // without CRS needs none.
+    GridGeoref georef;
+
+    // True when `georef` describes this grid: computed from its CRS, geotransform and size (a
+    // grid without CRS: any georeference of no CRS, the default one included).
+    bool georef_current() const;
 
     std::size_t size() const { return values.size(); }
     std::size_t index(int col, int row) const {

@@ -1,16 +1,11 @@
 #pragma once
-// Version of terrain and of the libraries it was built with.
+// Version of terrain (the libraries it was built with: terrain/io/dependency_versions.hpp).
 
 #include <string>
-#include <utility>
-#include <vector>
 
 namespace terrain {
 
 // "0.1.0"
 std::string version();
-
-// (library, version) pairs: GDAL, PROJ, CGAL, GeographicLib, OpenImageIO, Boost, Eigen, TBB.
-std::vector<std::pair<std::string, std::string>> dependency_versions();
 
 }  // namespace terrain

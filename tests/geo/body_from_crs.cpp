@@ -1,9 +1,9 @@
 #include <catch2/catch.hpp>
 
-#include "terrain/core/body.hpp"
 #include "terrain/core/error.hpp"
+#include "terrain/geo/body.hpp"
 
-using terrain::body_from_crs;
+using terrain::geo::body_from_crs;
 
 TEST_CASE("Earth from EPSG codes, with the WGS84 ellipsoid", "[body]") {
     for (const char* code : {"EPSG:4326", "EPSG:32611", "EPSG:3857"}) {
@@ -56,8 +56,8 @@ TEST_CASE("no CRS is a local metric grid; garbage is an error", "[body]") {
 }
 
 TEST_CASE("names win over radii, and Earth keywords come last", "[body]") {
-    CHECK(terrain::identify_body_name("GCS_MOON D_MOON MOON", 1737400) == "Moon");
-    CHECK(terrain::identify_body_name("MEAN EARTH/POLAR AXIS Moon", 1737400) == "Moon");
-    CHECK(terrain::identify_body_name("GCS_VESTA", 289000) == "Vesta");
-    CHECK(terrain::identify_body_name("Krassowsky 1940", 6378245) == "Earth");
+    CHECK(terrain::geo::identify_body_name("GCS_MOON D_MOON MOON", 1737400) == "Moon");
+    CHECK(terrain::geo::identify_body_name("MEAN EARTH/POLAR AXIS Moon", 1737400) == "Moon");
+    CHECK(terrain::geo::identify_body_name("GCS_VESTA", 289000) == "Vesta");
+    CHECK(terrain::geo::identify_body_name("Krassowsky 1940", 6378245) == "Earth");
 }

@@ -1,4 +1,4 @@
-#include "terrain/core/body.hpp"
+#include "terrain/geo/body.hpp"
 
 #include <ogr_spatialref.h>
 
@@ -10,7 +10,7 @@
 
 #include "terrain/core/error.hpp"
 
-namespace terrain {
+namespace terrain::geo {
 namespace {
 
 struct KnownBody {
@@ -83,6 +83,14 @@ Body body_from_crs(const std::string& crs_definition) {
     if (const char* name = srs.GetName()) names += name;
     body.name = identify_body_name(names, body.semi_major_axis);
     return body;
+}
+
+}  // namespace terrain::geo
+
+namespace terrain {
+
+Body body_from_crs(const std::string& crs_definition) {
+    return geo::body_from_crs(crs_definition);
 }
 
 }  // namespace terrain

@@ -1,21 +1,26 @@
 #include "lonlat_frame.hpp"
 
+#include <cpl_conv.h>
+
 #include <cmath>
 #include <vector>
 
-#include "gdal_support.hpp"
 #include "terrain/core/error.hpp"
 
-namespace terrain::io {
+namespace terrain::geo {
 
-LonLatFrame::LonLatFrame(const Dem& dem, const char* stage) {
-    ensure_gdal_registered();
-    if (dem.crs_wkt.empty()) throw Error(stage, "the DEM has no CRS, so no longitude/latitude");
+LonLatFrame::LonLatFrame(const Dem& dem, const char* stage)
+    : LonLatFrame(dem.crs_wkt, dem.body.name == "Earth",
+                  dem.map_xy(dem.width / 2.0, dem.height / 2.0), stage) {}
+
+LonLatFrame::LonLatFrame(const std::string& crs_wkt, bool earth, std::array<double, 2> centre,
+                         const char* stage) {
+    if (crs_wkt.empty()) throw Error(stage, "the DEM has no CRS, so no longitude/latitude");
     source_ = std::make_unique<OGRSpatialReference>();
-    if (source_->SetFromUserInput(dem.crs_wkt.c_str()) != OGRERR_NONE)
+    if (source_->SetFromUserInput(crs_wkt.c_str()) != OGRERR_NONE)
         throw Error(stage, "cannot read the DEM's CRS");
     source_->SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
-    earth_ = dem.body.name == "Earth";
+    earth_ = earth;
     if (earth_) {
         target_ = std::make_unique<OGRSpatialReference>();
         target_->importFromEPSG(4326);
@@ -27,7 +32,6 @@ LonLatFrame::LonLatFrame(const Dem& dem, const char* stage) {
     to_lonlat_.reset(OGRCreateCoordinateTransformation(source_.get(), target_.get()));
     if (!to_lonlat_)
         throw Error(stage, "cannot transform the DEM's CRS to longitude/latitude on its body");
-    auto centre = dem.map_xy(dem.width / 2.0, dem.height / 2.0);
     int ok = 0;
     if (!to_lonlat_->Transform(1, &centre[0], &centre[1], nullptr, &ok) || !ok)
         throw Error(stage, "the centre of the DEM has no longitude/latitude");
@@ -64,4 +68,18 @@ bool LonLatFrame::transform(std::size_t count, double* x, double* y) const {
     return true;
 }
 
-}  // namespace terrain::io
+bool LonLatFrame::transform(std::size_t count, double* x, double* y, std::uint8_t* ok) const {
+    if (count == 0) return true;
+    std::vector<int> done(count, 0);
+    const bool any = to_lonlat_->Transform(count, x, y, nullptr, done.data());
+    bool all = any;
+    for (std::size_t i = 0; i < count; ++i) {
+        const bool good = any && done[i] && std::isfinite(x[i]) && std::isfinite(y[i]);
+        if (good) x[i] = centre_lon_ + std::remainder(x[i] - centre_lon_, 360.0);
+        if (ok) ok[i] = good;
+        all = all && good;
+    }
+    return all;
+}
+
+}  // namespace terrain::geo
