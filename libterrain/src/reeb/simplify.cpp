@@ -29,8 +29,8 @@ namespace terrain::reeb {
 namespace {
 
 using detail::i32;
+using detail::idx;
 using detail::kNone;
-using detail::z;
 
 // Passes that gather from or scatter to random places start fetching them this many steps
 // ahead.
@@ -79,23 +79,23 @@ class ArcQueue {
         if (at_[a] == kNone) {
             heap_.push_back(key);
             up(heap_.size() - 1, key);
-        } else if (key < heap_[z(at_[a])]) {
-            up(z(at_[a]), key);
+        } else if (key < heap_[idx(at_[a])]) {
+            up(idx(at_[a]), key);
         } else {
-            down(z(at_[a]), key);
+            down(idx(at_[a]), key);
         }
     }
     void erase(i32 a) {
-        const i32 i = at_[z(a)];
+        const i32 i = at_[idx(a)];
         if (i == kNone) return;
-        at_[z(a)] = kNone;
+        at_[idx(a)] = kNone;
         const std::uint64_t last = heap_.back();
         heap_.pop_back();
-        if (z(i) == heap_.size()) return;
-        if (last < heap_[z(i)])
-            up(z(i), last);
+        if (idx(i) == heap_.size()) return;
+        if (last < heap_[idx(i)])
+            up(idx(i), last);
         else
-            down(z(i), last);
+            down(idx(i), last);
     }
     // The root's hole goes down to a leaf along the smaller children, and the last entry
     // comes up from there (it mostly belongs near the leaves).
@@ -151,10 +151,10 @@ class ArcQueue {
 // The root of x in a forest of parent links (kNone at a root); the path is compressed.
 i32 find_root(std::vector<i32>& parent, i32 x) {
     i32 root = x;
-    while (parent[z(root)] != kNone) root = parent[z(root)];
+    while (parent[idx(root)] != kNone) root = parent[idx(root)];
     while (x != root) {
-        const i32 up = parent[z(x)];
-        parent[z(x)] = root;
+        const i32 up = parent[idx(x)];
+        parent[idx(x)] = root;
         x = up;
     }
     return root;
@@ -163,7 +163,7 @@ i32 find_root(std::vector<i32>& parent, i32 x) {
 std::vector<double> node_areas(const TriangleMesh& mesh, const ReebGraph& g) {
     std::vector<double> area(g.node_count(), 0.0);
     for (std::size_t v = 0; v < g.vertex_nodes.size(); ++v)
-        area[z(g.vertex_nodes[v])] += mesh.vertex_areas.empty() ? 1.0 : mesh.vertex_areas[v];
+        area[idx(g.vertex_nodes[v])] += mesh.vertex_areas.empty() ? 1.0 : mesh.vertex_areas[v];
     return area;
 }
 
@@ -172,7 +172,7 @@ std::vector<double> node_areas(const TriangleMesh& mesh, const ReebGraph& g) {
 double node_area(const TriangleMesh& mesh, const ReebGraph& g, std::size_t n,
                  std::vector<i32>& scratch) {
     const i32* v = g.node_vertices.data() + g.node_vertex_offsets[n];
-    const std::size_t count = z(g.node_vertex_offsets[n + 1] - g.node_vertex_offsets[n]);
+    const std::size_t count = idx(g.node_vertex_offsets[n + 1] - g.node_vertex_offsets[n]);
     if (!std::is_sorted(v, v + count)) {
         scratch.assign(v, v + count);
         std::sort(scratch.begin(), scratch.end());
@@ -180,7 +180,7 @@ double node_area(const TriangleMesh& mesh, const ReebGraph& g, std::size_t n,
     }
     double s = 0;
     for (std::size_t i = 0; i < count; ++i)
-        s += mesh.vertex_areas.empty() ? 1.0 : mesh.vertex_areas[z(v[i])];
+        s += mesh.vertex_areas.empty() ? 1.0 : mesh.vertex_areas[idx(v[i])];
     return s;
 }
 
@@ -196,22 +196,22 @@ class Simplifier {
         // arc_nodes (`placed` says which positions hold their node); then the new numbers.
         constexpr i32 kEnd = -2;
         at_.assign(nn, kNone);
-        for (const auto& e : g.arcs) at_[z(e[0])] = at_[z(e[1])] = kEnd;
+        for (const auto& e : g.arcs) at_[idx(e[0])] = at_[idx(e[1])] = kEnd;
         std::vector<char> placed(nl, 0);
         for (std::size_t p = 0; p < nl; ++p) {
             const i32 r = g.arc_nodes[p];
             // (A critical node in a list keeps its neighbours in its record, which an arc end
             // needs for its arcs.)
-            if (at_[z(r)] != kNone)
+            if (at_[idx(r)] != kNone)
                 throw Error("simplify", "the graph is not valid: node " + std::to_string(r) +
                                             " is an arc end or in two arcs' lists");
-            if (g.node_kinds[z(r)] != NodeKind::regular) continue;
-            at_[z(r)] = static_cast<i32>(p);
+            if (g.node_kinds[idx(r)] != NodeKind::regular) continue;
+            at_[idx(r)] = static_cast<i32>(p);
             placed[p] = 1;
         }
         first_ = 0;
         for (const i32 i : at_) first_ += i < 0;
-        crit_.resize(z(first_));
+        crit_.resize(idx(first_));
         reg_.resize(nl);
         total_area_ = 0;
         std::vector<i32> scratch;
@@ -221,19 +221,19 @@ class Simplifier {
                 const std::size_t m = n + kAhead;
                 const i32 i = g.node_vertex_offsets[m];
                 if (!mesh.vertex_areas.empty() && i < g.node_vertex_offsets[m + 1])
-                    __builtin_prefetch(&mesh.vertex_areas[z(g.node_vertices[z(i)])]);
-                if (at_[m] >= 0) __builtin_prefetch(&reg_[z(at_[m])], 1);
+                    __builtin_prefetch(&mesh.vertex_areas[idx(g.node_vertices[idx(i)])]);
+                if (at_[m] >= 0) __builtin_prefetch(&reg_[idx(at_[m])], 1);
             }
             const double area = node_area(mesh, g, n, scratch);
             total_area_ += area;
             if (at_[n] < 0) {
-                crit_[z(k)].area = area;
-                crit_[z(k)].value = g.node_values[n];
-                crit_[z(k)].flags = g.node_kinds[n] != NodeKind::regular ? kCritical : 0;
+                crit_[idx(k)].area = area;
+                crit_[idx(k)].value = g.node_values[n];
+                crit_[idx(k)].flags = g.node_kinds[n] != NodeKind::regular ? kCritical : 0;
                 at_[n] = k++;
             } else {
-                reg_[z(at_[n])].area = area;
-                reg_[z(at_[n])].value = g.node_values[n];
+                reg_[idx(at_[n])].area = area;
+                reg_[idx(at_[n])].value = g.node_values[n];
                 at_[n] += first_;
             }
         }
@@ -246,16 +246,16 @@ class Simplifier {
         for (std::size_t a = 0; a < na; ++a) {
             Arc& arc = arcs_[a];
             if (a + kAhead < na)
-                for (const i32 e : g.arcs[a + kAhead]) __builtin_prefetch(&at_[z(e)]);
+                for (const i32 e : g.arcs[a + kAhead]) __builtin_prefetch(&at_[idx(e)]);
             if (a + kAhead / 2 < na)
                 for (const i32 e : g.arcs[a + kAhead / 2])
-                    __builtin_prefetch(&crit_[z(at_[z(e)])], 1);
-            arc.end = {at_[z(g.arcs[a][0])], at_[z(g.arcs[a][1])]};
+                    __builtin_prefetch(&crit_[idx(at_[idx(e)])], 1);
+            arc.end = {at_[idx(g.arcs[a][0])], at_[idx(g.arcs[a][1])]};
             for (const i32 e : arc.end) link(static_cast<i32>(a), e);
-            ++crit_[z(arc.end[1])].down;
+            ++crit_[idx(arc.end[1])].down;
             arc.set = static_cast<i32>(a);
             for (i32 p = g.arc_offsets[a]; p < g.arc_offsets[a + 1]; ++p) {
-                const i32 r = placed[z(p)] ? first_ + p : at_[z(g.arc_nodes[z(p)])];
+                const i32 r = placed[idx(p)] ? first_ + p : at_[idx(g.arc_nodes[idx(p)])];
                 forward(r) = -2 - arc.set;
                 if (arc.tail == kNone) {
                     arc.head = r;
@@ -272,7 +272,7 @@ class Simplifier {
     void run(const ProgressFn& progress, SimplifyResult& result) {
         for (std::size_t a = 0; a < arcs_.size(); ++a) {
             if (a + kAhead < arcs_.size())
-                for (const i32 e : arcs_[a + kAhead].end) __builtin_prefetch(&crit_[z(e)]);
+                for (const i32 e : arcs_[a + kAhead].end) __builtin_prefetch(&crit_[idx(e)]);
             if (!candidate(static_cast<i32>(a))) continue;
             queue_.seed(mark_queued(static_cast<i32>(a)));
             ++pushed_;
@@ -287,14 +287,15 @@ class Simplifier {
             const std::uint64_t far = queue_.sorted_ahead(kAhead), near = queue_.sorted_ahead(4);
             if (far != ArcQueue::kEmpty) __builtin_prefetch(&arcs_[far & 0xffffffffu]);
             if (near != ArcQueue::kEmpty)
-                for (const i32 e : arcs_[near & 0xffffffffu].end) __builtin_prefetch(&crit_[z(e)]);
+                for (const i32 e : arcs_[near & 0xffffffffu].end)
+                    __builtin_prefetch(&crit_[idx(e)]);
             const std::uint64_t top = queue_.top();
-            const std::size_t next = top == ArcQueue::kEmpty ? z(a) : z(top & 0xffffffffu);
+            const std::size_t next = top == ArcQueue::kEmpty ? idx(a) : idx(top & 0xffffffffu);
             __builtin_prefetch(&arcs_[next]);
-            arcs_[z(a)].queued = kNotQueued;
+            arcs_[idx(a)].queued = kNotQueued;
             if (!candidate(a)) continue;
             cancel(redirect(a), result);
-            for (const i32 e : arcs_[next].end) __builtin_prefetch(&crit_[z(e)]);
+            for (const i32 e : arcs_[next].end) __builtin_prefetch(&crit_[idx(e)]);
             if ((++done & 0xfff) == 0 && initial > 0)
                 report_progress(progress, std::min(0.9, 0.9 * done / static_cast<double>(initial)),
                                 "simplify");
@@ -351,11 +352,15 @@ class Simplifier {
     }
 
     // Any node's fields (a critical node's list neighbours are used once it is regular).
-    double& area(i32 n) { return n < first_ ? crit_[z(n)].area : reg_[z(n - first_)].area; }
-    float value(i32 n) const { return n < first_ ? crit_[z(n)].value : reg_[z(n - first_)].value; }
-    i32& forward(i32 n) { return n < first_ ? crit_[z(n)].forward : reg_[z(n - first_)].forward; }
-    i32& prev(i32 n) { return n < first_ ? crit_[z(n)].own[0] : reg_[z(n - first_)].prev; }
-    i32& next(i32 n) { return n < first_ ? crit_[z(n)].own[1] : reg_[z(n - first_)].next; }
+    double& area(i32 n) { return n < first_ ? crit_[idx(n)].area : reg_[idx(n - first_)].area; }
+    float value(i32 n) const {
+        return n < first_ ? crit_[idx(n)].value : reg_[idx(n - first_)].value;
+    }
+    i32& forward(i32 n) {
+        return n < first_ ? crit_[idx(n)].forward : reg_[idx(n - first_)].forward;
+    }
+    i32& prev(i32 n) { return n < first_ ? crit_[idx(n)].own[0] : reg_[idx(n - first_)].prev; }
+    i32& next(i32 n) { return n < first_ ? crit_[idx(n)].own[1] : reg_[idx(n - first_)].next; }
 
     // A critical node's arcs, the newest last: in its record while they fit, else in the arena.
     i32* run(Crit& c) { return c.shift == 0 ? c.own.data() : arena_.data() + c.offset; }
@@ -365,7 +370,7 @@ class Simplifier {
     // The arcs at a critical node, newest first.
     template <class F>
     void for_each_arc(i32 n, F&& f) const {
-        const Crit& c = crit_[z(n)];
+        const Crit& c = crit_[idx(n)];
         const i32* r = run(c);
         for (i32 i = c.size - 1; i >= 0; --i) f(r[i]);
     }
@@ -375,10 +380,10 @@ class Simplifier {
     }
     // Arc a joins node n; a full run moves to the arena's end with twice the room.
     void link(i32 a, i32 n) {
-        Crit& c = crit_[z(n)];
+        Crit& c = crit_[idx(n)];
         if (c.size == kInline << c.shift) {
             const i32 offset = static_cast<i32>(arena_.size());
-            arena_.resize(arena_.size() + 2 * z(c.size));
+            arena_.resize(arena_.size() + 2 * idx(c.size));
             std::copy_n(run(c), c.size, arena_.data() + offset);
             c.offset = offset;
             ++c.shift;
@@ -387,7 +392,7 @@ class Simplifier {
     }
     // Arc a leaves node n (the newest of its entries there, for an arc with both ends at n).
     void unlink(i32 a, i32 n) {
-        Crit& c = crit_[z(n)];
+        Crit& c = crit_[idx(n)];
         if (c.size == 1) {  // its only arc
             c.size = 0;
             return;
@@ -401,35 +406,35 @@ class Simplifier {
 
     // Arcs below and above a critical node: its arcs ending there as the upper / lower end
     // (`down` is updated wherever an arc end moves or an arc turns around).
-    i32 degree(i32 n) const { return crit_[z(n)].size; }
-    i32 down(i32 n) const { return crit_[z(n)].down; }
-    i32 up(i32 n) const { return crit_[z(n)].size - crit_[z(n)].down; }
+    i32 degree(i32 n) const { return crit_[idx(n)].size; }
+    i32 down(i32 n) const { return crit_[idx(n)].down; }
+    i32 up(i32 n) const { return crit_[idx(n)].size - crit_[idx(n)].down; }
     bool extremum(i32 n) const { return down(n) == 0 || up(n) == 0; }
     float persistence(i32 a) const {
-        const Arc& arc = arcs_[z(a)];
-        return std::fabs(crit_[z(arc.end[1])].value - crit_[z(arc.end[0])].value);
+        const Arc& arc = arcs_[idx(a)];
+        return std::fabs(crit_[idx(arc.end[1])].value - crit_[idx(arc.end[0])].value);
     }
     double area_ratio(i32 a) const {
-        const Arc& arc = arcs_[z(a)];
+        const Arc& arc = arcs_[idx(a)];
         double s = arc.area;
-        for (const i32 n : arc.end) s += crit_[z(n)].area / static_cast<double>(degree(n));
+        for (const i32 n : arc.end) s += crit_[idx(n)].area / static_cast<double>(degree(n));
         return s / total_area_;
     }
     bool multi(i32 a) const {
-        const Arc& arc = arcs_[z(a)];
+        const Arc& arc = arcs_[idx(a)];
         const i32 n = degree(arc.end[0]) <= degree(arc.end[1]) ? arc.end[0] : arc.end[1];
         if (degree(n) == 1) return false;  // a is its only arc
         bool found = false;
         for_each_arc(n, [&](i32 b) {
             if (b == a) return;
-            const auto& e = arcs_[z(b)].end;
+            const auto& e = arcs_[idx(b)].end;
             found |= (e[0] == arc.end[0] && e[1] == arc.end[1]) ||
                      (e[0] == arc.end[1] && e[1] == arc.end[0]);
         });
         return found;
     }
     bool candidate(i32 a) const {
-        const Arc& arc = arcs_[z(a)];
+        const Arc& arc = arcs_[idx(a)];
         if (arc.set == kNone) return false;
         if (!extremum(arc.end[0]) && !extremum(arc.end[1])) return false;
         if (multi(a)) return false;
@@ -439,7 +444,7 @@ class Simplifier {
     // queue.
     void consider(i32 a) {
         if (!candidate(a)) {
-            arcs_[z(a)].queued = kNotQueued;
+            arcs_[idx(a)].queued = kNotQueued;
             queue_.erase(a);
             return;
         }
@@ -452,7 +457,7 @@ class Simplifier {
     // queued with that key already.
     std::uint64_t mark_queued(i32 a) {
         const std::uint64_t key = key_of(persistence(a), a);
-        std::uint32_t& queued = arcs_[z(a)].queued;
+        std::uint32_t& queued = arcs_[idx(a)].queued;
         if (queued == key >> 32) return ArcQueue::kEmpty;
         queued = static_cast<std::uint32_t>(key >> 32);
         return key;
@@ -482,14 +487,14 @@ class Simplifier {
     // Node n's vertices (and everything already forwarded to it) join the critical node keep.
     void absorb(i32 n, i32 keep) {
         forward(n) = keep;
-        crit_[z(keep)].area += area(n);
+        crit_[idx(keep)].area += area(n);
     }
     // The regular nodes of an arc join keep, their area at once (the output tells them);
     // the arc, if it lives on, starts a new set.
     void absorb_list(Arc& arc, i32 keep, bool lives) {
         if (arc.head != kNone) {
-            crit_[z(keep)].area += arc.area;
-            set_fate_[z(arc.set)] = keep;
+            crit_[idx(keep)].area += arc.area;
+            set_fate_[idx(arc.set)] = keep;
             if (lives) {
                 arc.set = static_cast<i32>(set_fate_.size());
                 set_fate_.push_back(kNone);
@@ -503,8 +508,8 @@ class Simplifier {
     // Arc b now ends at keep (whose value may have changed): regular nodes outside the new
     // value range join keep, and the ends swap if the other end is now on the wrong side.
     void fit_arc(i32 b, i32 keep) {
-        Arc& arc = arcs_[z(b)];
-        const float fk = crit_[z(keep)].value;
+        Arc& arc = arcs_[idx(b)];
+        const float fk = crit_[idx(keep)].value;
         if (arc.end[1] == keep) {
             while (arc.tail != kNone && value(arc.tail) > fk) {
                 const i32 r = arc.tail;
@@ -516,10 +521,10 @@ class Simplifier {
                 arc.area -= area(r);
                 absorb(r, keep);
             }
-            if (crit_[z(arc.end[0])].value > fk) {
+            if (crit_[idx(arc.end[0])].value > fk) {
                 absorb_list(arc, keep, true);
-                ++crit_[z(arc.end[0])].down;
-                --crit_[z(keep)].down;
+                ++crit_[idx(arc.end[0])].down;
+                --crit_[idx(keep)].down;
                 turned_.push_back(arc.end[0]);
                 std::swap(arc.end[0], arc.end[1]);
             }
@@ -534,10 +539,10 @@ class Simplifier {
                 arc.area -= area(r);
                 absorb(r, keep);
             }
-            if (crit_[z(arc.end[1])].value < fk) {
+            if (crit_[idx(arc.end[1])].value < fk) {
                 absorb_list(arc, keep, true);
-                --crit_[z(arc.end[1])].down;
-                ++crit_[z(keep)].down;
+                --crit_[idx(arc.end[1])].down;
+                ++crit_[idx(keep)].down;
                 turned_.push_back(arc.end[1]);
                 std::swap(arc.end[0], arc.end[1]);
             }
@@ -552,11 +557,11 @@ class Simplifier {
         if (degree(n) != 2 || down(n) != 1) return false;
         arcs_at(n, all_);
         i32 lower = all_[0], upper = all_[1];
-        if (arcs_[z(lower)].end[1] != n) std::swap(lower, upper);
-        Arc& L = arcs_[z(lower)];
-        Arc& U = arcs_[z(upper)];
+        if (arcs_[idx(lower)].end[1] != n) std::swap(lower, upper);
+        Arc& L = arcs_[idx(lower)];
+        Arc& U = arcs_[idx(upper)];
         if (L.end[0] == U.end[1]) return false;
-        Crit& k = crit_[z(n)];
+        Crit& k = crit_[idx(n)];
         k.size = 0;  // its two arcs leave it, and its record takes its list neighbours
         k.down = 0;
         k.flags &= ~kCritical;
@@ -572,7 +577,7 @@ class Simplifier {
         L.area += k.area + U.area;
         const i32 q = U.end[1];
         L.end[1] = q;
-        set_parent_[z(U.set)] = L.set;
+        set_parent_[idx(U.set)] = L.set;
         U.set = kNone;
         unlink(upper, q);
         link(lower, q);
@@ -581,7 +586,7 @@ class Simplifier {
         out.push_back(lower);
         const i32 m = degree(L.end[0]) <= degree(L.end[1]) ? L.end[0] : L.end[1];
         for_each_arc(m, [&](i32 b) {
-            const auto& e = arcs_[z(b)].end;
+            const auto& e = arcs_[idx(b)].end;
             if (b != lower && e[0] == L.end[0] && e[1] == L.end[1]) out.push_back(b);
         });
         return true;
@@ -593,19 +598,19 @@ class Simplifier {
     // extremum to the farther value would cut across the closer saddle's branches (the
     // rewritten field would then disagree with the graph).
     i32 redirect(i32 a) const {
-        const Arc& arc = arcs_[z(a)];
+        const Arc& arc = arcs_[idx(a)];
         const i32 lo = arc.end[0], hi = arc.end[1];
         const bool lo_ext = down(lo) == 0, hi_ext = up(hi) == 0;
         if (lo_ext == hi_ext) return a;  // two extrema: their own rules
         const i32 ext = lo_ext ? lo : hi;
         if (degree(ext) < 2) return a;
-        const float fe = crit_[z(ext)].value;
+        const float fe = crit_[idx(ext)].value;
         i32 best = a;
-        float best_gap = std::fabs(crit_[z(lo_ext ? hi : lo)].value - fe);
+        float best_gap = std::fabs(crit_[idx(lo_ext ? hi : lo)].value - fe);
         for_each_arc(ext, [&](i32 b) {
-            const auto& e = arcs_[z(b)].end;
+            const auto& e = arcs_[idx(b)].end;
             const i32 other = e[0] == ext ? e[1] : e[0];
-            const float gap = std::fabs(crit_[z(other)].value - fe);
+            const float gap = std::fabs(crit_[idx(other)].value - fe);
             if (gap < best_gap && !extremum(other) && !multi(b)) {
                 best = b;
                 best_gap = gap;
@@ -616,7 +621,7 @@ class Simplifier {
 
     void cancel(i32 a, SimplifyResult& result) {
         turned_.clear();
-        Arc& arc = arcs_[z(a)];
+        Arc& arc = arcs_[idx(a)];
         const i32 lo = arc.end[0], hi = arc.end[1];
         const bool lo_ext = down(lo) == 0, hi_ext = up(hi) == 0;
         // Two extrema: they meet at the midpoint of their values, unless one of them has no
@@ -629,24 +634,24 @@ class Simplifier {
         i32 keep = lo;  // the midpoint, or a saddle (or degenerate extremum) below
         if (!midpoint && (both ? degree(lo) == 1 : lo_ext)) keep = hi;
         const i32 gone = keep == lo ? hi : lo;
-        const double share_before = crit_[z(keep)].area / static_cast<double>(degree(keep));
+        const double share_before = crit_[idx(keep)].area / static_cast<double>(degree(keep));
         const bool ext_before = extremum(keep);
-        if (midpoint) crit_[z(keep)].value = 0.5f * (crit_[z(lo)].value + crit_[z(hi)].value);
+        if (midpoint) crit_[idx(keep)].value = 0.5f * (crit_[idx(lo)].value + crit_[idx(hi)].value);
         ++(both ? result.extremum_extremum : result.saddle_extremum);
-        Crit& k = crit_[z(keep)];
+        Crit& k = crit_[idx(keep)];
         k.flags |= kModified;
         unlink(a, lo);
         unlink(a, hi);
-        --crit_[z(hi)].down;
+        --crit_[idx(hi)].down;
         absorb_list(arc, keep, false);
         arc.set = kNone;
         absorb(gone, keep);
         std::vector<i32>& touched = touched_;
         arcs_at(gone, touched);
-        crit_[z(gone)].size = 0;
-        crit_[z(gone)].down = 0;
+        crit_[idx(gone)].size = 0;
+        crit_[idx(gone)].down = 0;
         for (const i32 b : touched) {
-            Arc& other = arcs_[z(b)];
+            Arc& other = arcs_[idx(b)];
             link(b, keep);
             for (auto& e : other.end)
                 if (e == gone) e = keep;
@@ -672,7 +677,7 @@ class Simplifier {
         // that node may now be regular, or an extremum whose arcs are new candidates.
         for (const i32 n : turned_) {
             if (degree(n) == 0) continue;
-            crit_[z(n)].flags |= kModified;
+            crit_[idx(n)].flags |= kModified;
             if (!regularize(n, touched)) for_each_arc(n, [&](i32 b) { touched.push_back(b); });
         }
         for (const i32 b : touched) consider(b);
@@ -684,22 +689,22 @@ class Simplifier {
         // only absorbed into critical nodes); for a remaining node, -2 - its new id.
         // A listed node's forward: the fate of its set's root (kNone for a list still there).
         const auto fate = [&](i32 f) {
-            return f > -2 ? f : set_fate_[z(find_root(set_parent_, -2 - f))];
+            return f > -2 ? f : set_fate_[idx(find_root(set_parent_, -2 - f))];
         };
-        std::vector<i32> code(z(first_) + nl);
-        for (std::size_t k = 0; k < z(first_); ++k) code[k] = fate(crit_[k].forward);
-        for (std::size_t k = 0; k < z(first_); ++k)
+        std::vector<i32> code(idx(first_) + nl);
+        for (std::size_t k = 0; k < idx(first_); ++k) code[k] = fate(crit_[k].forward);
+        for (std::size_t k = 0; k < idx(first_); ++k)
             if (code[k] != kNone) code[k] = find_root(code, code[k]);
         for (std::size_t p = 0; p < nl; ++p) {
             const i32 f = fate(reg_[p].forward);
-            code[z(first_) + p] = f == kNone || code[z(f)] == kNone ? f : code[z(f)];
+            code[idx(first_) + p] = f == kNone || code[idx(f)] == kNone ? f : code[idx(f)];
         }
         // The remaining nodes are numbered in the order of the old ones; at_ takes each old
         // node's new node (first -2 - the node that took it, for the absorbed ones).
         std::vector<std::array<i32, 2>> kept;  // {old node, internal index} by new id
         for (std::size_t n = 0; n < nn; ++n) {
-            if (n + kAhead < nn) __builtin_prefetch(&code[z(at_[n + kAhead])]);
-            i32& c = code[z(at_[n])];
+            if (n + kAhead < nn) __builtin_prefetch(&code[idx(at_[n + kAhead])]);
+            i32& c = code[idx(at_[n])];
             if (c != kNone) {
                 at_[n] = -2 - c;
                 continue;
@@ -711,8 +716,8 @@ class Simplifier {
         const std::size_t count = kept.size();
         std::vector<i32> size(count + 1, 0);
         for (std::size_t n = 0; n < nn; ++n) {
-            if (at_[n] < 0) at_[n] = -2 - code[z(-2 - at_[n])];
-            size[z(at_[n]) + 1] += g_.node_vertex_offsets[n + 1] - g_.node_vertex_offsets[n];
+            if (at_[n] < 0) at_[n] = -2 - code[idx(-2 - at_[n])];
+            size[idx(at_[n]) + 1] += g_.node_vertex_offsets[n + 1] - g_.node_vertex_offsets[n];
         }
         ReebGraph& out = result.graph;
         out.node_values.resize(count);
@@ -723,16 +728,16 @@ class Simplifier {
         for (std::size_t nid = 0; nid < count; ++nid) {
             const auto [n, i] = kept[nid];
             out.node_values[nid] = value(i);
-            if (i >= first_ || !(crit_[z(i)].flags & kCritical)) continue;
+            if (i >= first_ || !(crit_[idx(i)].flags & kCritical)) continue;
             const i32 d = down(i), u = up(i);
             out.node_kinds[nid] = d == 0   ? NodeKind::minimum
                                   : u == 0 ? NodeKind::maximum
                                            : NodeKind::saddle;
-            const bool unchanged = !(crit_[z(i)].flags & kModified);
-            out.node_lower_links[nid] =
-                unchanged ? g_.node_lower_links[z(n)] : static_cast<std::uint8_t>(std::min(d, 255));
-            out.node_upper_links[nid] =
-                unchanged ? g_.node_upper_links[z(n)] : static_cast<std::uint8_t>(std::min(u, 255));
+            const bool unchanged = !(crit_[idx(i)].flags & kModified);
+            out.node_lower_links[nid] = unchanged ? g_.node_lower_links[idx(n)]
+                                                  : static_cast<std::uint8_t>(std::min(d, 255));
+            out.node_upper_links[nid] = unchanged ? g_.node_upper_links[idx(n)]
+                                                  : static_cast<std::uint8_t>(std::min(u, 255));
         }
         // Vertices: grouped by new node, in the order of their old nodes.
         for (std::size_t i = 1; i < size.size(); ++i) size[i] += size[i - 1];
@@ -743,19 +748,19 @@ class Simplifier {
             if (n + kAhead < nn) {
                 const i32 i = g_.node_vertex_offsets[n + kAhead];
                 if (i < g_.node_vertex_offsets[n + kAhead + 1])
-                    __builtin_prefetch(&out.vertex_nodes[z(g_.node_vertices[z(i)])], 1);
+                    __builtin_prefetch(&out.vertex_nodes[idx(g_.node_vertices[idx(i)])], 1);
             }
             const i32 nid = at_[n];
             for (i32 i = g_.node_vertex_offsets[n]; i < g_.node_vertex_offsets[n + 1]; ++i) {
-                const i32 v = g_.node_vertices[z(i)];
-                out.node_vertices[z(size[z(nid)]++)] = v;
-                out.vertex_nodes[z(v)] = nid;
+                const i32 v = g_.node_vertices[idx(i)];
+                out.node_vertices[idx(size[idx(nid)]++)] = v;
+                out.vertex_nodes[idx(v)] = nid;
             }
         }
         result.field.resize(g_.vertex_nodes.size());
         for (std::size_t v = 0; v < result.field.size(); ++v)
-            result.field[v] = out.node_values[z(out.vertex_nodes[v])];
-        const auto new_id = [&](i32 i) { return -2 - code[z(i)]; };
+            result.field[v] = out.node_values[idx(out.vertex_nodes[v])];
+        const auto new_id = [&](i32 i) { return -2 - code[idx(i)]; };
         out.arc_offsets.assign(1, 0);
         for (const Arc& arc : arcs_) {
             if (arc.set == kNone) continue;
@@ -764,7 +769,7 @@ class Simplifier {
             for (i32 r = arc.head; r != kNone; r = next(r)) {
                 const i32 nid = new_id(r);
                 out.arc_nodes.push_back(nid);
-                out.node_arcs[z(nid)] = id;
+                out.node_arcs[idx(nid)] = id;
             }
             out.arc_offsets.push_back(static_cast<i32>(out.arc_nodes.size()));
         }
@@ -800,11 +805,11 @@ ArcMetrics arc_metrics(const TriangleMesh& mesh, const ReebGraph& g) {
     m.area_ratio.resize(g.arc_count());
     for (std::size_t a = 0; a < g.arc_count(); ++a) {
         const auto [lo, hi] = g.arcs[a];
-        m.persistence[a] = std::fabs(g.node_values[z(hi)] - g.node_values[z(lo)]);
-        double s = area[z(lo)] / static_cast<double>(inc.degree(lo)) +
-                   area[z(hi)] / static_cast<double>(inc.degree(hi));
+        m.persistence[a] = std::fabs(g.node_values[idx(hi)] - g.node_values[idx(lo)]);
+        double s = area[idx(lo)] / static_cast<double>(inc.degree(lo)) +
+                   area[idx(hi)] / static_cast<double>(inc.degree(hi));
         for (i32 i = g.arc_offsets[a]; i < g.arc_offsets[a + 1]; ++i)
-            s += area[z(g.arc_nodes[z(i)])];
+            s += area[idx(g.arc_nodes[idx(i)])];
         m.area_ratio[a] = s / total;
     }
     return m;
