@@ -197,6 +197,7 @@ void Simplifier::cancel(i32 a, SimplifyResult& result) {
             ++result.made_regular;
             ++result.turned_made_regular;
         } else {
+            result.turned_made_extremum += extremum(n);
             for_each_arc(n, [&](i32 b) { touched.push_back(b); });
         }
     }
