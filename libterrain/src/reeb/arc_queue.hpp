@@ -39,7 +39,7 @@ class ArcQueue {
         detail::release(heap_);
         detail::release(sorted_);
     }
-    // The first candidates, in any order, then sorted by seal().
+    // The first candidates, in increasing arc order, then sorted by seal().
     void seed(std::uint64_t key) { sorted_.push_back(key); }
     void seal() {
         // Seeded in increasing arc order: a stable sort of the high halves sorts the keys.
