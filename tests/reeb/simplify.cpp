@@ -60,6 +60,17 @@ const Sample& vesta() {
     return s;
 }
 
+// Checks a simplification against the counts it reports: every cancellation removes one
+// critical node and one arc, and so does every node made regular (its two arcs merge).
+void check_path(const reeb::ReebGraph& before, const reeb::SimplifyResult& r) {
+    const auto b = reeb::summarize(before), a = reeb::summarize(r.graph);
+    const auto cancelled = r.saddle_extremum + r.extremum_extremum;
+    CHECK(b.critical - a.critical == cancelled + r.made_regular);
+    CHECK(b.arcs - a.arcs == cancelled + r.made_regular);
+    CHECK(r.turned_made_regular <= r.made_regular);
+    CHECK(r.turned_made_regular + r.turned_made_extremum <= r.arcs_turned);
+}
+
 }  // namespace
 
 TEST_CASE("Two hills: persistence above the smaller hill cuts it down, keeps the high one",
@@ -114,17 +125,41 @@ TEST_CASE("Arcs turned around elsewhere: their far nodes become regular or extre
     // A cancellation moves the kept node's value; an arc of it whose far node is now on the
     // other side turns around, and that far node may be left with one arc below and one
     // above (it must become regular) or become an extremum (its arcs are new candidates).
-    // This 300x300 synthetic tile meets the first case at area ratio 0.5 %.
+    // The Vesta sample's shape index meets the first case at area ratio 1 %; a noisy plate
+    // with two holes meets the second at 5 %.
+    const auto& s = vesta();
+    const auto g = reeb::build_reeb_graph(s.mesh, s.si);
+    for (const double a : {0.5, 1.0}) {
+        INFO("Vesta, area ratio " << a);
+        const auto r = simplified(s.mesh, s.si, 0, a);  // checks the graph
+        check_path(g, r);
+        CHECK(critical_nodes(reeb::build_reeb_graph(s.mesh, r.field)) == critical_nodes(r.graph));
+        CHECK(r.arcs_turned >= 1);
+        if (a == 1.0) CHECK(r.turned_made_regular >= 1);  // the first case
+    }
+    const auto plate = test::plate_mesh(80, 40, 2);
+    const auto noise = test::noise_field(plate.vertex_count(), 1);
+    const auto r = simplified(plate, noise, 0, 5);
+    check_path(reeb::build_reeb_graph(plate, noise), r);
+    CHECK(r.turned_made_extremum >= 1);  // the second case
+    CHECK(reeb::summarize(r.graph).loops == 2);
+}
+
+TEST_CASE("The counts of a simplification tell its path (synthetic tile)", "[simplify]") {
     synth::VestaTileOptions options;
     options.width = options.height = 300;
     Dem dem = synth::generate_vesta_tile(options);
     geo::georeference(dem);
     const auto mesh = mesh::dem_to_mesh(dem);
     const auto si = field::shape_index_field(mesh);
+    const auto g = reeb::build_reeb_graph(mesh, si);
     for (const auto& [p, a] :
          std::vector<std::pair<double, double>>{{0, 0.1}, {0, 0.5}, {10, 0.1}, {10, 0.5}, {0, 2}}) {
         INFO("persistence " << p << " area ratio " << a);
         const auto r = simplified(mesh, si, p, a);  // checks the graph
+        check_path(g, r);
+        CHECK(r.saddle_extremum > 0);
+        CHECK(r.made_regular > 0);
         CHECK(critical_nodes(reeb::build_reeb_graph(mesh, r.field)) == critical_nodes(r.graph));
     }
 }

@@ -8,8 +8,10 @@
 namespace terrain::detail {
 
 using i32 = std::int32_t;
-inline constexpr i32 kNone = -1;
-inline std::size_t z(i32 i) {
+inline constexpr i32 kNone = -1;  // no vertex, node, arc or triangle
+
+// A 32-bit index as a subscript: v[idx(i)].
+inline std::size_t idx(i32 i) {
     return static_cast<std::size_t>(i);
 }
 

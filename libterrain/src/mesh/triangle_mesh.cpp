@@ -1,4 +1,5 @@
 #include "terrain/mesh/triangle_mesh.hpp"
+#include "../core/disjoint_sets.hpp"
 #include "../core/release.hpp"
 
 #include <algorithm>
@@ -116,12 +117,7 @@ MeshTopology mesh_topology(const TriangleMesh& mesh) {
                 static_cast<std::size_t>(std::lower_bound(first, last, b) - nb.begin());
             uses[slot] = static_cast<std::uint8_t>(std::min(uses[slot] + 1, 3));
         }
-    std::vector<std::uint32_t> parent(topo.vertices);
-    std::iota(parent.begin(), parent.end(), 0u);
-    auto find = [&](std::uint32_t x) {
-        while (parent[x] != x) x = parent[x] = parent[parent[x]];
-        return x;
-    };
+    detail::DisjointSets<std::uint32_t> sets(topo.vertices);
     // Boundary loops: components of the graph of boundary edges.
     std::vector<std::uint32_t> boundary_vertices;
     for (std::size_t v = 0; v < topo.vertices; ++v)
@@ -132,27 +128,22 @@ MeshTopology mesh_topology(const TriangleMesh& mesh) {
             if (uses[static_cast<std::size_t>(i)] != 1) continue;
             ++topo.boundary_edges;
             boundary_vertices.push_back(static_cast<std::uint32_t>(v));
-            const auto a = find(static_cast<std::uint32_t>(v)),
-                       b = find(static_cast<std::uint32_t>(w));
-            if (a != b) parent[a] = b;
+            sets.unite(static_cast<std::uint32_t>(w), static_cast<std::uint32_t>(v));
         }
-    for (auto& v : boundary_vertices) v = find(v);
+    for (auto& v : boundary_vertices) v = sets.find(v);
     std::sort(boundary_vertices.begin(), boundary_vertices.end());
     topo.boundary_loops =
         static_cast<std::size_t>(std::unique(boundary_vertices.begin(), boundary_vertices.end()) -
                                  boundary_vertices.begin());
     // Components by triangles.
-    std::iota(parent.begin(), parent.end(), 0u);
+    sets.reset(topo.vertices);
     for (const auto& t : mesh.triangles)
-        for (int k = 1; k < 3; ++k) {
-            const auto a = find(std::uint32_t(t[0])), b = find(std::uint32_t(t[k]));
-            if (a != b) parent[a] = b;
-        }
+        for (int k = 1; k < 3; ++k) sets.unite(std::uint32_t(t[k]), std::uint32_t(t[0]));
     std::vector<char> used(topo.vertices, 0);
     for (const auto& t : mesh.triangles)
         for (int k = 0; k < 3; ++k) used[t[k]] = 1;
     for (std::size_t v = 0; v < topo.vertices; ++v)
-        if (used[v] && find(std::uint32_t(v)) == v) ++topo.components;
+        if (used[v] && sets.is_root(std::uint32_t(v))) ++topo.components;
     topo.euler_characteristic =
         std::int64_t(topo.vertices) - std::int64_t(topo.edges) + std::int64_t(topo.faces);
     return topo;
@@ -175,22 +166,16 @@ std::size_t split_pinched_vertices(TriangleMesh& mesh, std::int32_t* first_pinch
     }
     std::size_t split = 0;
     std::vector<std::pair<std::int32_t, std::int32_t>> others;  // (other vertex, local index)
-    std::vector<std::int32_t> parent, size;
+    detail::DisjointSets<std::int32_t> fans_of;  // the triangles around v, by local index
+    std::vector<std::int32_t> size;
     constexpr std::int32_t kPairwise = 16;
     for (std::size_t v = 0; v < n; ++v) {
         const auto begin = offsets[v], end = offsets[v + 1];
         const auto k = end - begin;
         if (k < 2) continue;
-        parent.resize(k);
-        for (std::int32_t i = 0; i < k; ++i) parent[i] = i;
-        auto find = [&](std::int32_t x) {
-            while (parent[x] != x) x = parent[x] = parent[parent[x]];
-            return x;
-        };
-        auto unite = [&](std::int32_t i, std::int32_t j) {
-            const auto a = find(i), b = find(j);
-            if (a != b) parent[std::max(a, b)] = std::min(a, b);
-        };
+        fans_of.reset(static_cast<std::size_t>(k));
+        auto find = [&](std::int32_t x) { return fans_of.find(x); };
+        auto unite = [&](std::int32_t i, std::int32_t j) { fans_of.unite_to_smaller(i, j); };
         // Two triangles at v are in one fan when they share another corner (an edge at v).
         if (k <= kPairwise) {
             // The usual few triangles: compared pair by pair, no sort.

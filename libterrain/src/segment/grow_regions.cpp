@@ -27,8 +27,8 @@ const char* to_string(GrowCost cost) {
 namespace {
 
 using detail::i32;
+using detail::idx;
 using detail::kNone;
-using detail::z;
 
 struct Candidate {
     float cost;
@@ -48,7 +48,7 @@ class Grower {
         node_region_.assign(nn, kNone);
         node_area_.assign(nn, 0.0);
         for (std::size_t v = 0; v < g.vertex_nodes.size(); ++v)
-            node_area_[z(g.vertex_nodes[v])] +=
+            node_area_[idx(g.vertex_nodes[v])] +=
                 mesh.vertex_areas.empty() ? 1.0 : mesh.vertex_areas[v];
         build_reeb_neighbours();
         unassigned_branches_.resize(nn);
@@ -63,7 +63,7 @@ class Grower {
             if (g_.is_extremum(static_cast<i32>(n))) {
                 i32 lowest = INT32_MAX;
                 for (i32 i = g_.node_vertex_offsets[n]; i < g_.node_vertex_offsets[n + 1]; ++i)
-                    lowest = std::min(lowest, g_.node_vertices[z(i)]);
+                    lowest = std::min(lowest, g_.node_vertices[idx(i)]);
                 seeds.emplace_back(lowest, static_cast<i32>(n));
             }
         std::sort(seeds.begin(), seeds.end());
@@ -78,7 +78,7 @@ class Grower {
             while (!heap_.empty()) {
                 const Candidate c = heap_.top();
                 heap_.pop();
-                if (node_region_[z(c.node)] != kNone) continue;
+                if (node_region_[idx(c.node)] != kNone) continue;
                 if (!relaxed && options_.cost == GrowCost::graph && !reeb_eligible(c.node))
                     continue;
                 const float now = cost(c.node, c.region, relaxed);
@@ -103,7 +103,7 @@ class Grower {
         out.region_count = static_cast<std::uint32_t>(seeds.size());
         out.labels.resize(g_.vertex_nodes.size());
         for (std::size_t v = 0; v < out.labels.size(); ++v)
-            out.labels[v] = static_cast<std::uint32_t>(node_region_[z(g_.vertex_nodes[v])] + 1);
+            out.labels[v] = static_cast<std::uint32_t>(node_region_[idx(g_.vertex_nodes[v])] + 1);
         report_progress(progress, 1.0, "grow");
         return out;
     }
@@ -117,37 +117,37 @@ class Grower {
         auto along = [&](std::size_t a, bool from_lower) {
             const i32 b = g_.arc_offsets[a], e = g_.arc_offsets[a + 1];
             if (b == e) return from_lower ? g_.arcs[a][1] : g_.arcs[a][0];
-            return from_lower ? g_.arc_nodes[z(b)] : g_.arc_nodes[z(e - 1)];
+            return from_lower ? g_.arc_nodes[idx(b)] : g_.arc_nodes[idx(e - 1)];
         };
         for (std::size_t n = 0; n < nn; ++n)
             nb_off_[n + 1] = g_.is_critical(static_cast<i32>(n)) ? 0 : 2;
         for (const auto& a : g_.arcs) {
-            ++nb_off_[z(a[0]) + 1];
-            ++nb_off_[z(a[1]) + 1];
+            ++nb_off_[idx(a[0]) + 1];
+            ++nb_off_[idx(a[1]) + 1];
         }
         for (std::size_t n = 0; n < nn; ++n) nb_off_[n + 1] += nb_off_[n];
-        nb_.resize(z(nb_off_[nn]));
+        nb_.resize(idx(nb_off_[nn]));
         std::vector<i32> fill(nb_off_.begin(), nb_off_.end() - 1);
         for (std::size_t a = 0; a < g_.arc_count(); ++a) {
-            nb_[z(fill[z(g_.arcs[a][0])]++)] = along(a, true);
-            nb_[z(fill[z(g_.arcs[a][1])]++)] = along(a, false);
+            nb_[idx(fill[idx(g_.arcs[a][0])]++)] = along(a, true);
+            nb_[idx(fill[idx(g_.arcs[a][1])]++)] = along(a, false);
             const i32 b = g_.arc_offsets[a], e = g_.arc_offsets[a + 1];
             for (i32 i = b; i < e; ++i) {
-                const i32 r = g_.arc_nodes[z(i)];
-                nb_[z(fill[z(r)]++)] = i == b ? g_.arcs[a][0] : g_.arc_nodes[z(i - 1)];
-                nb_[z(fill[z(r)]++)] = i + 1 == e ? g_.arcs[a][1] : g_.arc_nodes[z(i + 1)];
+                const i32 r = g_.arc_nodes[idx(i)];
+                nb_[idx(fill[idx(r)]++)] = i == b ? g_.arcs[a][0] : g_.arc_nodes[idx(i - 1)];
+                nb_[idx(fill[idx(r)]++)] = i + 1 == e ? g_.arcs[a][1] : g_.arc_nodes[idx(i + 1)];
             }
         }
     }
 
     bool reeb_eligible(i32 n) const {
-        return unassigned_branches_[z(n)] < nb_off_[z(n) + 1] - nb_off_[z(n)];
+        return unassigned_branches_[idx(n)] < nb_off_[idx(n) + 1] - nb_off_[idx(n)];
     }
 
     float cost(i32 n, i32 r, bool relaxed) const {
-        const double mean = region_sum_[z(r)] / std::max(region_area_[z(r)], 1e-300);
-        double c = std::fabs(mean - static_cast<double>(g_.node_values[z(n)]));
-        if (!relaxed && options_.cost == GrowCost::graph && unassigned_branches_[z(n)] > 1)
+        const double mean = region_sum_[idx(r)] / std::max(region_area_[idx(r)], 1e-300);
+        double c = std::fabs(mean - static_cast<double>(g_.node_values[idx(n)]));
+        if (!relaxed && options_.cost == GrowCost::graph && unassigned_branches_[idx(n)] > 1)
             c += options_.saddle_penalty;
         return static_cast<float>(c);
     }
@@ -156,13 +156,14 @@ class Grower {
 
     // Candidates (u, r) for the unassigned nodes u touching node n (in region r) on the mesh.
     void push_mesh_candidates(i32 n, bool relaxed) {
-        const i32 r = node_region_[z(n)];
+        const i32 r = node_region_[idx(n)];
         i32 last = kNone;
-        for (i32 i = g_.node_vertex_offsets[z(n)]; i < g_.node_vertex_offsets[z(n) + 1]; ++i) {
-            const i32 v = g_.node_vertices[z(i)];
-            for (i32 k = mesh_.neighbor_offsets[z(v)]; k < mesh_.neighbor_offsets[z(v) + 1]; ++k) {
-                const i32 u = g_.vertex_nodes[z(mesh_.neighbors[z(k)])];
-                if (u == last || node_region_[z(u)] != kNone) continue;
+        for (i32 i = g_.node_vertex_offsets[idx(n)]; i < g_.node_vertex_offsets[idx(n) + 1]; ++i) {
+            const i32 v = g_.node_vertices[idx(i)];
+            for (i32 k = mesh_.neighbor_offsets[idx(v)]; k < mesh_.neighbor_offsets[idx(v) + 1];
+                 ++k) {
+                const i32 u = g_.vertex_nodes[idx(mesh_.neighbors[idx(k)])];
+                if (u == last || node_region_[idx(u)] != kNone) continue;
                 last = u;
                 if (!relaxed && options_.cost == GrowCost::graph && !reeb_eligible(u)) continue;
                 push(u, r, relaxed);
@@ -172,27 +173,28 @@ class Grower {
 
     // Candidates for node u against every region it touches on the mesh.
     void push_all_regions(i32 u) {
-        for (i32 i = g_.node_vertex_offsets[z(u)]; i < g_.node_vertex_offsets[z(u) + 1]; ++i) {
-            const i32 v = g_.node_vertices[z(i)];
-            for (i32 k = mesh_.neighbor_offsets[z(v)]; k < mesh_.neighbor_offsets[z(v) + 1]; ++k) {
-                const i32 r = node_region_[z(g_.vertex_nodes[z(mesh_.neighbors[z(k)])])];
+        for (i32 i = g_.node_vertex_offsets[idx(u)]; i < g_.node_vertex_offsets[idx(u) + 1]; ++i) {
+            const i32 v = g_.node_vertices[idx(i)];
+            for (i32 k = mesh_.neighbor_offsets[idx(v)]; k < mesh_.neighbor_offsets[idx(v) + 1];
+                 ++k) {
+                const i32 r = node_region_[idx(g_.vertex_nodes[idx(mesh_.neighbors[idx(k)])])];
                 if (r != kNone) push(u, r, false);
             }
         }
     }
 
     void assign(i32 n, i32 r) {
-        node_region_[z(n)] = r;
-        region_sum_[z(r)] += node_area_[z(n)] * g_.node_values[z(n)];
-        region_area_[z(r)] += node_area_[z(n)];
+        node_region_[idx(n)] = r;
+        region_sum_[idx(r)] += node_area_[idx(n)] * g_.node_values[idx(n)];
+        region_area_[idx(r)] += node_area_[idx(n)];
         if (options_.cost == GrowCost::graph) {
             // Reeb neighbours: one more branch assigned; a node that just became eligible, or
             // a saddle that just lost its penalty, gets its candidates (again).
-            for (i32 k = nb_off_[z(n)]; k < nb_off_[z(n) + 1]; ++k) {
-                const i32 u = nb_[z(k)];
-                if (node_region_[z(u)] != kNone) continue;
-                const i32 before = unassigned_branches_[z(u)]--;
-                const i32 degree = nb_off_[z(u) + 1] - nb_off_[z(u)];
+            for (i32 k = nb_off_[idx(n)]; k < nb_off_[idx(n) + 1]; ++k) {
+                const i32 u = nb_[idx(k)];
+                if (node_region_[idx(u)] != kNone) continue;
+                const i32 before = unassigned_branches_[idx(u)]--;
+                const i32 degree = nb_off_[idx(u) + 1] - nb_off_[idx(u)];
                 if (before == degree || before == 2) push_all_regions(u);
             }
         }

@@ -5,9 +5,10 @@
 // nodes sit, sorted by value, in the list of the arc they lie on. Parallel arcs between the
 // same two nodes are kept: they are the graph's loops.
 //
-// Built by a sweep in increasing value that tracks the level-set contours through the
-// triangles they cross (docs/reeb.md): exact for any 2-manifold mesh, with or without
-// boundary, of any genus.
+// Built by one of two exact algorithms (docs/reeb.md), both giving the same graph: the contour
+// tree (join and split trees merged) when every component of the mesh is a disk or a sphere,
+// else a sweep in increasing value that tracks the level-set contours through the triangles
+// they cross, for any 2-manifold mesh with or without boundary, of any genus.
 
 #include <array>
 #include <cstddef>

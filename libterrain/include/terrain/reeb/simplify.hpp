@@ -25,6 +25,14 @@ struct SimplifyResult {
     ReebGraph graph;           // the simplified graph, nodes renumbered
     std::vector<float> field;  // the rewritten field: each vertex takes its node's value
     std::size_t saddle_extremum = 0, extremum_extremum = 0;  // cancellations done
+    // What the cancellations did besides. Each node made regular merges its two arcs into one,
+    // so the graph loses (cancellations + made_regular) critical nodes and as many arcs.
+    std::size_t made_regular = 0;  // critical nodes left with one arc below and one above
+    std::size_t arcs_turned = 0;   // arcs whose far end was left on the other side of a moved
+                                   // end's value, so that their ends swapped
+    std::size_t turned_made_regular = 0;   // of made_regular: far ends of turned arcs
+    std::size_t turned_made_extremum = 0;  // far ends of turned arcs left extrema (their
+                                           // arcs are new candidates)
 };
 
 // Throws terrain::Error (stage "simplify") for a negative or non-finite threshold, or an area

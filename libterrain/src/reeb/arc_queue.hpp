@@ -1,0 +1,139 @@
+#pragma once
+// Private: the queue of candidate arcs for the simplification (simplify.cpp), by key:
+// persistence first, then arc id (ties by id).
+
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <cstddef>
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+#include "../core/indices.hpp"
+#include "../core/release.hpp"
+
+namespace terrain::reeb::internal {
+
+using detail::i32;
+
+// Queued arcs by key (persistence bits, then the arc id in the low half), in two parts: the
+// first candidates, sorted once and read in order (most of them are cancelled with the key
+// they started with), and a 4-ary min-heap for the keys set later, each arc at most once there
+// (re-keying moves its entry). An arc re-keyed or dropped leaves its sorted entry behind: the
+// caller, who knows each arc's current key, skips such entries.
+class ArcQueue {
+  public:
+    static constexpr std::uint64_t kEmpty = ~std::uint64_t{0};  // above any key
+    // The key of arc a: the persistence's order-preserving bits (a persistence is never
+    // negative), then the arc id (ties by id).
+    static std::uint64_t key_of(float persistence, i32 a) {
+        return (std::uint64_t{std::bit_cast<std::uint32_t>(persistence)} << 32) |
+               static_cast<std::uint32_t>(a);
+    }
+    static i32 arc_of(std::uint64_t key) { return static_cast<i32>(key & 0xffffffffu); }
+
+    void init(std::size_t arcs) { slot_.assign(arcs, detail::kNone); }
+    void release() {
+        detail::release(slot_);
+        detail::release(heap_);
+        detail::release(sorted_);
+    }
+    // The first candidates, in increasing arc order, then sorted by seal().
+    void seed(std::uint64_t key) { sorted_.push_back(key); }
+    void seal() {
+        // Seeded in increasing arc order: a stable sort of the high halves sorts the keys.
+        std::vector<std::uint64_t> tmp(sorted_.size());
+        for (const int shift : {32, 43, 54}) {
+            std::array<std::size_t, 2048> count{};
+            for (const std::uint64_t k : sorted_) ++count[(k >> shift) & 2047];
+            std::size_t sum = 0;
+            for (std::size_t& c : count) sum += std::exchange(c, sum);
+            for (const std::uint64_t k : sorted_) tmp[count[(k >> shift) & 2047]++] = k;
+            sorted_.swap(tmp);
+        }
+        next_ = 0;
+    }
+    // The next sorted entry (kEmpty after the last), and the one `ahead` places further.
+    std::uint64_t sorted_front() const { return next_ < sorted_.size() ? sorted_[next_] : kEmpty; }
+    std::uint64_t sorted_ahead(std::size_t ahead) const {
+        return next_ + ahead < sorted_.size() ? sorted_[next_ + ahead] : kEmpty;
+    }
+    void skip_sorted() { ++next_; }
+    std::uint64_t top() const { return heap_.empty() ? kEmpty : heap_.front(); }
+    // Queues arc `key & 0xffffffff` with this key, or moves it there.
+    void set(std::uint64_t key) {
+        const std::size_t a = arc(key);
+        if (slot_[a] == detail::kNone) {
+            heap_.push_back(key);
+            up(heap_.size() - 1, key);
+        } else if (key < heap_[detail::idx(slot_[a])]) {
+            up(detail::idx(slot_[a]), key);
+        } else {
+            down(detail::idx(slot_[a]), key);
+        }
+    }
+    void erase(i32 a) {
+        const i32 i = slot_[detail::idx(a)];
+        if (i == detail::kNone) return;
+        slot_[detail::idx(a)] = detail::kNone;
+        const std::uint64_t last = heap_.back();
+        heap_.pop_back();
+        if (detail::idx(i) == heap_.size()) return;
+        if (last < heap_[detail::idx(i)])
+            up(detail::idx(i), last);
+        else
+            down(detail::idx(i), last);
+    }
+    // The root's hole goes down to a leaf along the smaller children, and the last entry
+    // comes up from there (it mostly belongs near the leaves).
+    std::uint64_t pop() {
+        const std::uint64_t key = heap_.front(), last = heap_.back();
+        slot_[arc(key)] = detail::kNone;
+        heap_.pop_back();
+        const std::size_t n = heap_.size();
+        if (n == 0) return key;
+        std::size_t i = 0;
+        for (std::size_t m; (m = smallest_child(i)) != 0; i = m) place(i, heap_[m]);
+        up(i, last);
+        return key;
+    }
+
+  private:
+    static std::size_t arc(std::uint64_t key) { return static_cast<std::uint32_t>(key); }
+    void place(std::size_t i, std::uint64_t key) {
+        heap_[i] = key;
+        slot_[arc(key)] = static_cast<i32>(i);
+    }
+    // Puts `key` at slot i or above (below) it, moving the entries in its way.
+    void up(std::size_t i, std::uint64_t key) {
+        while (i > 0) {
+            const std::size_t parent = (i - 1) / 4;
+            if (heap_[parent] <= key) break;
+            place(i, heap_[parent]);
+            i = parent;
+        }
+        place(i, key);
+    }
+    void down(std::size_t i, std::uint64_t key) {
+        for (std::size_t m; (m = smallest_child(i)) != 0 && heap_[m] < key; i = m)
+            place(i, heap_[m]);
+        place(i, key);
+    }
+    // The slot of i's smallest child, 0 when it has none.
+    std::size_t smallest_child(std::size_t i) const {
+        const std::size_t c = 4 * i + 1, n = heap_.size();
+        if (c >= n) return 0;
+        std::size_t m = c;
+        for (std::size_t j = c + 1; j < std::min(c + 4, n); ++j)
+            if (heap_[j] < heap_[m]) m = j;
+        return m;
+    }
+
+    std::vector<std::uint64_t> heap_;
+    std::vector<i32> slot_;  // each arc's slot in heap_, kNone when not there
+    std::vector<std::uint64_t> sorted_;
+    std::size_t next_ = 0;  // sorted_[next_ ..] are still to come
+};
+
+}  // namespace terrain::reeb::internal

@@ -1,0 +1,304 @@
+// The contour tree of a field on a mesh without loops (paper s.3.1 on disks and spheres; Carr,
+// Snoeyink & Axen 2003, "Computing contour trees in all dimensions"). The join tree and the
+// split tree come from two union-find sweeps over the events, upwards and downwards, run side
+// by side; they are merged leaf by leaf into the augmented contour tree (each removed leaf is
+// one edge), whose chains of regular nodes become the arcs. The sweeps unite link components
+// (link_components.cpp), not neighbours. The join tree also tells whether the mesh has loops
+// (its roots are the components; a single component is a disk or a sphere exactly when
+// V - E + F is 1 or 2): then the caller falls back to the contour-tracking sweep.
+
+#include "contour_tree.hpp"
+
+#include <tbb/parallel_invoke.h>
+
+#include <algorithm>
+#include <array>
+#include <cstdint>
+#include <numeric>
+#include <utility>
+#include <vector>
+
+#include "../core/disjoint_sets.hpp"
+#include "../core/indices.hpp"
+#include "../core/release.hpp"
+#include "link_components.hpp"
+#include "terrain/core/error.hpp"
+
+namespace terrain::reeb::internal {
+
+using detail::i32;
+using detail::idx;
+using detail::kNone;
+
+bool loop_free(const TriangleMesh& mesh) {
+    // A component's Euler characteristic is 2 - 2g - b: it is 1 or 2 exactly when the
+    // component is a disk (g = 0, b = 1) or a sphere (g = 0, b = 0).
+    const std::size_t nv = mesh.vertex_count();
+    detail::DisjointSets<i32> components(nv);  // each rooted at its lowest vertex
+    for (const auto& t : mesh.triangles)
+        for (int k = 0; k < 2; ++k) components.unite_to_smaller(t[idx(k)], t[idx(k + 1)]);
+    std::vector<std::int64_t> chi(nv, 0);
+    for (std::size_t v = 0; v < nv; ++v) {
+        std::int64_t upper_neighbours = 0;
+        for (i32 i = mesh.neighbor_offsets[v]; i < mesh.neighbor_offsets[v + 1]; ++i)
+            upper_neighbours += idx(mesh.neighbors[idx(i)]) > v;
+        chi[idx(components.find(static_cast<i32>(v)))] += 1 - upper_neighbours;
+    }
+    for (const auto& t : mesh.triangles) chi[idx(components.find(t[0]))] += 1;
+    for (std::size_t v = 0; v < nv; ++v)
+        if (components.is_root(static_cast<i32>(v)) && chi[v] != 1 && chi[v] != 2) return false;
+    return true;
+}
+
+bool contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& progress) {
+    const std::size_t nn = g.node_count();
+    g.node_lower_links.assign(nn, 1);
+    g.node_upper_links.assign(nn, 1);
+    std::vector<char> general;
+    std::vector<LinkCounts> vertex_links;
+    const std::vector<LinkReps> reps = link_components(mesh, g, vertex_links, general);
+    report_progress(progress, 0.3, "reeb: links");
+
+    // Each event's parent in the join tree (below it) and in the split tree (above it).
+    std::vector<i32> join_parent(nn, kNone), split_parent(nn, kNone);
+    // Children in the join and split trees. The sweeps run in opposite directions, so they
+    // share cache lines only where they cross.
+    std::vector<std::array<i32, 2>> children(nn);
+    // One union-find sweep over the components of the part swept so far (the sublevel set for
+    // the join tree, the superlevel set for the split tree). A node's entry holds its parent,
+    // or (at a root) minus one minus its rank, and the last event added to its component (the
+    // component's head, where the next event joining it hangs in the tree). Union by rank with
+    // the head beside the link, in one record: not detail::DisjointSets, on the hottest path.
+    // Most events have one link component below (above): one find, and the event hangs under
+    // the root. The join (ascending) and split (descending) sweeps are independent and run
+    // side by side.
+    struct Entry {
+        i32 up, head;
+    };
+    auto sweep = [&](bool ascending, std::vector<i32>& tree_parent) {
+        const std::size_t side = ascending ? 0 : 1;
+        std::vector<Entry> swept(nn, Entry{-1, 0});
+        auto find = [&](i32 x) {
+            i32 r = x;
+            while (swept[idx(r)].up >= 0) r = swept[idx(r)].up;
+            while (x != r) {
+                const i32 nx = swept[idx(x)].up;
+                swept[idx(x)].up = r;
+                x = nx;
+            }
+            return r;
+        };
+        auto reps_at = [&](std::size_t k) -> const std::array<i32, 2>& {
+            const std::size_t e = ascending ? k : nn - 1 - k;
+            return ascending ? reps[e].lower : reps[e].upper;
+        };
+        // Paths are short: two steps up without branching, then the rare longer path.
+        auto find_short = [&](i32 x) {
+            const i32 ux = swept[idx(x)].up;
+            const i32 b = ux >= 0 ? ux : x;
+            const i32 ub = swept[idx(b)].up;
+            i32 c = ub >= 0 ? ub : b;
+            if (swept[idx(c)].up >= 0) [[unlikely]]
+                c = find(c);
+            swept[idx(x)].up = ux >= 0 ? c : ux;
+            return c;
+        };
+        // The sweep waits on memory: the entries of the representatives a few events ahead
+        // are fetched early (and, from those, their parents').
+        constexpr std::size_t kAhead = 16;
+        auto prefetch = [&](i32 x) {
+            __builtin_prefetch(&swept[idx(x >= 0 && idx(x) < nn ? x : 0)]);
+        };
+        // Component c (a root) joins the component of event e whose root is cur, by rank (the
+        // higher rank has the lower `up`); returns the new root.
+        auto join = [&](i32 cur, i32 c, i32 e) {
+            tree_parent[idx(swept[idx(c)].head)] = e;
+            ++children[idx(e)][side];
+            const bool cur_higher = swept[idx(cur)].up <= swept[idx(c)].up;
+            const i32 hi = cur_higher ? cur : c, lo = cur_higher ? c : cur;
+            if (swept[idx(hi)].up == swept[idx(lo)].up) --swept[idx(hi)].up;
+            swept[idx(lo)].up = hi;
+            swept[idx(hi)].head = e;
+            return hi;
+        };
+        std::vector<i32> roots;
+        for (std::size_t k = 0; k < nn; ++k) {
+            if (k + kAhead < nn) {
+                const auto& r = reps_at(k + kAhead);
+                prefetch(r[0]);
+                prefetch(r[1]);
+            }
+            if (k + kAhead / 2 < nn) {
+                const auto& r = reps_at(k + kAhead / 2);
+                if (r[0] >= 0) prefetch(swept[idx(r[0])].up);
+                if (r[1] >= 0) prefetch(swept[idx(r[1])].up);
+            }
+            const i32 e = static_cast<i32>(ascending ? k : nn - 1 - k);
+            const auto& rep = reps_at(k);
+            if (rep[0] >= 0) {
+                // The event hangs under the component of its first link component.
+                const i32 c = find_short(rep[0]);
+                Entry& root = swept[idx(c)];
+                tree_parent[idx(root.head)] = e;
+                children[idx(e)][side] = 1;
+                swept[idx(e)].up = c;
+                root.head = e;
+                root.up -= root.up == -1;  // rank 0 -> 1
+                if (rep[1] < 0) continue;
+                const i32 o = find_short(rep[1]);
+                if (o != c) join(c, o, e);  // a second component joins here
+                continue;
+            }
+            swept[idx(e)] = {-1, e};
+            children[idx(e)][side] = 0;
+            if (rep[0] == kNone) continue;
+            roots.clear();
+            for (i32 i = g.node_vertex_offsets[idx(e)]; i < g.node_vertex_offsets[idx(e) + 1];
+                 ++i) {
+                const i32 v = g.node_vertices[idx(i)];
+                for (i32 j = mesh.neighbor_offsets[idx(v)]; j < mesh.neighbor_offsets[idx(v) + 1];
+                     ++j) {
+                    const i32 n = g.vertex_nodes[idx(mesh.neighbors[idx(j)])];
+                    if (ascending ? n >= e : n <= e) continue;
+                    const i32 c = find(n);
+                    if (std::find(roots.begin(), roots.end(), c) == roots.end()) roots.push_back(c);
+                }
+            }
+            i32 cur = e;
+            for (const i32 c : roots) cur = join(cur, c, e);
+        }
+    };
+    tbb::parallel_invoke([&] { sweep(true, join_parent); }, [&] { sweep(false, split_parent); });
+    const auto components = std::count(join_parent.begin(), join_parent.end(), kNone);
+    const auto chi = static_cast<std::int64_t>(mesh.vertex_count()) -
+                     static_cast<std::int64_t>(mesh.neighbors.size() / 2) +
+                     static_cast<std::int64_t>(mesh.triangle_count());
+    if (components == 1 ? (chi != 1 && chi != 2) : !loop_free(mesh)) return false;
+    report_progress(progress, 0.6, "reeb: join and split trees");
+
+    // Merge: remove leaves one by one; each removal is one edge of the augmented tree. A
+    // removed node's join-children count is set to -1; attach[x] = 2 * y + (x was below y).
+    auto dead = [&](i32 x) { return children[idx(x)][0] < 0; };
+    auto next_alive = [&](std::vector<i32>& parent, i32 x) {
+        i32 p = parent[idx(x)];
+        while (p != kNone && dead(p)) p = parent[idx(p)];
+        for (i32 q = parent[idx(x)]; q != p;) {
+            const i32 nx = parent[idx(q)];
+            parent[idx(q)] = p;
+            q = nx;
+        }
+        parent[idx(x)] = p;
+        return p;
+    };
+    auto is_leaf = [&](i32 x) {
+        const auto [j, s] = children[idx(x)];
+        return (j == 0 && s == 1) || (s == 0 && j == 1);
+    };
+    std::vector<i32> queue, attach(nn, kNone);
+    queue.reserve(nn);
+    for (std::size_t n = 0; n < nn; ++n)
+        if (is_leaf(static_cast<i32>(n))) queue.push_back(static_cast<i32>(n));
+    constexpr std::size_t kAhead = 16;  // as in the sweeps: fetch the next leaves' entries early
+    for (std::size_t qi = 0; qi < queue.size(); ++qi) {
+        if (qi + kAhead < queue.size()) {
+            const i32 x = queue[qi + kAhead];
+            __builtin_prefetch(&children[idx(x)]);
+            __builtin_prefetch(&join_parent[idx(x)]);
+            __builtin_prefetch(&split_parent[idx(x)]);
+        }
+        if (qi + kAhead / 2 < queue.size()) {
+            const i32 x = queue[qi + kAhead / 2];
+            const i32 p = (children[idx(x)][0] == 0 ? join_parent : split_parent)[idx(x)];
+            __builtin_prefetch(&children[idx(p >= 0 ? p : 0)]);
+        }
+        const i32 x = queue[qi];
+        if (dead(x) || !is_leaf(x)) continue;
+        const bool lower = children[idx(x)][0] == 0;
+        const i32 y = next_alive(lower ? join_parent : split_parent, x);
+        if (y == kNone) throw Error("reeb", "internal error: contour tree leaf without parent");
+        children[idx(x)][0] = -1;
+        attach[idx(x)] = 2 * y + lower;
+        --children[idx(y)][lower ? 0 : 1];
+        if (is_leaf(y)) queue.push_back(y);
+    }
+    detail::release(queue);
+    detail::release(children);
+    report_progress(progress, 0.75, "reeb: contour tree");
+
+    // Up-edges per node (CSR, in the order of the removed leaves' indices), and down degrees.
+    std::vector<i32> up_off(nn + 1, 0), up_to(nn), down_deg(nn, 0);
+    auto edge = [&](std::size_t x) {
+        const i32 y = attach[x] >> 1, self = static_cast<i32>(x);
+        return (attach[x] & 1) ? std::pair{self, y} : std::pair{y, self};
+    };
+    for (std::size_t x = 0; x < nn; ++x)
+        if (attach[x] != kNone) {
+            const auto [lo, hi] = edge(x);
+            ++up_off[idx(lo) + 1];
+            ++down_deg[idx(hi)];
+        }
+    std::partial_sum(up_off.begin(), up_off.end(), up_off.begin());
+    {
+        std::vector<i32> fill(up_off.begin(), up_off.end() - 1);
+        for (std::size_t x = 0; x < nn; ++x)
+            if (attach[x] != kNone) {
+                const auto [lo, hi] = edge(x);
+                up_to[idx(fill[idx(lo)]++)] = hi;
+            }
+    }
+    g.node_kinds.assign(nn, NodeKind::regular);
+    for (std::size_t n = 0; n < nn; ++n) {
+        const int d = down_deg[n], u = up_off[n + 1] - up_off[n];
+        if (d == 1 && u == 1) continue;  // Reeb-regular, whatever its link (links stay 1, 1)
+        g.node_kinds[n] = d == 0   ? NodeKind::minimum
+                          : u == 0 ? NodeKind::maximum
+                                   : NodeKind::saddle;
+        if (general[n]) continue;  // counted below
+        const auto links = vertex_links[idx(g.node_vertices[idx(g.node_vertex_offsets[n])])];
+        g.node_lower_links[n] = links[0];
+        g.node_upper_links[n] = links[1];
+    }
+    detail::release(vertex_links);
+    // Arcs in the order of their lower nodes, then of their up-edges. A regular node takes the
+    // arc of the edge below it; `below` holds that edge as the regular node under it, or as
+    // -2 - arc when the edge leaves a critical node. One pass in increasing order then fills in
+    // every regular node (its lower neighbour comes first), so no chain is followed.
+    auto critical = [&](i32 n) { return g.node_kinds[idx(n)] != NodeKind::regular; };
+    std::vector<i32>& below = attach;  // attach is no longer needed
+    g.arcs.clear();
+    for (std::size_t lo = 0; lo < nn; ++lo)
+        for (i32 k = up_off[lo]; k < up_off[lo + 1]; ++k) {
+            const i32 hi = up_to[idx(k)];
+            if (critical(static_cast<i32>(lo))) {
+                const i32 arc = static_cast<i32>(g.arcs.size());
+                g.arcs.push_back({static_cast<i32>(lo), critical(hi) ? hi : kNone});
+                if (!critical(hi)) below[idx(hi)] = -2 - arc;
+            } else if (!critical(hi)) {
+                below[idx(hi)] = static_cast<i32>(lo);
+            }
+        }
+    g.node_arcs.assign(nn, kNone);
+    g.arc_offsets.assign(g.arcs.size() + 1, 0);
+    for (std::size_t n = 0; n < nn; ++n) {
+        if (critical(static_cast<i32>(n))) continue;
+        const i32 b = below[n];
+        const i32 arc = b >= 0 ? g.node_arcs[idx(b)] : -2 - b;
+        g.node_arcs[n] = arc;
+        ++g.arc_offsets[idx(arc) + 1];
+        const i32 hi = up_to[idx(up_off[n])];
+        if (critical(hi)) g.arcs[idx(arc)][1] = hi;
+    }
+    std::partial_sum(g.arc_offsets.begin(), g.arc_offsets.end(), g.arc_offsets.begin());
+    g.arc_nodes.resize(idx(g.arc_offsets.back()));
+    {
+        std::vector<i32> fill(g.arc_offsets.begin(), g.arc_offsets.end() - 1);
+        for (std::size_t n = 0; n < nn; ++n)
+            if (!critical(static_cast<i32>(n)))
+                g.arc_nodes[idx(fill[idx(g.node_arcs[n])]++)] = static_cast<i32>(n);
+    }
+    report_progress(progress, 0.9, "reeb: arcs");
+    count_general_links(mesh, g, general);
+    return true;
+}
+
+}  // namespace terrain::reeb::internal

@@ -1,0 +1,19 @@
+#pragma once
+// Private: the contour tree, the Reeb graph of a field on a mesh without loops.
+
+#include "terrain/core/progress.hpp"
+#include "terrain/mesh/triangle_mesh.hpp"
+#include "terrain/reeb/reeb_graph.hpp"
+
+namespace terrain::reeb::internal {
+
+// True when the Reeb graph of any field on the mesh is a tree: every connected component is
+// of genus 0 with at most one boundary loop (a disk or a sphere). Assumes a 2-manifold.
+bool loop_free(const TriangleMesh& mesh);
+
+// The Reeb graph of the field whose events order_events put in g, when the mesh has no loops
+// (then it is the contour tree). Returns false, leaving the graph half made, when the mesh
+// has handles or holes.
+bool contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& progress);
+
+}  // namespace terrain::reeb::internal

@@ -1,0 +1,131 @@
+// The order of events (paper s.3.1: the sweep over the field's values; docs/reeb.md "Nodes").
+// Vertices are sorted by value with a stable radix sort of the float bits; adjacent vertices
+// of exactly equal value are one event, one node (a plateau, the paper's Conley-index
+// treatment); other ties are broken by the plateau's lowest vertex, then by vertex index
+// (simulation of simplicity), so the graph depends on nothing but the mesh and the field.
+
+#include "event_order.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <cstdint>
+#include <utility>
+
+#include "../core/disjoint_sets.hpp"
+#include "../core/indices.hpp"
+#include "../core/release.hpp"
+
+namespace terrain::reeb::internal {
+
+namespace {
+
+using detail::i32;
+using detail::idx;
+
+// Sort key of a float: monotonic unsigned bits (-0 taken as +0).
+inline std::uint32_t float_key(float f) {
+    if (f == 0.0f) f = 0.0f;
+    const auto u = std::bit_cast<std::uint32_t>(f);
+    return (u & 0x80000000u) ? ~u : (u | 0x80000000u);
+}
+
+// The float of a sort key (-0 comes back as +0).
+inline float key_float(std::uint32_t k) {
+    return std::bit_cast<float>((k & 0x80000000u) ? (k & 0x7fffffffu) : ~k);
+}
+
+}  // namespace
+
+void order_events(const TriangleMesh& mesh, const std::vector<float>& field, ReebGraph& g) {
+    const std::size_t nv = field.size();
+    // Stable LSD radix sort of (value bits << 32 | vertex) on the value bits, 11 bits per
+    // pass: ties keep vertex order.
+    std::vector<std::uint64_t> keys(nv), tmp(nv);
+    for (std::size_t v = 0; v < nv; ++v) keys[v] = (std::uint64_t{float_key(field[v])} << 32) | v;
+    constexpr int kBits = 11;
+    constexpr std::size_t kBuckets = std::size_t{1} << kBits;
+    std::vector<std::uint32_t> count(3 * kBuckets, 0u);
+    for (const std::uint64_t k : keys)
+        for (int p = 0; p < 3; ++p)
+            ++count[idx(p) * kBuckets + ((k >> (32 + kBits * p)) & (kBuckets - 1))];
+    for (int p = 0; p < 3; ++p) {
+        std::uint32_t* c = count.data() + idx(p) * kBuckets;
+        const int shift = 32 + kBits * p;
+        if (nv == 0 || c[(keys[0] >> shift) & (kBuckets - 1)] == nv) continue;  // one bucket
+        std::uint32_t sum = 0;
+        for (std::size_t b = 0; b < kBuckets; ++b) sum += std::exchange(c[b], sum);
+        for (const std::uint64_t k : keys) tmp[c[(k >> shift) & (kBuckets - 1)]++] = k;
+        keys.swap(tmp);
+    }
+    detail::release(tmp);
+    auto same_value = [](std::uint64_t a, std::uint64_t b) { return (a >> 32) == (b >> 32); };
+    auto vertex = [](std::uint64_t k) { return static_cast<i32>(k & 0xffffffffu); };
+    // Plateaus: adjacent vertices of equal value. Only a vertex whose value another vertex
+    // shares (next to it in the sorted order) can be in one; in a noisy field that is rare.
+    std::vector<char> tied;
+    for (std::size_t i = 1; i < nv; ++i)
+        if (same_value(keys[i], keys[i - 1])) {
+            if (tied.empty()) tied.assign(nv, 0);
+            tied[idx(vertex(keys[i]))] = tied[idx(vertex(keys[i - 1]))] = 1;
+        }
+    // Each vertex's plateau; its representative (the root) is its lowest vertex.
+    detail::DisjointSets<i32> plateaus;
+    for (std::size_t v = 0; v < tied.size(); ++v) {
+        if (!tied[v]) continue;
+        for (auto i = mesh.neighbor_offsets[v]; i < mesh.neighbor_offsets[v + 1]; ++i) {
+            const i32 w = mesh.neighbors[idx(i)];
+            if (idx(w) > v && field[idx(w)] == field[v]) {
+                if (plateaus.empty()) plateaus.reset(nv);
+                plateaus.unite_to_smaller(static_cast<i32>(v), w);
+            }
+        }
+    }
+    detail::release(tied);
+    const bool any_plateau = !plateaus.empty();
+    if (any_plateau) {
+        plateaus.flatten();
+        const auto rep = [&](std::uint64_t k) { return plateaus.parent(vertex(k)); };
+        // Equal values: plateaus together, ordered by their lowest vertex.
+        for (std::size_t i = 0; i < nv;) {
+            std::size_t j = i + 1;
+            while (j < nv && same_value(keys[i], keys[j])) ++j;
+            if (j - i > 1)
+                std::sort(keys.begin() + static_cast<std::ptrdiff_t>(i),
+                          keys.begin() + static_cast<std::ptrdiff_t>(j),
+                          [&](std::uint64_t a, std::uint64_t b) {
+                              const i32 ra = rep(a), rb = rep(b);
+                              return ra != rb ? ra < rb : vertex(a) < vertex(b);
+                          });
+            i = j;
+        }
+    }
+    auto same_event = [&](std::uint64_t a, std::uint64_t b) {
+        return any_plateau && same_value(a, b) &&
+               plateaus.parent(vertex(a)) == plateaus.parent(vertex(b));
+    };
+    g.node_vertices.resize(nv);
+    g.vertex_nodes.resize(nv);
+    g.node_vertex_offsets.clear();
+    g.node_values.clear();
+    std::size_t n_nodes = nv;
+    if (any_plateau) {
+        n_nodes = 0;
+        for (std::size_t i = 0; i < nv; ++i) n_nodes += i == 0 || !same_event(keys[i], keys[i - 1]);
+    }
+    g.node_vertex_offsets.reserve(n_nodes + 1);
+    g.node_values.reserve(n_nodes);
+    constexpr std::size_t kAhead = 16;  // vertex_nodes is written in random order
+    for (std::size_t i = 0; i < nv; ++i) {
+        if (i + kAhead < nv) __builtin_prefetch(&g.vertex_nodes[idx(vertex(keys[i + kAhead]))], 1);
+        const i32 v = vertex(keys[i]);
+        if (i == 0 || !same_event(keys[i], keys[i - 1])) {
+            g.node_vertex_offsets.push_back(static_cast<i32>(i));
+            g.node_values.push_back(key_float(static_cast<std::uint32_t>(keys[i] >> 32)));
+        }
+        g.node_vertices[i] = v;
+        g.vertex_nodes[idx(v)] = static_cast<i32>(g.node_vertex_offsets.size() - 1);
+    }
+    g.node_vertex_offsets.push_back(static_cast<i32>(nv));
+}
+
+}  // namespace terrain::reeb::internal

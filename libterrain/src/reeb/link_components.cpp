@@ -1,0 +1,151 @@
+// Link components (paper s.2.1): a node's lower (upper) link is the part of the ring of
+// vertices around it that lies below (above) it, with the star's edges between them; the
+// numbers of components of the two classify the node (regular 1/1, Morse saddle 2/2, ...) and
+// name the components that the contour tree's join and split sweeps unite (one union-find
+// step per component instead of one per neighbour). Two ways to count: in bulk for
+// single-vertex nodes from local counts (link_components), and by union-find over the star
+// for plateaus and very high degrees (LinkCounter, also used by the contour-tracking sweep).
+
+#include "link_components.hpp"
+
+#include <algorithm>
+
+namespace terrain::reeb::internal {
+
+using detail::idx;
+using detail::kNone;
+
+std::pair<int, int> LinkCounter::count(const TriangleMesh& mesh, const ReebGraph& g, i32 e,
+                                       const std::vector<i32>& star) {
+    verts_.clear();
+    for (const i32 t : star)
+        for (const i32 c : mesh.triangles[idx(t)])
+            if (g.vertex_nodes[idx(c)] != e) verts_.push_back(c);
+    std::sort(verts_.begin(), verts_.end());
+    verts_.erase(std::unique(verts_.begin(), verts_.end()), verts_.end());
+    components_.reset(verts_.size());
+    auto index = [&](i32 v) {
+        return static_cast<i32>(std::lower_bound(verts_.begin(), verts_.end(), v) - verts_.begin());
+    };
+    for (const i32 t : star) {
+        const auto& tri = mesh.triangles[idx(t)];
+        for (int j = 0; j < 3; ++j) {
+            const i32 a = tri[idx(j)], b = tri[idx((j + 1) % 3)];
+            const i32 na = g.vertex_nodes[idx(a)], nb = g.vertex_nodes[idx(b)];
+            if (na == e || nb == e || (na < e) != (nb < e)) continue;
+            components_.unite(index(b), index(a));
+        }
+    }
+    int lower = 0, upper = 0;
+    for (std::size_t i = 0; i < verts_.size(); ++i)
+        if (components_.is_root(static_cast<i32>(i)))
+            ++(g.vertex_nodes[idx(verts_[i])] < e ? lower : upper);
+    return {lower, upper};
+}
+
+std::vector<LinkReps> link_components(const TriangleMesh& mesh, const ReebGraph& g,
+                                      std::vector<LinkCounts>& vertex_links,
+                                      std::vector<char>& general) {
+    const std::size_t nv = mesh.vertex_count(), nn = g.node_count();
+    const auto& node = g.vertex_nodes;
+    // starts[0..1]: lower runs' first vertices, starts[2..3]: upper runs'; runs[0], runs[1]:
+    // how many lower and upper runs were seen.
+    struct Star {
+        std::array<i32, 4> starts;
+        std::uint8_t triangles, lower_edges, upper_edges;
+        std::array<std::uint8_t, 2> runs;
+    };
+    std::vector<Star> stars(nv, Star{{kNone, kNone, kNone, kNone}, 0, 0, 0, {0, 0}});
+    for (const auto& t : mesh.triangles) {
+        const std::array<i32, 3> n{node[idx(t[0])], node[idx(t[1])], node[idx(t[2])]};
+        for (const i32 c : t) ++stars[idx(c)].triangles;
+        if (n[0] != n[1] && n[1] != n[2] && n[0] != n[2]) {
+            // The highest corner sees a lower link edge, the lowest an upper one; going round
+            // the middle corner counter-clockwise, the step a -> b crosses its value: b starts
+            // a lower run when a is above, an upper run when a is below. No branches: the
+            // orders are unpredictable.
+            const int hi = n[0] > n[1] ? (n[0] > n[2] ? 0 : 2) : (n[1] > n[2] ? 1 : 2);
+            const int lo = n[0] < n[1] ? (n[0] < n[2] ? 0 : 2) : (n[1] < n[2] ? 1 : 2);
+            const int mid = 3 - hi - lo, a = mid == 2 ? 0 : mid + 1, b = 3 - mid - a;
+            ++stars[idx(t[idx(hi)])].lower_edges;
+            ++stars[idx(t[idx(lo)])].upper_edges;
+            Star& s = stars[idx(t[idx(mid)])];
+            const int side = n[idx(a)] > n[idx(mid)] ? 0 : 1;
+            s.starts[idx(2 * side + (s.runs[idx(side)] & 1))] = n[idx(b)];
+            ++s.runs[idx(side)];
+            continue;
+        }
+        // Two corners in one node (a plateau): the third sees an edge of its lower or upper
+        // link; the plateau's corners see an edge touching their node, which does not count.
+        for (int k = 0; k < 3; ++k) {
+            const i32 m = n[idx(k)], p = n[idx((k + 1) % 3)], q = n[idx((k + 2) % 3)];
+            stars[idx(t[idx(k)])].lower_edges += (m > p) & (m > q);
+            stars[idx(t[idx(k)])].upper_edges += (m < p) & (m < q);
+        }
+    }
+    std::vector<LinkReps> reps(nn);
+    general.assign(nn, 0);
+    vertex_links.resize(nv);
+    constexpr std::size_t kAhead = 16;  // the nodes' entries are written in random order
+    for (std::size_t v = 0; v < nv; ++v) {
+        if (v + kAhead < nv) __builtin_prefetch(&reps[idx(node[v + kAhead])], 1);
+        const i32 n = node[v];
+        const i32 b = mesh.neighbor_offsets[v], e = mesh.neighbor_offsets[v + 1];
+        int below = 0, same = 0;
+        i32 some_below = kNone, some_above = kNone;
+        for (i32 i = b; i < e; ++i) {
+            const i32 m = node[idx(mesh.neighbors[idx(i)])];
+            below += m < n;
+            same += m == n;  // a plateau
+            some_below = m < n ? m : some_below;
+            some_above = m < n ? some_above : m;
+        }
+        if (e - b > 250 || same > 0) {
+            general[idx(n)] = 1;
+            reps[idx(n)] = {{kSeveral, kNone}, {kSeveral, kNone}};
+            continue;
+        }
+        const int above = e - b - below;
+        const Star& s = stars[v];
+        const bool interior = s.triangles == e - b;
+        const int lower = (above == 0 && interior && below > 0) ? 1 : below - s.lower_edges;
+        const int upper = (below == 0 && interior && above > 0) ? 1 : above - s.upper_edges;
+        vertex_links[v] = {static_cast<std::uint8_t>(lower), static_cast<std::uint8_t>(upper)};
+        auto side = [&](int count, i32 some, int runs, const std::array<i32, 2>& starts) {
+            if (count <= 1) return std::array<i32, 2>{count == 0 ? kNone : some, kNone};
+            if (count == 2 && runs == 2) return starts;
+            return std::array<i32, 2>{kSeveral, kNone};
+        };
+        reps[idx(n)] = {side(lower, some_below, s.runs[0], {s.starts[0], s.starts[1]}),
+                        side(upper, some_above, s.runs[1], {s.starts[2], s.starts[3]})};
+    }
+    return reps;
+}
+
+// The link counts of the critical nodes that link_components left (plateaus, vertices of very
+// high degree), from their stars' triangles.
+void count_general_links(const TriangleMesh& mesh, ReebGraph& g, const std::vector<char>& general) {
+    std::vector<char> wanted;  // per vertex
+    for (std::size_t n = 0; n < g.node_count(); ++n) {
+        if (!general[n] || g.node_kinds[n] == NodeKind::regular) continue;
+        if (wanted.empty()) wanted.assign(mesh.vertex_count(), 0);
+        for (i32 i = g.node_vertex_offsets[n]; i < g.node_vertex_offsets[n + 1]; ++i)
+            wanted[idx(g.node_vertices[idx(i)])] = 1;
+    }
+    if (wanted.empty()) return;
+    std::vector<std::pair<i32, i32>> star;  // (node, triangle)
+    for (std::size_t t = 0; t < mesh.triangle_count(); ++t)
+        for (const i32 c : mesh.triangles[t])
+            if (wanted[idx(c)]) star.push_back({g.vertex_nodes[idx(c)], static_cast<i32>(t)});
+    std::sort(star.begin(), star.end());
+    LinkCounter counter;
+    std::vector<i32> tris;
+    for (std::size_t i = 0; i < star.size();) {
+        const i32 n = star[i].first;
+        tris.clear();
+        for (; i < star.size() && star[i].first == n; ++i) tris.push_back(star[i].second);
+        set_links(g, n, counter.count(mesh, g, n, tris));
+    }
+}
+
+}  // namespace terrain::reeb::internal

@@ -1,0 +1,64 @@
+#pragma once
+// Private: link components of the nodes (paper s.2.1: the lower and upper link subgraphs,
+// whose numbers of components classify a node), for both construction algorithms.
+
+#include <algorithm>
+#include <array>
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+#include "../core/disjoint_sets.hpp"
+#include "../core/indices.hpp"
+#include "terrain/mesh/triangle_mesh.hpp"
+#include "terrain/reeb/reeb_graph.hpp"
+
+namespace terrain::reeb::internal {
+
+using detail::i32;
+
+// The numbers of connected components of a node's lower and upper links: the vertices
+// around the node (not in it), joined by the edges of its star's triangles that do not touch
+// it (the paper's link subgraphs).
+class LinkCounter {
+  public:
+    // `star`: the triangles with a corner in node e (repeats allowed).
+    std::pair<int, int> count(const TriangleMesh& mesh, const ReebGraph& g, i32 e,
+                              const std::vector<i32>& star);
+
+  private:
+    std::vector<i32> verts_;
+    detail::DisjointSets<i32> components_;  // over verts_
+};
+
+// Stores a node's link counts, capped at 255.
+inline void set_links(ReebGraph& g, i32 e, std::pair<int, int> links) {
+    g.node_lower_links[detail::idx(e)] = static_cast<std::uint8_t>(std::min(links.first, 255));
+    g.node_upper_links[detail::idx(e)] = static_cast<std::uint8_t>(std::min(links.second, 255));
+}
+
+inline constexpr i32 kSeveral = -2;
+// Up to two link components' representatives below and above a node: {kNone, kNone} for an
+// empty link, {r, kNone} for one component, {r, s} for two, {kSeveral, ...} when the node is
+// handled vertex by vertex (more components, a plateau, a vertex of very high degree).
+struct LinkReps {
+    std::array<i32, 2> lower, upper;
+};
+
+// Link components of every single-vertex node, in a pass over the triangles and one over the
+// vertices, both in memory order. In a 2-manifold the link of a vertex is a cycle (interior)
+// or a path (boundary), so a part of it has as many components as vertices minus edges,
+// except the whole cycle (one). Going round an interior vertex counter-clockwise, each run of
+// lower (upper) link vertices starts right after an upper (lower) one: the triangle holding
+// that step names the run's first vertex, its representative. Gives the link counts of those
+// vertices in `vertex_links`; `general` marks the nodes left to a LinkCounter.
+using LinkCounts = std::array<std::uint8_t, 2>;
+std::vector<LinkReps> link_components(const TriangleMesh& mesh, const ReebGraph& g,
+                                      std::vector<LinkCounts>& vertex_links,
+                                      std::vector<char>& general);
+
+// The link counts of the critical nodes that link_components left (plateaus, vertices of very
+// high degree), from their stars' triangles.
+void count_general_links(const TriangleMesh& mesh, ReebGraph& g, const std::vector<char>& general);
+
+}  // namespace terrain::reeb::internal

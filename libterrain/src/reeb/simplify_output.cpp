@@ -1,0 +1,109 @@
+// The result of the simplification (paper s.3.2: the simplified graph, and the field
+// rewritten so that it agrees with it): every remaining node is numbered anew in the order of
+// the old ones, an absorbed node's vertices join the node that finally took it (following
+// forward links and the union-find sets of absorbed lists), each vertex takes its node's
+// value, and the arcs that remain are listed with their regular nodes from the lower end up.
+
+#include <algorithm>
+#include <array>
+
+#include "../core/disjoint_sets.hpp"
+#include "working_graph.hpp"
+
+namespace terrain::reeb::internal {
+
+using detail::find_root;
+
+void WorkingGraph::write_result(SimplifyResult& result) {
+    const std::size_t nn = g_.node_count(), nl = regular_.size();
+    // code[i]: for an absorbed node, the critical node that finally took it (nodes are
+    // only absorbed into critical nodes); for a remaining node, -2 - its new id.
+    // A listed node's forward: the fate of its set's root (kNone for a list still there).
+    const auto fate = [&](i32 f) {
+        return f > -2 ? f : set_fate_[idx(find_root(set_parent_, -2 - f))];
+    };
+    std::vector<i32> code(idx(critical_count_) + nl);
+    for (std::size_t k = 0; k < idx(critical_count_); ++k) code[k] = fate(critical_[k].forward);
+    for (std::size_t k = 0; k < idx(critical_count_); ++k)
+        if (code[k] != kNone) code[k] = find_root(code, code[k]);
+    for (std::size_t p = 0; p < nl; ++p) {
+        const i32 f = fate(regular_[p].forward);
+        code[idx(critical_count_) + p] = f == kNone || code[idx(f)] == kNone ? f : code[idx(f)];
+    }
+    // The remaining nodes are numbered in the order of the old ones; node_map_ takes each old
+    // node's new node (first -2 - the node that took it, for the absorbed ones).
+    std::vector<std::array<i32, 2>> kept;  // {old node, internal index} by new id
+    for (std::size_t n = 0; n < nn; ++n) {
+        if (n + kAhead < nn) __builtin_prefetch(&code[idx(node_map_[n + kAhead])]);
+        i32& c = code[idx(node_map_[n])];
+        if (c != kNone) {
+            node_map_[n] = -2 - c;
+            continue;
+        }
+        c = -2 - static_cast<i32>(kept.size());
+        kept.push_back({static_cast<i32>(n), node_map_[n]});
+        node_map_[n] = -2 - c;
+    }
+    const std::size_t count = kept.size();
+    std::vector<i32> size(count + 1, 0);
+    for (std::size_t n = 0; n < nn; ++n) {
+        if (node_map_[n] < 0) node_map_[n] = -2 - code[idx(-2 - node_map_[n])];
+        size[idx(node_map_[n]) + 1] += g_.node_vertex_offsets[n + 1] - g_.node_vertex_offsets[n];
+    }
+    ReebGraph& out = result.graph;
+    out.node_values.resize(count);
+    out.node_kinds.assign(count, NodeKind::regular);
+    out.node_lower_links.assign(count, 1);
+    out.node_upper_links.assign(count, 1);
+    out.node_arcs.assign(count, kNone);
+    for (std::size_t nid = 0; nid < count; ++nid) {
+        const auto [n, i] = kept[nid];
+        out.node_values[nid] = value(i);
+        if (i >= critical_count_ || !(critical_[idx(i)].flags & kCritical)) continue;
+        const i32 d = down(i), u = up(i);
+        out.node_kinds[nid] = d == 0   ? NodeKind::minimum
+                              : u == 0 ? NodeKind::maximum
+                                       : NodeKind::saddle;
+        const bool unchanged = !(critical_[idx(i)].flags & kModified);
+        out.node_lower_links[nid] =
+            unchanged ? g_.node_lower_links[idx(n)] : static_cast<std::uint8_t>(std::min(d, 255));
+        out.node_upper_links[nid] =
+            unchanged ? g_.node_upper_links[idx(n)] : static_cast<std::uint8_t>(std::min(u, 255));
+    }
+    // Vertices: grouped by new node, in the order of their old nodes.
+    for (std::size_t i = 1; i < size.size(); ++i) size[i] += size[i - 1];
+    out.node_vertex_offsets = size;
+    out.node_vertices.resize(g_.node_vertices.size());
+    out.vertex_nodes.resize(g_.vertex_nodes.size());
+    for (std::size_t n = 0; n < nn; ++n) {
+        if (n + kAhead < nn) {
+            const i32 i = g_.node_vertex_offsets[n + kAhead];
+            if (i < g_.node_vertex_offsets[n + kAhead + 1])
+                __builtin_prefetch(&out.vertex_nodes[idx(g_.node_vertices[idx(i)])], 1);
+        }
+        const i32 nid = node_map_[n];
+        for (i32 i = g_.node_vertex_offsets[n]; i < g_.node_vertex_offsets[n + 1]; ++i) {
+            const i32 v = g_.node_vertices[idx(i)];
+            out.node_vertices[idx(size[idx(nid)]++)] = v;
+            out.vertex_nodes[idx(v)] = nid;
+        }
+    }
+    result.field.resize(g_.vertex_nodes.size());
+    for (std::size_t v = 0; v < result.field.size(); ++v)
+        result.field[v] = out.node_values[idx(out.vertex_nodes[v])];
+    const auto new_id = [&](i32 i) { return -2 - code[idx(i)]; };
+    out.arc_offsets.assign(1, 0);
+    for (const Arc& arc : arcs_) {
+        if (arc.set == kNone) continue;
+        const i32 id = static_cast<i32>(out.arcs.size());
+        out.arcs.push_back({new_id(arc.end[0]), new_id(arc.end[1])});
+        for (i32 r = arc.head; r != kNone; r = next(r)) {
+            const i32 nid = new_id(r);
+            out.arc_nodes.push_back(nid);
+            out.node_arcs[idx(nid)] = id;
+        }
+        out.arc_offsets.push_back(static_cast<i32>(out.arc_nodes.size()));
+    }
+}
+
+}  // namespace terrain::reeb::internal

@@ -1,0 +1,114 @@
+// The working graph of the simplification: the Reeb graph copied into the layout that
+// working_graph.hpp describes (critical nodes first, one record each; the lists' regular
+// nodes in list order; each arc's list its own set at first).
+
+#include "working_graph.hpp"
+
+#include <algorithm>
+#include <string>
+
+#include "terrain/core/error.hpp"
+
+namespace terrain::reeb::internal {
+
+namespace {
+
+// The summed area of node n's vertices, added in increasing vertex order (as a sweep over
+// the vertices would add them).
+double node_area(const TriangleMesh& mesh, const ReebGraph& g, std::size_t n,
+                 std::vector<i32>& scratch) {
+    const i32* v = g.node_vertices.data() + g.node_vertex_offsets[n];
+    const std::size_t count = idx(g.node_vertex_offsets[n + 1] - g.node_vertex_offsets[n]);
+    if (!std::is_sorted(v, v + count)) {
+        scratch.assign(v, v + count);
+        std::sort(scratch.begin(), scratch.end());
+        v = scratch.data();
+    }
+    double s = 0;
+    for (std::size_t i = 0; i < count; ++i)
+        s += mesh.vertex_areas.empty() ? 1.0 : mesh.vertex_areas[idx(v[i])];
+    return s;
+}
+
+}  // namespace
+
+WorkingGraph::WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g) : g_(g) {
+    const std::size_t nn = g.node_count(), na = g.arc_count(), nl = g.arc_nodes.size();
+    // node_map_[n]: arc ends marked, the other regular nodes of the lists by their position in
+    // arc_nodes (`placed` says which positions hold their node); then the new numbers.
+    constexpr i32 kEnd = -2;
+    node_map_.assign(nn, kNone);
+    for (const auto& e : g.arcs) node_map_[idx(e[0])] = node_map_[idx(e[1])] = kEnd;
+    std::vector<char> placed(nl, 0);
+    for (std::size_t p = 0; p < nl; ++p) {
+        const i32 r = g.arc_nodes[p];
+        // (A critical node in a list keeps its neighbours in its record, which an arc end
+        // needs for its arcs.)
+        if (node_map_[idx(r)] != kNone)
+            throw Error("simplify", "the graph is not valid: node " + std::to_string(r) +
+                                        " is an arc end or in two arcs' lists");
+        if (g.node_kinds[idx(r)] != NodeKind::regular) continue;
+        node_map_[idx(r)] = static_cast<i32>(p);
+        placed[p] = 1;
+    }
+    critical_count_ = 0;
+    for (const i32 i : node_map_) critical_count_ += i < 0;
+    critical_.resize(idx(critical_count_));
+    regular_.resize(nl);
+    total_area_ = 0;
+    std::vector<i32> scratch;
+    i32 k = 0;
+    for (std::size_t n = 0; n < nn; ++n) {
+        if (n + kAhead < nn) {
+            const std::size_t m = n + kAhead;
+            const i32 i = g.node_vertex_offsets[m];
+            if (!mesh.vertex_areas.empty() && i < g.node_vertex_offsets[m + 1])
+                __builtin_prefetch(&mesh.vertex_areas[idx(g.node_vertices[idx(i)])]);
+            if (node_map_[m] >= 0) __builtin_prefetch(&regular_[idx(node_map_[m])], 1);
+        }
+        const double area = node_area(mesh, g, n, scratch);
+        total_area_ += area;
+        if (node_map_[n] < 0) {
+            critical_[idx(k)].area = area;
+            critical_[idx(k)].value = g.node_values[n];
+            critical_[idx(k)].flags = g.node_kinds[n] != NodeKind::regular ? kCritical : 0;
+            node_map_[n] = k++;
+        } else {
+            regular_[idx(node_map_[n])].area = area;
+            regular_[idx(node_map_[n])].value = g.node_values[n];
+            node_map_[n] += critical_count_;
+        }
+    }
+    total_area_ = mesh_area_or_one(total_area_);
+    // Arc a joins its lower then its upper end, a in order.
+    arcs_.resize(na);
+    set_parent_.assign(na, kNone);
+    set_fate_.assign(na, kNone);
+    for (std::size_t a = 0; a < na; ++a) {
+        Arc& arc = arcs_[a];
+        if (a + kAhead < na)
+            for (const i32 e : g.arcs[a + kAhead]) __builtin_prefetch(&node_map_[idx(e)]);
+        if (a + kAhead / 2 < na)
+            for (const i32 e : g.arcs[a + kAhead / 2])
+                __builtin_prefetch(&critical_[idx(node_map_[idx(e)])], 1);
+        arc.end = {node_map_[idx(g.arcs[a][0])], node_map_[idx(g.arcs[a][1])]};
+        for (const i32 e : arc.end) link(static_cast<i32>(a), e);
+        ++critical_[idx(arc.end[1])].down;
+        arc.set = static_cast<i32>(a);
+        for (i32 p = g.arc_offsets[a]; p < g.arc_offsets[a + 1]; ++p) {
+            const i32 r =
+                placed[idx(p)] ? critical_count_ + p : node_map_[idx(g.arc_nodes[idx(p)])];
+            forward(r) = -2 - arc.set;
+            if (arc.tail == kNone) {
+                arc.head = r;
+            } else {
+                next(arc.tail) = r;
+                prev(r) = arc.tail;
+            }
+            arc.tail = r;
+            arc.area += area(r);
+        }
+    }
+}
+
+}  // namespace terrain::reeb::internal
