@@ -34,6 +34,10 @@ class ArcQueue {
     static i32 arc_of(std::uint64_t key) { return static_cast<i32>(key & 0xffffffffu); }
 
     void init(std::size_t arcs) { slot_.assign(arcs, detail::kNone); }
+    std::size_t bytes() const {
+        return heap_.capacity() * sizeof(std::uint64_t) + slot_.capacity() * sizeof(i32) +
+               sorted_.capacity() * sizeof(std::uint64_t);
+    }
     void release() {
         detail::release(slot_);
         detail::release(heap_);

@@ -75,6 +75,7 @@ bool Simplifier::regularize(i32 n, std::vector<i32>& out) {
     if (L.end[0] == U.end[1]) return false;
     CriticalNode& k = critical_[idx(n)];
     k.size = 0;  // its two arcs leave it, and its record takes its list neighbours
+    release_run(k);
     k.down = 0;
     k.flags &= ~kCritical;
     k.forward = -2 - L.set;
@@ -161,6 +162,7 @@ void Simplifier::cancel(i32 a, SimplifyResult& result) {
     std::vector<i32>& touched = touched_;
     arcs_at(gone, touched);
     critical_[idx(gone)].size = 0;
+    release_run(critical_[idx(gone)]);
     critical_[idx(gone)].down = 0;
     for (const i32 b : touched) {
         Arc& other = arcs_[idx(b)];

@@ -63,6 +63,7 @@ void Simplifier::run(const ProgressFn& progress, SimplifyResult& result) {
             report_progress(progress, std::min(0.9, 0.9 * done / static_cast<double>(initial)),
                             "simplify");
     }
+    result.working_bytes = working_bytes() + queue_.bytes();
     queue_.release();  // the output is the peak of memory: the queue is done
     write_result(result);
     report_progress(progress, 1.0, "simplify");

@@ -5,11 +5,36 @@
 #include "working_graph.hpp"
 
 #include <algorithm>
+#include <limits>
 #include <string>
 
 #include "terrain/core/error.hpp"
 
 namespace terrain::reeb::internal {
+
+i32 WorkingGraph::take_run(std::uint8_t shift) {
+    const std::size_t room = std::size_t{kInline} << shift;
+    auto& freed = free_runs_[shift];
+    if (!freed.empty()) {
+        const i32 offset = freed.back();
+        freed.pop_back();
+        return offset;
+    }
+    const std::size_t offset = arena_.size();
+    if (offset + room > static_cast<std::size_t>(std::numeric_limits<i32>::max()))
+        throw Error("simplify", "a node has more arcs than the working graph can hold (2^31)");
+    arena_.resize(offset + room);
+    arena_peak_ = std::max(arena_peak_, arena_.size());
+    return static_cast<i32>(offset);
+}
+
+std::size_t WorkingGraph::working_bytes() const {
+    std::size_t freed = 0;
+    for (const auto& f : free_runs_) freed += f.capacity() * sizeof(i32);
+    return critical_.capacity() * sizeof(CriticalNode) + regular_.capacity() * sizeof(RegularNode) +
+           arcs_.capacity() * sizeof(Arc) + arena_.capacity() * sizeof(i32) + freed +
+           (set_parent_.capacity() + set_fate_.capacity() + node_map_.capacity()) * sizeof(i32);
+}
 
 namespace {
 

@@ -36,6 +36,8 @@ class WorkingGraph {
 
     // The simplified graph and the rewritten field (simplify_output.cpp).
     void write_result(SimplifyResult& result);
+    // The bytes it holds now: records, arc runs (freed ones included), list sets.
+    std::size_t working_bytes() const;
 
   protected:
     // A critical node (one of the first critical_count_), in one cache line: its fields and its
@@ -115,15 +117,21 @@ class WorkingGraph {
         out.clear();
         for_each_arc(n, [&](i32 a) { out.push_back(a); });
     }
-    // Arc a joins node n; a full run moves to the arena's end with twice the room.
+    // Arc a joins node n. A full run moves to a run with twice the room: a freed run of that
+    // size if there is one, else a new one at the arena's end; the old run is freed. The
+    // arena thus holds at most the runs of the nodes that have arcs now (plus freed runs
+    // waiting for reuse), however often arcs move between nodes: moving a high-degree node's
+    // arcs to a new node at every cancellation, as the degenerate extrema of noisy closed
+    // surfaces do, once grew it without bound (past 2^31 entries on a 66 M pixel global grid).
     void link(i32 a, i32 n) {
         CriticalNode& c = critical_[idx(n)];
         if (c.size == kInline << c.shift) {
-            const i32 offset = static_cast<i32>(arena_.size());
-            arena_.resize(arena_.size() + 2 * idx(c.size));
+            const std::uint8_t shift = static_cast<std::uint8_t>(c.shift + 1);
+            const i32 offset = take_run(shift);
             std::copy_n(arc_run(c), c.size, arena_.data() + offset);
+            release_run(c);
             c.offset = offset;
-            ++c.shift;
+            c.shift = shift;
         }
         arc_run(c)[c.size++] = a;
     }
@@ -132,6 +140,7 @@ class WorkingGraph {
         CriticalNode& c = critical_[idx(n)];
         if (c.size == 1) {  // its only arc
             c.size = 0;
+            release_run(c);
             return;
         }
         i32* const last = arc_run(c) + c.size;
@@ -140,6 +149,15 @@ class WorkingGraph {
         for (; it + 1 != last; ++it) *it = *(it + 1);
         --c.size;
     }
+    // A node left with no arcs gives its run back (its arcs go in its record again, and its
+    // record may hold its list neighbours).
+    void release_run(CriticalNode& c) {
+        if (c.shift == 0) return;
+        free_runs_[c.shift].push_back(c.offset);
+        c.shift = 0;
+    }
+    // A run with room for kInline << shift arcs: a freed one, or a new one at the arena's end.
+    i32 take_run(std::uint8_t shift);
 
     // Arcs below and above a critical node: its arcs ending there as the upper / lower end
     // (`down` is updated wherever an arc end moves or an arc turns around).
@@ -201,6 +219,8 @@ class WorkingGraph {
     std::vector<CriticalNode> critical_;
     std::vector<RegularNode> regular_;  // node critical_count_ + i is regular_[i]
     std::vector<i32> arena_;
+    std::array<std::vector<i32>, 32> free_runs_;  // freed runs by shift
+    std::size_t arena_peak_ = 0;                  // the arena's largest size, entries
     double total_area_ = 0;
     std::vector<i32> set_parent_;  // of each set, kNone for a root (an arc's current set)
     std::vector<i32> set_fate_;    // of each root set: the node that absorbed it, or kNone

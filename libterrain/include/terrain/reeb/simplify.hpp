@@ -33,6 +33,9 @@ struct SimplifyResult {
     std::size_t turned_made_regular = 0;   // of made_regular: far ends of turned arcs
     std::size_t turned_made_extremum = 0;  // far ends of turned arcs left extrema (their
                                            // arcs are new candidates)
+    // Bytes of the working graph and the queue at the end of the cancellations (their arc
+    // runs never shrink, so this is their peak).
+    std::size_t working_bytes = 0;
 };
 
 // Throws terrain::Error (stage "simplify") for a negative or non-finite threshold, or an area
