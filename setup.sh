@@ -26,6 +26,9 @@ packages=(
   libeigen3-dev libtbb-dev
   catch2
   time
+  # The Python module and its tests (docs/python.md).
+  pybind11-dev python3-pybind11 python3-dev python3-numpy python3-pytest
+  python3-gdal python3-geopandas python3-rasterio python3-networkx
 )
 # Only for `./setup.sh bench`: libcgal-demo ships CGAL's sample meshes (data.tar.gz), on
 # which bench_sdf compares our Shape Diameter Function with CGAL's.
