@@ -292,7 +292,7 @@ def shape_index(dem, geotransform=None, crs=None, *, rings=2, radius=0.0, progre
 class ReebGraph:
     """The Reeb graph of a field: its critical nodes and the arcs between them.
 
-    nodes: node, value, kind ("minimum", "maximum", "saddle"), vertex (a mesh vertex of the
+    nodes: node, value, kind ("min", "max", "saddle"), vertex (a mesh vertex of the
         node), vertex_count, col, row (its DEM pixel; -1 for mesh files).
     arcs: lower, upper (indices into the node columns), regular_nodes.
     critical_before: critical nodes before simplification.
