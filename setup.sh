@@ -3,6 +3,8 @@
 #   ./setup.sh          install missing Debian packages, build, run the main job on the sample
 #   ./setup.sh test     install missing Debian packages, build, run the whole test suite
 #   ./setup.sh bench    also install the bench-only packages, build, run the benchmarks
+#   ./setup.sh qgis     also install QGIS, build, install the Processing provider into the
+#                       QGIS profile (QGIS_PROFILE, default: the user's default profile)
 # All are idempotent: installed packages are skipped and the build directory is reused.
 # Environment: BUILD_DIR (default build), OUT_DIR (default out), JOBS (default nproc).
 set -euo pipefail
@@ -26,7 +28,13 @@ packages=(
   libeigen3-dev libtbb-dev
   catch2
   time
+  # The Python module and its tests (docs/python.md).
+  pybind11-dev python3-pybind11 python3-dev python3-numpy python3-pytest
+  python3-gdal python3-geopandas python3-rasterio python3-networkx
 )
+# For `./setup.sh test` (the headless test of the QGIS provider, ~3 min to install) and
+# `./setup.sh qgis`; the default set-up does not download QGIS.
+qgis_packages=(qgis python3-qgis)
 # Only for `./setup.sh bench`: libcgal-demo ships CGAL's sample meshes (data.tar.gz), on
 # which bench_sdf compares our Shape Diameter Function with CGAL's.
 bench_packages=(libcgal-demo)
@@ -73,7 +81,7 @@ case "$mode" in
     echo "setup: outputs in $out_dir/vesta_hamo_tile/ (labels.tif, regions.geojson, adjacency.*, preview.png, run.json)"
     ;;
   test)
-    install_packages "${packages[@]}"
+    install_packages "${packages[@]}" "${qgis_packages[@]}"
     build
     ctest --test-dir "$build_dir" --output-on-failure -j "$jobs"
     ;;
@@ -97,8 +105,23 @@ case "$mode" in
     "$build_dir/tests/bench/bench_outputs"
     tests/bench/bench_segment.sh "$build_dir"
     ;;
+  qgis)
+    install_packages "${packages[@]}" "${qgis_packages[@]}"
+    build
+    # The plugin, with local.json telling it where this build's module and program are.
+    profile="${QGIS_PROFILE:-$HOME/.local/share/QGIS/QGIS3/profiles/default}"
+    plugin="$profile/python/plugins/terrain_provider"
+    mkdir -p "$(dirname "$plugin")"
+    rm -rf "$plugin"
+    cp -r qgis/terrain_provider "$plugin"
+    printf '{"pythonpath": "%s", "cli": "%s"}\n' "$here/$build_dir/python" \
+      "$here/$build_dir/tools/terrain" >"$plugin/local.json"
+    qgis_process="$(command -v qgis_process.bin || echo /usr/bin/qgis_process.bin)"
+    QT_QPA_PLATFORM=offscreen "$qgis_process" plugins enable terrain_provider >/dev/null
+    echo "setup: the terrain provider is in $plugin (Processing toolbox > terrain)"
+    ;;
   *)
-    echo "usage: ./setup.sh [run|test|bench]" >&2
+    echo "usage: ./setup.sh [run|test|bench|qgis]" >&2
     exit 2
     ;;
 esac

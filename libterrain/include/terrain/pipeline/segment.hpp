@@ -1,0 +1,178 @@
+#pragma once
+// The segmentation pipeline as library calls (docs/segment.md): the input read and meshed,
+// the field, the Reeb graph, its simplification, region growing and the region table, each
+// stage timed, with one progress callback; then every output file of `terrain segment` and
+// run.json written into a directory. The command line, the examples and the Python module
+// call these; the command line adds only option parsing, printing and exit codes.
+//
+//   auto input = pipeline::load_input("tile.tif");
+//   auto result = pipeline::segment(std::move(input), options, progress);
+//   pipeline::OutputDirectory dir("out", true);
+//   pipeline::write_segment_directory(result, options, "tile.tif", dir.temp_path());
+//   dir.commit();
+
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "terrain/core/dem.hpp"
+#include "terrain/core/progress.hpp"
+#include "terrain/field/vertex_field.hpp"
+#include "terrain/io/read_dem.hpp"
+#include "terrain/mesh/triangle_mesh.hpp"
+#include "terrain/reeb/reeb_graph.hpp"
+#include "terrain/reeb/simplify.hpp"
+#include "terrain/segment/grow_regions.hpp"
+#include "terrain/segment/regions.hpp"
+
+namespace terrain::pipeline {
+
+// What a pipeline runs on: a DEM and the mesh made from it, or a mesh read from a file.
+struct Input {
+    std::optional<Dem> dem;  // set for DEM input
+    TriangleMesh mesh;
+    double read_seconds = 0, mesh_seconds = 0;  // wall time of reading and triangulating
+};
+
+struct InputOptions {
+    io::ReadDemOptions dem;
+    // body, map or auto: body-fixed X,Y,Z, or map easting/northing/height (auto: body for
+    // planetary and geographic CRSs, map otherwise).
+    std::string frame = "auto";
+    bool repair = false;  // mesh files: repair degenerate or non-manifold elements
+};
+
+// The frame named by InputOptions::frame; throws terrain::Error (stage "mesh") otherwise.
+std::optional<MeshFrame> parse_frame(const std::string& name);
+
+// Reads `path` as a mesh file (.off/.ply/.obj) or as a DEM, and meshes the DEM.
+Input load_input(const std::string& path, const InputOptions& options = {},
+                 const ProgressFn& progress = {});
+// A DEM held in memory (georeferenced: geo::georeference(dem) has run), meshed.
+Input input_from_dem(Dem dem, const std::string& frame = "auto", const ProgressFn& progress = {});
+
+// The options of `terrain segment` (docs/cli.md), with its defaults.
+struct SegmentOptions {
+    std::string field = "shape-index";          // shape-index, sdf or height
+    field::ShapeIndexOptions shape_index;       // rings, radius
+    int rays = 25;                              // sdf: rays per face
+    double cone_angle_degrees = 120;            // sdf: opening of each face's cone of rays
+    bool postprocess = true;                    // sdf: bilateral smoothing of the face values
+    bool allow_open = false;                    // sdf: a mesh with holes is accepted
+    reeb::SimplifyOptions simplify{10.0, 0.5};  // persistence, area ratio (percent)
+    std::string cost = "auto";  // graph, standard, or auto: graph for DEMs, standard for meshes
+    double saddle_penalty = 20;
+    std::string format = "GeoJSON";  // OGR driver of the region polygons
+};
+
+// Thresholds and names, checked before any long work; throws terrain::Error.
+void check_options(const SegmentOptions& options);
+// The field library's options.
+field::FieldOptions field_options(const SegmentOptions& options);
+// The cost `auto` resolves to: graph for a DEM, standard for a mesh file.
+segment::GrowCost grow_cost(const SegmentOptions& options, bool dem);
+
+struct StageTime {
+    std::string name;
+    double seconds = 0;
+};
+
+// The mesh's counts in run.json. Edges come from the adjacency lists; in an edge-manifold
+// mesh 3F = 2 E_interior + E_boundary, so E_boundary = 2E - 3F without looking at edges.
+struct MeshCounts {
+    std::size_t vertices = 0, faces = 0, boundary_edges = 0;
+    std::int64_t euler_characteristic = 0;
+};
+MeshCounts mesh_counts(const TriangleMesh& mesh);
+
+// What the segmentation of one input gives: the field, the labels per mesh vertex, the
+// region table and adjacency graph, the counts and the time of each stage.
+struct SegmentResult {
+    Input input;
+    std::vector<float> field;         // per mesh vertex, as computed
+    std::size_t critical_before = 0;  // critical nodes of the unsimplified Reeb graph
+    reeb::ReebSummary after;          // the simplified graph of the segmentation
+    segment::Segmentation segmentation;
+    segment::RegionGraph regions;
+    std::vector<StageTime> timings;         // read, mesh, field, reeb, simplify, grow, write
+    std::optional<MeshCounts> mesh_counts;  // kept by release_large_data for run.json
+
+    const Dem* dem() const { return input.dem ? &*input.dem : nullptr; }
+    void add_time(const std::string& name, double seconds);
+    // The label of each DEM pixel (row-major, 0 = NoData), as in labels.tif; DEM input only.
+    std::vector<std::uint32_t> label_pixels() const;
+};
+
+// The field of the input's mesh into result.field (stage "field").
+void compute_field(SegmentResult& result, const SegmentOptions& options,
+                   const ProgressFn& progress = {});
+// The unsimplified Reeb graph of result.field (stage "reeb"); sets critical_before.
+reeb::ReebGraph compute_reeb(SegmentResult& result, const ProgressFn& progress = {});
+
+// One scale: the graph simplified with options.simplify and the regions grown on it.
+struct ScaleResult {
+    segment::Segmentation segmentation;
+    reeb::ReebSummary after;  // of the simplified graph
+    double simplify_seconds = 0, grow_seconds = 0;
+};
+// Reads its arguments only, so scales can run side by side.
+ScaleResult segment_scale(const Input& input, const reeb::ReebGraph& graph,
+                          const SegmentOptions& options, const ProgressFn& progress = {});
+
+// The whole segmentation: field, Reeb graph, simplification, growing, region table.
+// Throws terrain::Error (with the failing stage) on bad options or input, "cancelled" when
+// the progress callback returns false.
+SegmentResult segment(Input input, const SegmentOptions& options, const ProgressFn& progress = {});
+
+// Frees the mesh's arrays, the field and the labels (what is left: counts, timings, the
+// region table, the DEM), and gives the memory back to the system.
+void release_large_data(SegmentResult& result);
+
+struct WriteOptions {
+    // Frees the large data once the files that need it are written, before preview.png is
+    // encoded (OpenImageIO, loaded for it, then does not add to the peak memory).
+    bool release_memory = false;
+};
+
+// Every output of `terrain segment` into the existing directory `dir` (docs/outputs.md):
+// for a DEM labels.tif, regions.<format>, adjacency.{json,graphml,geojson}, preview.png;
+// for a mesh file labels.ply, faces.seg and the adjacency files; then run.json, which
+// records `input_path`. Returns the file names written (run.json last). Stage "write".
+std::vector<std::string> write_segment_directory(
+    SegmentResult& result, const SegmentOptions& options, const std::string& input_path,
+    const std::string& dir, const WriteOptions& write = {}, const ProgressFn& progress = {});
+
+// run.json at `path`: the input, parameters, counts, timings, the files written, `extra`
+// members (name, JSON text) and the versions.
+void write_run_json(const SegmentResult& result, const std::string& input_path,
+                    const SegmentOptions& options, const std::vector<std::string>& files,
+                    const std::string& path,
+                    const std::vector<std::pair<std::string, std::string>>& extra = {});
+
+// A directory written in full beside its final place, then moved there: it appears complete
+// or not at all. An existing non-empty directory is refused unless `overwrite`. Throws
+// terrain::Error (stage "write") when the place cannot be written.
+class OutputDirectory {
+  public:
+    OutputDirectory(std::string path, bool overwrite);
+    ~OutputDirectory();
+    OutputDirectory(const OutputDirectory&) = delete;
+    OutputDirectory& operator=(const OutputDirectory&) = delete;
+    const std::string& temp_path() const { return temp_; }
+    void commit();
+
+  private:
+    std::string path_, temp_;
+    bool committed_ = false;
+};
+
+// The library as one call: reads `input_path`, segments it and writes `output_dir` as
+// `terrain segment` does. Returns the result with its large data released.
+SegmentResult segment_to_directory(const std::string& input_path, const std::string& output_dir,
+                                   bool overwrite, const InputOptions& input_options,
+                                   const SegmentOptions& options, const ProgressFn& progress = {});
+
+}  // namespace terrain::pipeline

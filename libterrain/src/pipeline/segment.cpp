@@ -1,0 +1,322 @@
+#include "terrain/pipeline/segment.hpp"
+
+#include <malloc.h>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <type_traits>
+
+#include "terrain/core/error.hpp"
+#include "terrain/core/json_writer.hpp"
+#include "terrain/core/version.hpp"
+#include "terrain/io/dependency_versions.hpp"
+#include "terrain/io/mesh_files.hpp"
+#include "terrain/io/segment_outputs.hpp"
+#include "terrain/mesh/dem_to_mesh.hpp"
+
+namespace terrain::pipeline {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+using clock = std::chrono::steady_clock;
+double since(clock::time_point t0) {
+    return std::chrono::duration<double>(clock::now() - t0).count();
+}
+
+}  // namespace
+
+std::optional<MeshFrame> parse_frame(const std::string& name) {
+    if (name == "body") return MeshFrame::body;
+    if (name == "map") return MeshFrame::map;
+    if (name == "auto") return std::nullopt;
+    throw Error("mesh", "the frame must be body, map or auto, not '" + name + "'");
+}
+
+Input load_input(const std::string& path, const InputOptions& options, const ProgressFn& progress) {
+    const auto t0 = clock::now();
+    if (io::is_mesh_file(path)) {
+        io::ReadMeshOptions read_options;
+        read_options.repair = options.repair;
+        Input input;
+        input.mesh = io::read_mesh(path, read_options, progress);
+        input.read_seconds = since(t0);
+        return input;
+    }
+    const auto frame = parse_frame(options.frame);
+    Dem dem = io::read_dem(path, options.dem, scaled_progress(progress, 0, 0.3));
+    const double read_seconds = since(t0);
+    mesh::DemToMeshOptions mesh_options;
+    mesh_options.frame = frame;
+    const auto t1 = clock::now();
+    Input input;
+    input.mesh = mesh::dem_to_mesh(dem, mesh_options, scaled_progress(progress, 0.3, 1));
+    input.mesh_seconds = since(t1);
+    input.read_seconds = read_seconds;
+    input.dem = std::move(dem);
+    return input;
+}
+
+Input input_from_dem(Dem dem, const std::string& frame, const ProgressFn& progress) {
+    mesh::DemToMeshOptions mesh_options;
+    mesh_options.frame = parse_frame(frame);
+    const auto t0 = clock::now();
+    Input input;
+    input.mesh = mesh::dem_to_mesh(dem, mesh_options, progress);
+    input.mesh_seconds = since(t0);
+    input.dem = std::move(dem);
+    return input;
+}
+
+void check_options(const SegmentOptions& o) {
+    field::parse_field_kind(o.field);
+    if (!std::isfinite(o.simplify.persistence) || o.simplify.persistence < 0)
+        throw Error("segment", "--persistence must be a number >= 0");
+    if (!std::isfinite(o.simplify.area_ratio) || o.simplify.area_ratio < 0 ||
+        o.simplify.area_ratio > 100)
+        throw Error("segment", "--area-ratio is a percentage of the surface: between 0 and 100");
+    if (!std::isfinite(o.saddle_penalty) || o.saddle_penalty < 0)
+        throw Error("segment", "--saddle-penalty must be a number >= 0");
+    if (o.cost != "auto") segment::parse_grow_cost(o.cost);
+}
+
+field::FieldOptions field_options(const SegmentOptions& o) {
+    field::FieldOptions out;
+    out.kind = field::parse_field_kind(o.field);
+    out.shape_index = o.shape_index;
+    out.sdf.rays = o.rays;
+    out.sdf.cone_angle = o.cone_angle_degrees * std::numbers::pi / 180.0;
+    out.sdf.postprocess = o.postprocess;
+    out.sdf.allow_open = o.allow_open;
+    return out;
+}
+
+segment::GrowCost grow_cost(const SegmentOptions& o, bool dem) {
+    if (o.cost == "auto") return dem ? segment::GrowCost::graph : segment::GrowCost::standard;
+    return segment::parse_grow_cost(o.cost);
+}
+
+MeshCounts mesh_counts(const TriangleMesh& mesh) {
+    MeshCounts c;
+    c.vertices = mesh.vertex_count();
+    c.faces = mesh.triangle_count();
+    const auto edges = static_cast<std::int64_t>(mesh.neighbors.size() / 2);
+    c.boundary_edges = static_cast<std::size_t>(2 * edges - 3 * static_cast<std::int64_t>(c.faces));
+    c.euler_characteristic =
+        static_cast<std::int64_t>(c.vertices) - edges + static_cast<std::int64_t>(c.faces);
+    return c;
+}
+
+void SegmentResult::add_time(const std::string& name, double seconds) {
+    for (auto& t : timings)
+        if (t.name == name) {
+            t.seconds += seconds;
+            return;
+        }
+    timings.push_back({name, seconds});
+}
+
+std::vector<std::uint32_t> SegmentResult::label_pixels() const {
+    if (!input.dem) throw Error("segment", "label pixels need a DEM; this input is a mesh file");
+    return segment::label_pixels(input.mesh, *input.dem, segmentation.labels);
+}
+
+void compute_field(SegmentResult& result, const SegmentOptions& options,
+                   const ProgressFn& progress) {
+    const auto t0 = clock::now();
+    result.field =
+        field::vertex_field(result.input.mesh, result.dem(), field_options(options), progress);
+    result.add_time("field", since(t0));
+}
+
+reeb::ReebGraph compute_reeb(SegmentResult& result, const ProgressFn& progress) {
+    const auto t0 = clock::now();
+    auto graph = reeb::build_reeb_graph(result.input.mesh, result.field, {}, progress);
+    result.critical_before = reeb::summarize(graph).critical;
+    result.add_time("reeb", since(t0));
+    return graph;
+}
+
+namespace {
+
+// Regions grown on a simplified graph.
+ScaleResult grow_scale(const Input& input, const SegmentOptions& options,
+                       const reeb::SimplifyResult& simplified, double simplify_seconds,
+                       const ProgressFn& progress) {
+    ScaleResult out;
+    out.after = reeb::summarize(simplified.graph);
+    out.simplify_seconds = simplify_seconds;
+    const auto t0 = clock::now();
+    segment::GrowOptions grow;
+    grow.saddle_penalty = options.saddle_penalty;
+    grow.cost = grow_cost(options, input.dem.has_value());
+    out.segmentation = segment::grow_regions(input.mesh, simplified.graph, grow, progress);
+    out.grow_seconds = since(t0);
+    return out;
+}
+
+}  // namespace
+
+ScaleResult segment_scale(const Input& input, const reeb::ReebGraph& graph,
+                          const SegmentOptions& options, const ProgressFn& progress) {
+    const auto t0 = clock::now();
+    const auto simplified =
+        reeb::simplify(input.mesh, graph, options.simplify, scaled_progress(progress, 0, 0.3));
+    return grow_scale(input, options, simplified, since(t0), scaled_progress(progress, 0.3, 1));
+}
+
+SegmentResult segment(Input input, const SegmentOptions& options, const ProgressFn& progress) {
+    check_options(options);
+    SegmentResult result;
+    result.input = std::move(input);
+    result.timings.push_back({"read", result.input.read_seconds});
+    if (result.input.dem) result.timings.push_back({"mesh", result.input.mesh_seconds});
+    // The slices of the command line's bar (field 0.15-0.45, reeb -0.6, segment -0.7).
+    compute_field(result, options, scaled_progress(progress, 0, 30.0 / 55));
+    auto graph = compute_reeb(result, scaled_progress(progress, 30.0 / 55, 45.0 / 55));
+    // One scale only: the simplification takes the graph and frees what it no longer needs,
+    // which lowers the peak memory.
+    const auto t0 = clock::now();
+    const auto simplified = reeb::simplify(result.input.mesh, std::move(graph), options.simplify,
+                                           scaled_progress(progress, 45.0 / 55, 48.0 / 55));
+    const double seconds = since(t0);
+    auto scale = grow_scale(result.input, options, simplified, seconds,
+                            scaled_progress(progress, 48.0 / 55, 1));
+    result.segmentation = std::move(scale.segmentation);
+    result.after = scale.after;
+    result.add_time("simplify", scale.simplify_seconds);
+    const auto t1 = clock::now();
+    result.regions =
+        segment::region_graph(result.input.mesh, result.field, result.segmentation.labels,
+                              result.segmentation.region_count, result.dem());
+    result.add_time("grow", scale.grow_seconds + since(t1));
+    return result;
+}
+
+void release_large_data(SegmentResult& result) {
+    if (!result.mesh_counts) result.mesh_counts = mesh_counts(result.input.mesh);
+    // (`v = {}` would keep a vector's capacity: it is the initializer-list assignment.)
+    auto drop = [](auto& v) { std::decay_t<decltype(v)>().swap(v); };
+    auto& m = result.input.mesh;
+    drop(m.positions);
+    drop(m.triangles);
+    drop(m.vertex_areas);
+    drop(m.neighbor_offsets);
+    drop(m.neighbors);
+    drop(m.vertex_pixel);
+    drop(result.field);
+    drop(result.segmentation.labels);
+    drop(result.segmentation.seeds);
+    malloc_trim(0);
+}
+
+std::vector<std::string> write_segment_directory(SegmentResult& result,
+                                                 const SegmentOptions& options,
+                                                 const std::string& input_path,
+                                                 const std::string& dir, const WriteOptions& write,
+                                                 const ProgressFn& progress) {
+    const auto t0 = clock::now();
+    io::SegmentOutputOptions out;
+    out.polygons.driver = options.format;
+    // The preview is written last, once the large data is freed.
+    io::PreviewImage preview;
+    const bool deferred = write.release_memory && result.input.dem;
+    if (deferred) out.deferred_preview = &preview;
+    const auto paths =
+        io::write_segment_outputs(dir, result.input.mesh, result.field, result.segmentation.labels,
+                                  result.regions, result.dem(), out, progress);
+    result.add_time("write", since(t0));
+    std::vector<std::string> names;
+    for (const auto& p : paths) names.push_back(fs::path(p).filename().string());
+    if (write.release_memory) release_large_data(result);
+    if (deferred) {
+        const auto t1 = clock::now();
+        io::write_preview_image(preview, (fs::path(dir) / "preview.png").string(), false);
+        result.add_time("write", since(t1));
+    }
+    write_run_json(result, input_path, options, names, (fs::path(dir) / "run.json").string());
+    names.push_back("run.json");
+    return names;
+}
+
+void write_run_json(const SegmentResult& result, const std::string& input_path,
+                    const SegmentOptions& options, const std::vector<std::string>& files,
+                    const std::string& path,
+                    const std::vector<std::pair<std::string, std::string>>& extra) {
+    std::ofstream os(path, std::ios::binary);
+    if (!os) throw Error("write", "cannot write " + path);
+    JsonWriter j(os);
+    const auto topo = result.mesh_counts ? *result.mesh_counts : mesh_counts(result.input.mesh);
+    const auto& after = result.after;
+    const bool dem = result.input.dem.has_value();
+    j.begin_object();
+    j.field("input", fs::absolute(input_path).lexically_normal().string());
+    j.key("parameters")
+        .begin_object()
+        .field("field", options.field)
+        .field("rings", options.shape_index.rings)
+        .field("radius", options.shape_index.radius)
+        .field("persistence", options.simplify.persistence)
+        .field("area_ratio_percent", options.simplify.area_ratio)
+        .field("cost", options.cost == "auto" ? (dem ? "graph" : "standard") : options.cost.c_str())
+        .field("saddle_penalty", options.saddle_penalty)
+        .field("format", options.format)
+        .field("frame", to_string(result.input.mesh.frame));
+    if (options.field == "sdf")
+        j.field("rays", options.rays)
+            .field("cone_angle_degrees", options.cone_angle_degrees)
+            .field("postprocess", options.postprocess)
+            .field("allow_open", options.allow_open);
+    j.end_object();
+    j.key("counts")
+        .begin_object()
+        .field("vertices", topo.vertices)
+        .field("faces", topo.faces)
+        .field("boundary_edges", topo.boundary_edges)
+        .field("euler_characteristic", topo.euler_characteristic)
+        .field("critical_nodes_before", result.critical_before)
+        .field("critical_nodes_after", after.critical)
+        .field("loops", after.loops)
+        .field("regions", static_cast<std::size_t>(result.segmentation.region_count))
+        .field("relaxed_nodes", result.segmentation.relaxed_nodes)
+        .end_object();
+    j.key("timings_seconds").begin_object();
+    double total = 0;
+    for (const auto& t : result.timings) {
+        j.field(t.name, t.seconds);
+        total += t.seconds;
+    }
+    j.field("total", total).end_object();
+    j.key("outputs").begin_array();
+    for (const auto& f : files) j.value(f);
+    j.end_array();
+    for (const auto& [k, v] : extra) j.key(k).raw(v);
+    j.key("versions").begin_object().field("terrain", version());
+    for (const auto& [name, v] : dependency_versions()) j.field(name, v);
+    j.end_object();
+    j.end_object();
+    os.flush();
+    if (!os) throw Error("write", "writing " + path + " failed (disk full?)");
+}
+
+SegmentResult segment_to_directory(const std::string& input_path, const std::string& output_dir,
+                                   bool overwrite, const InputOptions& input_options,
+                                   const SegmentOptions& options, const ProgressFn& progress) {
+    check_options(options);
+    OutputDirectory dir(output_dir, overwrite);
+    auto input = load_input(input_path, input_options, scaled_progress(progress, 0, 0.15));
+    auto result = segment(std::move(input), options, scaled_progress(progress, 0.15, 0.7));
+    WriteOptions write;
+    write.release_memory = true;
+    write_segment_directory(result, options, input_path, dir.temp_path(), write,
+                            scaled_progress(progress, 0.7, 0.95));
+    dir.commit();
+    report_progress(progress, 1.0);
+    return result;
+}
+
+}  // namespace terrain::pipeline

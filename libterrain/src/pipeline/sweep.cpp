@@ -1,0 +1,253 @@
+#include "terrain/pipeline/sweep.hpp"
+
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include "terrain/core/error.hpp"
+#include "terrain/core/json_writer.hpp"
+#include "terrain/io/segment_outputs.hpp"
+
+namespace terrain::pipeline {
+
+namespace {
+
+using clock = std::chrono::steady_clock;
+double since(clock::time_point t0) {
+    return std::chrono::duration<double>(clock::now() - t0).count();
+}
+
+void write_text(const std::string& path, const std::string& text) {
+    std::ofstream f(path, std::ios::binary);
+    f << text;
+    f.flush();
+    if (!f) throw Error("write", "cannot write " + path);
+}
+
+void check_ratios(const std::vector<double>& ratios) {
+    if (ratios.empty()) throw Error("sweep", "--area-ratios needs at least one value");
+    for (const double v : ratios)
+        if (!std::isfinite(v) || v <= 0 || v > 100)
+            throw Error("sweep",
+                        "--area-ratios takes percentages in (0, 100] separated by commas; '" +
+                            JsonWriter::number(v) + "' is not one");
+}
+
+}  // namespace
+
+std::vector<double> parse_area_ratios(const std::string& text) {
+    std::vector<double> out;
+    std::stringstream ss(text);
+    std::string item;
+    while (std::getline(ss, item, ',')) {
+        std::size_t used = 0;
+        double v = 0;
+        try {
+            v = std::stod(item, &used);
+        } catch (const std::exception&) {
+            used = 0;
+        }
+        if (used != item.size() || !std::isfinite(v) || v <= 0 || v > 100)
+            throw Error("sweep",
+                        "--area-ratios takes percentages in (0, 100] separated by commas; '" +
+                            item + "' is not one");
+        out.push_back(v);
+    }
+    if (out.empty()) throw Error("sweep", "--area-ratios needs at least one value");
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+    return out;
+}
+
+SweepResult sweep(Input input, const std::vector<double>& area_ratios,
+                  const SegmentOptions& options, const ProgressFn& progress) {
+    check_options(options);
+    check_ratios(area_ratios);
+    std::vector<double> ratios = area_ratios;
+    std::sort(ratios.begin(), ratios.end());
+    ratios.erase(std::unique(ratios.begin(), ratios.end()), ratios.end());
+
+    SweepResult out;
+    auto& base = out.base;
+    base.input = std::move(input);
+    base.add_time("read", base.input.read_seconds);
+    if (base.input.dem) base.add_time("mesh", base.input.mesh_seconds);
+    // The slices of the command line's bar (field 0.15-0.4, reeb -0.5, scales -0.75).
+    compute_field(base, options, scaled_progress(progress, 0, 0.25 / 0.6));
+    const auto graph = compute_reeb(base, scaled_progress(progress, 0.25 / 0.6, 0.35 / 0.6));
+
+    // Every scale from the same unsimplified graph, as `segment` would do it.
+    auto& scales = out.scales;
+    scales.resize(ratios.size());
+    const auto t0 = clock::now();
+    tbb::parallel_for(std::size_t{0}, scales.size(), [&](std::size_t i) {
+        const auto s0 = clock::now();
+        SegmentOptions scale_options = options;
+        scale_options.simplify.area_ratio = ratios[i];
+        auto result = segment_scale(base.input, graph, scale_options);
+        scales[i].ratio = ratios[i];
+        scales[i].name = JsonWriter::number(ratios[i]);
+        scales[i].after = result.after;
+        scales[i].segmentation = std::move(result.segmentation);
+        scales[i].regions =
+            segment::region_graph(base.input.mesh, base.field, scales[i].segmentation.labels,
+                                  scales[i].segmentation.region_count, base.dem());
+        scales[i].seconds = since(s0);
+    });
+    // lineage: scale i -> scale i+1.
+    out.lineage.resize(scales.empty() ? 0 : scales.size() - 1);
+    tbb::parallel_for(std::size_t{0}, out.lineage.size(), [&](std::size_t i) {
+        const auto& a = scales[i];
+        const auto& b = scales[i + 1];
+        out.lineage[i] = segment::region_lineage(base.input.mesh, base.dem(), a.segmentation.labels,
+                                                 a.segmentation.region_count, b.segmentation.labels,
+                                                 b.segmentation.region_count);
+    });
+    base.add_time("scales", since(t0));
+    report_progress(progress, 1.0);
+    return out;
+}
+
+std::vector<std::string> write_sweep_directory(SweepResult& result, const SegmentOptions& options,
+                                               const std::string& input_path,
+                                               const std::string& dir_path,
+                                               const ProgressFn& progress) {
+    auto& base = result.base;
+    const auto& scales = result.scales;
+    const std::string d = dir_path + "/";
+    const auto w0 = clock::now();
+    std::vector<std::string> files;
+    const Dem* dem = base.dem();
+    if (dem) {
+        std::vector<std::vector<std::uint32_t>> bands;
+        std::vector<std::string> descriptions;
+        for (const auto& s : scales) {
+            bands.push_back(segment::label_pixels(base.input.mesh, *dem, s.segmentation.labels));
+            descriptions.push_back("area_ratio=" + s.name);
+        }
+        io::write_label_stack(*dem, bands, descriptions, d + "labels.tif", false);
+        files.push_back("labels.tif");
+        report_progress(progress, 0.2);
+        // Each scale polygonized once; then the GeoPackage's layers one after the other,
+        // the GeoJSON files beside them.
+        std::vector<io::RegionPolygons> polygons(scales.size());
+        tbb::parallel_for(std::size_t{0}, scales.size(), [&](std::size_t i) {
+            polygons[i] = io::polygonize_regions(*dem, bands[i], scales[i].regions.regions.size());
+        });
+        tbb::parallel_invoke(
+            [&] {
+                for (std::size_t i = 0; i < scales.size(); ++i) {
+                    io::RegionPolygonOptions gpkg;
+                    gpkg.driver = "GPKG";
+                    gpkg.layer = "regions_" + scales[i].name;
+                    gpkg.append_layer = true;
+                    io::write_region_polygons(*dem, polygons[i], scales[i].regions,
+                                              d + "regions.gpkg", false, gpkg);
+                }
+            },
+            [&] {
+                tbb::parallel_for(std::size_t{0}, scales.size(), [&](std::size_t i) {
+                    io::write_region_polygons(*dem, polygons[i], scales[i].regions,
+                                              d + "regions_" + scales[i].name + ".geojson", false);
+                });
+            });
+        files.push_back("regions.gpkg");
+        for (const auto& s : scales) files.push_back("regions_" + s.name + ".geojson");
+    } else {
+        for (const auto& s : scales) {
+            io::write_faces_seg(base.input.mesh, s.segmentation.labels,
+                                d + "faces_" + s.name + ".seg", false);
+            files.push_back("faces_" + s.name + ".seg");
+        }
+    }
+    report_progress(progress, 0.7);
+    for (const auto& s : scales) {
+        io::write_adjacency_json(s.regions, d + "adjacency_" + s.name + ".json", false);
+        files.push_back("adjacency_" + s.name + ".json");
+    }
+    {
+        std::ofstream os(d + "lineage.json", std::ios::binary);
+        JsonWriter j(os);
+        j.begin_object();
+        j.key("scales").begin_array();
+        for (const auto& s : scales) j.value(s.ratio);
+        j.end_array();
+        j.field("area_unit", dem ? "m^2 of pixel footprints on the body" : "m^2 of mesh surface");
+        j.key("links").begin_array();
+        for (std::size_t i = 0; i < result.lineage.size(); ++i) {
+            const auto& a = scales[i];
+            const auto& b = scales[i + 1];
+            j.begin_object().field("from_area_ratio", a.ratio).field("to_area_ratio", b.ratio);
+            j.key("regions").begin_array();
+            for (const auto& r : result.lineage[i]) {
+                j.begin_object()
+                    .field("region", static_cast<std::int64_t>(r.region))
+                    .field("area_m2", r.area_m2);
+                j.key("overlaps").begin_array();
+                for (const auto& o : r.overlaps)
+                    j.begin_object()
+                        .field("region", static_cast<std::int64_t>(o.region))
+                        .field("area_m2", o.area_m2)
+                        .field("fraction", o.fraction)
+                        .end_object();
+                j.end_array().end_object();
+            }
+            j.end_array().end_object();
+        }
+        j.end_array().end_object();
+        os.flush();
+        if (!os) throw Error("write", "cannot write lineage.json");
+        files.push_back("lineage.json");
+    }
+    // sweep.csv and sweep.png.
+    std::vector<double> xs, counts, means;
+    std::string csv =
+        "area_ratio_percent,regions,critical_nodes,mean_region_area_m2,total_area_m2\n";
+    for (const auto& s : scales) {
+        double total = 0;
+        for (const auto& r : s.regions.regions) total += r.area_m2;
+        const double n = s.segmentation.region_count;
+        const double mean = n > 0 ? total / n : 0;
+        csv += s.name + "," + std::to_string(s.segmentation.region_count) + "," +
+               std::to_string(s.after.critical) + "," + JsonWriter::number(mean) + "," +
+               JsonWriter::number(total) + "\n";
+        xs.push_back(s.ratio);
+        counts.push_back(n);
+        means.push_back(mean);
+    }
+    write_text(d + "sweep.csv", csv);
+    files.push_back("sweep.csv");
+    io::write_sweep_plot(xs, counts, means, d + "sweep.png", false);
+    files.push_back("sweep.png");
+    base.add_time("write", since(w0));
+
+    // run.json: the last scale stands in for the one-segmentation fields; every scale listed.
+    if (!scales.empty()) {
+        base.segmentation.region_count = scales.back().segmentation.region_count;
+        base.segmentation.relaxed_nodes = scales.back().segmentation.relaxed_nodes;
+        base.after = scales.back().after;
+    }
+    std::string per_scale = "[";
+    for (std::size_t i = 0; i < scales.size(); ++i) {
+        const auto& s = scales[i];
+        per_scale += std::string(i ? "," : "") + "{\"area_ratio_percent\":" + s.name +
+                     ",\"regions\":" + std::to_string(s.segmentation.region_count) +
+                     ",\"critical_nodes_after\":" + std::to_string(s.after.critical) +
+                     ",\"relaxed_nodes\":" + std::to_string(s.segmentation.relaxed_nodes) +
+                     ",\"seconds\":" + JsonWriter::number(s.seconds) + "}";
+    }
+    per_scale += "]";
+    SegmentOptions recorded = options;
+    if (!scales.empty()) recorded.simplify.area_ratio = scales.back().ratio;
+    write_run_json(base, input_path, recorded, files, d + "run.json", {{"scales", per_scale}});
+    files.push_back("run.json");
+    report_progress(progress, 1.0);
+    return files;
+}
+
+}  // namespace terrain::pipeline

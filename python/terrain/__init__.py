@@ -1,0 +1,329 @@
+"""terrain: segment planetary DEMs into landform regions with Reeb graphs.
+
+The C++ library as Python calls (docs/python.md)::
+
+    import terrain
+    result = terrain.segment("tile.tif", persistence=10, area_ratio=0.5)
+    result.labels              # 2-D numpy array on the DEM's grid, as labels.tif
+    result.regions             # dict of numpy columns, one row per region
+    result.to_geodataframe()   # the region polygons (geopandas)
+    result.graph.to_networkx() # the adjacency graph (networkx)
+
+A DEM can be a path, a terrain.Dem (terrain.read_dem) or a 2-D numpy array (NaN = NoData)
+with its GDAL geotransform and CRS. Long calls release the GIL; `progress` takes a callable
+progress(fraction, message) that returns False to cancel. The library's errors raise
+terrain.Error with the command line's one-line messages.
+"""
+
+import os
+import tempfile
+
+import numpy as np
+
+from . import _terrain
+from ._terrain import Dem, Error, __version__
+
+__all__ = [
+    "Dem",
+    "Error",
+    "ReebGraph",
+    "RegionGraph",
+    "SegmentResult",
+    "SweepResult",
+    "read_dem",
+    "reeb_graph",
+    "segment",
+    "shape_index",
+    "sweep",
+]
+
+# The options of `terrain segment` (docs/cli.md), as keyword arguments.
+_SEGMENT_OPTIONS = (
+    "field", "rings", "radius", "rays", "cone_angle", "postprocess", "allow_open",
+    "persistence", "area_ratio", "cost", "saddle_penalty", "format",
+)
+# How the input is read and meshed.
+_INPUT_OPTIONS = ("band", "elevation", "nan_nodata", "pixel_size", "frame", "repair")
+
+
+def read_dem(path, band=1, *, elevation="auto", nan_nodata=False, pixel_size=None):
+    """Read one band of any raster GDAL opens into a terrain.Dem.
+
+    Scale and offset are applied and NoData becomes NaN. elevation: "auto" (detected),
+    "height" or "radius". nan_nodata: NaN/Inf pixels become holes instead of an error.
+    pixel_size: metres per pixel for a raster without geotransform.
+    Returns a Dem with .values (2-D float64), .geotransform, .crs (WKT), .body, .elevation.
+    Raises terrain.Error when the file is missing or not a DEM.
+    """
+    return _terrain.read_dem(os.fspath(path), band, elevation, nan_nodata, pixel_size)
+
+
+def _geotransform(geotransform):
+    if geotransform is None:
+        return None
+    if hasattr(geotransform, "to_gdal"):  # an affine.Affine, as rasterio gives it
+        geotransform = geotransform.to_gdal()
+    return [float(v) for v in geotransform]
+
+
+def _crs(crs):
+    if crs is None:
+        return ""
+    if hasattr(crs, "to_wkt"):  # rasterio.crs.CRS, pyproj.CRS, osgeo.osr.SpatialReference
+        return crs.to_wkt() if not hasattr(crs, "ExportToWkt") else crs.ExportToWkt()
+    if hasattr(crs, "ExportToWkt"):
+        return crs.ExportToWkt()
+    return str(crs)
+
+
+def _source(dem, geotransform, crs, elevation):
+    """A path (str), a Dem, or a Dem made from an array."""
+    if isinstance(dem, Dem):
+        return dem
+    if isinstance(dem, (str, bytes, os.PathLike)):
+        return os.fsdecode(dem)
+    values = dem
+    if isinstance(values, np.ma.MaskedArray):
+        values = values.astype(np.float64).filled(np.nan)
+    values = np.asarray(values, dtype=np.float64)
+    if values.ndim == 3 and values.shape[0] == 1:  # one band as rasterio reads it
+        values = values[0]
+    return _terrain.dem_from_array(values, _geotransform(geotransform), _crs(crs), elevation)
+
+
+def _split_options(options, allowed):
+    native = _terrain.SegmentOptions()
+    read = {}
+    if "rings" in options and options.get("radius", 0):
+        raise Error("field: give rings or radius, not both")
+    for name, value in options.items():
+        if name in allowed:
+            setattr(native, name, value)
+        elif name in _INPUT_OPTIONS:
+            read[name] = value
+        else:
+            raise TypeError(f"unknown option '{name}'; the options are: "
+                            + ", ".join(allowed + _INPUT_OPTIONS))
+    if "elevation" not in read:
+        read["elevation"] = "auto"
+    return native, read
+
+
+def _input_path(source):
+    return source.source if isinstance(source, Dem) else source
+
+
+class RegionGraph:
+    """The regions' adjacency graph: .nodes (the region table) and .edges, numpy columns.
+
+    Edge columns: a, b (region ids, a < b), boundary_length_m, contrast (|field_mean(a) -
+    field_mean(b)|), mesh_edges.
+    """
+
+    def __init__(self, nodes, edges):
+        self.nodes = nodes
+        self.edges = edges
+
+    def __len__(self):
+        return len(self.nodes["id"])
+
+    def to_networkx(self):
+        """A networkx.Graph: one node per region id with the region's columns as attributes,
+        one edge per pair of adjacent regions with the edge's columns."""
+        import networkx as nx
+
+        g = nx.Graph()
+        names = list(self.nodes)
+        for i, rid in enumerate(self.nodes["id"]):
+            g.add_node(int(rid), **{k: _scalar(self.nodes[k][i]) for k in names if k != "id"})
+        enames = [k for k in self.edges if k not in ("a", "b")]
+        for i in range(len(self.edges["a"])):
+            g.add_edge(int(self.edges["a"][i]), int(self.edges["b"][i]),
+                       **{k: _scalar(self.edges[k][i]) for k in enames})
+        return g
+
+
+def _scalar(v):
+    return v.item() if hasattr(v, "item") else v
+
+
+def _geodataframe(write_polygons, regions):
+    import geopandas
+
+    with tempfile.TemporaryDirectory(prefix="terrain-") as tmp:
+        path = os.path.join(tmp, "regions.gpkg")
+        write_polygons(path)
+        gdf = geopandas.read_file(path)
+    return gdf
+
+
+class SegmentResult:
+    """What terrain.segment returns.
+
+    labels: the label of each DEM pixel (2-D uint32, 0 = NoData), identical to the command
+        line's labels.tif; None for a mesh file (see vertex_labels).
+    vertex_labels: the label of each mesh vertex.
+    field: the field (shape index x100 by default) on the DEM's grid (NaN = NoData).
+    regions: the region table, a dict of numpy columns (id, area_m2, field_mean, landform,
+        point_x/y/z, ...; docs/outputs.md).
+    graph: the adjacency graph (RegionGraph; .to_networkx()).
+    region_count, critical_before, critical_after, timings, dem.
+    """
+
+    def __init__(self, native, options, input_path):
+        self._native = native
+        self._options = options
+        self._input_path = input_path
+        self.regions = native.region_columns
+        self.graph = RegionGraph(self.regions, native.edge_columns)
+
+    labels = property(lambda self: self._native.labels)
+    vertex_labels = property(lambda self: self._native.vertex_labels)
+    field = property(lambda self: self._native.field)
+    region_count = property(lambda self: self._native.region_count)
+    critical_before = property(lambda self: self._native.critical_before)
+    critical_after = property(lambda self: self._native.critical_after)
+    timings = property(lambda self: self._native.timings)
+    dem = property(lambda self: self._native.dem)
+    point_frame = property(lambda self: self._native.point_frame)
+
+    def to_geodataframe(self):
+        """The region polygons with the region table's columns, as a geopandas.GeoDataFrame
+        in the DEM's CRS (the polygons of the command line's regions file)."""
+        return _geodataframe(lambda p: self._native.write_polygons(p, "GPKG"), self.regions)
+
+    def write(self, directory, overwrite=False, progress=None):
+        """Write every output of `terrain segment` (labels.tif, regions.geojson,
+        adjacency.*, preview.png, run.json) into `directory`; returns the file names."""
+        return self._native.write(self._options, os.fspath(directory), overwrite,
+                                  self._input_path, progress)
+
+    def __repr__(self):
+        return f"<terrain.SegmentResult: {self.region_count} regions>"
+
+
+def segment(dem, geotransform=None, crs=None, *, progress=None, **options):
+    """Segment a DEM (or a mesh file) into landform regions, as `terrain segment` does.
+
+    dem: a path (DEM or .off/.ply/.obj mesh), a terrain.Dem, or a 2-D numpy array of
+        elevations in metres (NaN = NoData) with its GDAL `geotransform` (6 numbers or an
+        affine.Affine) and `crs` (WKT, "EPSG:32611", "IAU_2015:30100", or a CRS object).
+    options (keywords, the command line's defaults): field="shape-index" (or "sdf",
+        "height"), rings=2, radius=0, rays=25, cone_angle=120, postprocess=True,
+        allow_open=False, persistence=10, area_ratio=0.5 (percent), cost="auto" ("graph",
+        "standard"), saddle_penalty=20, format="GeoJSON"; reading: band=1,
+        elevation="auto", nan_nodata=False, pixel_size=None, frame="auto", repair=False.
+    progress: optional callable progress(fraction, message); return False to cancel.
+    Returns a SegmentResult (.labels, .regions, .graph, .to_geodataframe(), .write()).
+    Raises terrain.Error on bad input or options, TypeError on an unknown option.
+    """
+    native_options, read = _split_options(options, _SEGMENT_OPTIONS)
+    source = _source(dem, geotransform, crs, read.pop("elevation"))
+    native = _terrain.segment(source, native_options, progress=progress, **read)
+    return SegmentResult(native, native_options, _input_path(source))
+
+
+class SweepScale:
+    """One scale of a sweep: ratio, labels, vertex_labels, regions, graph, region_count."""
+
+    def __init__(self, sweep, index):
+        self._sweep = sweep
+        self._index = index
+        self.ratio = sweep.ratios[index]
+        self.regions = sweep.region_columns(index)
+        self.graph = RegionGraph(self.regions, sweep.edge_columns(index))
+        self.region_count = sweep.region_count(index)
+        self.critical_after = sweep.critical_after(index)
+
+    labels = property(lambda self: self._sweep.labels(self._index))
+    vertex_labels = property(lambda self: self._sweep.vertex_labels(self._index))
+
+    def to_geodataframe(self):
+        """This scale's region polygons as a geopandas.GeoDataFrame."""
+        return _geodataframe(lambda p: self._sweep.write_polygons(self._index, p, "GPKG"),
+                             self.regions)
+
+
+class SweepResult:
+    """What terrain.sweep returns: .scales (by increasing area ratio), .lineage(i) (how the
+    regions of scale i overlap those of scale i + 1: from_region, to_region, area_m2,
+    fraction columns), .write(directory)."""
+
+    def __init__(self, native, options, input_path):
+        self._native = native
+        self._options = options
+        self._input_path = input_path
+        self.scales = [SweepScale(native, i) for i in range(native.scale_count())]
+        self.critical_before = native.critical_before
+
+    def lineage(self, index):
+        return self._native.lineage(index)
+
+    def write(self, directory, overwrite=False, progress=None):
+        """Write every output of `terrain sweep` into `directory`; returns the file names."""
+        return self._native.write(self._options, os.fspath(directory), overwrite,
+                                  self._input_path, progress)
+
+
+def sweep(dem, geotransform=None, crs=None, *, area_ratios=(0.1, 0.25, 0.5, 1, 2),
+          progress=None, **options):
+    """Segment at several area ratios (percent) from one field and Reeb graph, as
+    `terrain sweep` does; the other options are segment()'s. Returns a SweepResult."""
+    native_options, read = _split_options(options, _SEGMENT_OPTIONS)
+    source = _source(dem, geotransform, crs, read.pop("elevation"))
+    native = _terrain.sweep(source, [float(r) for r in area_ratios], native_options,
+                            progress=progress, **read)
+    return SweepResult(native, native_options, _input_path(source))
+
+
+def shape_index(dem, geotransform=None, crs=None, *, rings=2, radius=0.0, progress=None,
+                **read):
+    """The shape index x100 (0 cup, 50 saddle or plane, 100 cap) of each DEM pixel, a 2-D
+    float32 array (NaN = NoData), fitted over the vertices within `rings` mesh edges or
+    `radius` metres; per vertex (1-D) for a mesh file."""
+    options = {"field": "shape-index", "radius": radius, **read}
+    if not radius:
+        options["rings"] = rings
+    native_options, read = _split_options(options, _SEGMENT_OPTIONS)
+    source = _source(dem, geotransform, crs, read.pop("elevation"))
+    return _terrain.field(source, native_options, progress=progress, **read)
+
+
+class ReebGraph:
+    """The Reeb graph of a field: its critical nodes and the arcs between them.
+
+    nodes: node, value, kind ("min", "max", "saddle"), vertex (a mesh vertex of the
+        node), vertex_count, col, row (its DEM pixel; -1 for mesh files).
+    arcs: lower, upper (indices into the node columns), regular_nodes.
+    critical_before: critical nodes before simplification.
+    """
+
+    def __init__(self, nodes, arcs, critical_before):
+        self.nodes = nodes
+        self.arcs = arcs
+        self.critical_before = critical_before
+
+    def to_networkx(self):
+        """A networkx.MultiDiGraph, arcs from their lower to their upper node (parallel arcs
+        are the graph's loops)."""
+        import networkx as nx
+
+        g = nx.MultiDiGraph()
+        for i in range(len(self.nodes["node"])):
+            g.add_node(i, **{k: _scalar(v[i]) for k, v in self.nodes.items()})
+        for i in range(len(self.arcs["lower"])):
+            g.add_edge(int(self.arcs["lower"][i]), int(self.arcs["upper"][i]),
+                       regular_nodes=int(self.arcs["regular_nodes"][i]))
+        return g
+
+
+def reeb_graph(dem, geotransform=None, crs=None, *, persistence=0.0, area_ratio=0.0,
+               progress=None, **options):
+    """The Reeb graph of the field (shape index by default) on the DEM's mesh, simplified
+    when persistence or area_ratio (percent) is above 0, as `terrain reeb` builds it.
+    Field and reading options as in segment(). Returns a ReebGraph."""
+    options = dict(options, persistence=persistence, area_ratio=area_ratio)
+    native_options, read = _split_options(options, _SEGMENT_OPTIONS)
+    source = _source(dem, geotransform, crs, read.pop("elevation"))
+    nodes, arcs, before = _terrain.reeb_graph(source, native_options, progress=progress, **read)
+    return ReebGraph(nodes, arcs, before)

@@ -1,0 +1,122 @@
+// pipeline::segment and pipeline::sweep: the library calls behind `terrain segment` and
+// `terrain sweep`, their values and the directory they write.
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <set>
+
+#include "support/test_support.hpp"
+#include "terrain/core/error.hpp"
+#include "terrain/io/read_dem.hpp"
+#include "terrain/pipeline/segment.hpp"
+#include "terrain/pipeline/sweep.hpp"
+
+namespace fs = std::filesystem;
+using namespace terrain;
+
+TEST_CASE("pipeline::segment gives labels, regions and the files of terrain segment",
+          "[pipeline]") {
+    const std::string path = test::sample("moon_ldem4_copernicus.tif");
+    pipeline::SegmentOptions options;
+    double last = -1;
+    bool monotone = true;
+    auto result =
+        pipeline::segment(pipeline::load_input(path), options, [&](double f, std::string_view) {
+            monotone = monotone && f >= last - 1e-12;
+            last = f;
+            return true;
+        });
+    CHECK(monotone);
+    CHECK(last == Approx(1.0));
+    REQUIRE(result.dem());
+    const auto n = result.segmentation.region_count;
+    REQUIRE(n > 1);
+    CHECK(result.regions.regions.size() == n);
+    CHECK(result.segmentation.labels.size() == result.input.mesh.vertex_count());
+    const auto pixels = result.label_pixels();
+    REQUIRE(pixels.size() == result.dem()->values.size());
+    std::set<std::uint32_t> used(pixels.begin(), pixels.end());
+    used.erase(0);
+    CHECK(used.size() == n);
+    CHECK(*used.rbegin() == n);
+    std::vector<std::string> stages;
+    for (const auto& t : result.timings) stages.push_back(t.name);
+    CHECK(stages == std::vector<std::string>{"read", "mesh", "field", "reeb", "simplify", "grow"});
+
+    // The directory: labels.tif holds label_pixels(); run.json is listed last.
+    const auto dir = test::scratch_dir("pipeline_segment");
+    const auto files = pipeline::write_segment_directory(result, options, path, dir.string());
+    CHECK(files.front() == "labels.tif");
+    CHECK(files.back() == "run.json");
+    for (const auto& f : files) CHECK(fs::exists(dir / f));
+    const auto written = test::read_raster_values((dir / "labels.tif").string());
+    REQUIRE(written.size() == pixels.size());
+    CHECK(std::equal(pixels.begin(), pixels.end(), written.begin(),
+                     [](std::uint32_t a, float b) { return static_cast<float>(a) == b; }));
+
+    // The same DEM handed over in memory gives the same labels.
+    auto again = pipeline::segment(pipeline::input_from_dem(io::read_dem(path)), options);
+    CHECK(again.label_pixels() == pixels);
+}
+
+TEST_CASE("pipeline options are checked before any work", "[pipeline]") {
+    pipeline::SegmentOptions options;
+    options.simplify.persistence = -1;
+    CHECK_THROWS_WITH(pipeline::check_options(options),
+                      "segment: --persistence must be a number >= 0");
+    options = {};
+    options.cost = "cheap";
+    CHECK_THROWS_AS(pipeline::check_options(options), Error);
+    options = {};
+    options.field = "slope";
+    CHECK_THROWS_AS(pipeline::segment(pipeline::Input{}, options), Error);
+    CHECK_THROWS_AS(pipeline::parse_frame("sideways"), Error);
+    CHECK_THROWS_AS(pipeline::parse_area_ratios("0.5,200"), Error);
+    CHECK(pipeline::parse_area_ratios("1,0.25,1") == std::vector<double>{0.25, 1});
+}
+
+TEST_CASE("A cancelled segmentation throws and leaves no directory", "[pipeline]") {
+    const auto dir = test::scratch_dir("pipeline_cancel");
+    const auto out = dir / "out";
+    CHECK_THROWS_WITH(pipeline::segment_to_directory(
+                          test::sample("moon_ldem4_copernicus.tif"), out.string(), false, {}, {},
+                          [](double f, std::string_view) { return f < 0.5; }),
+                      Catch::Contains("cancelled"));
+    CHECK_FALSE(fs::exists(out));
+    std::size_t entries = 0;
+    for (const auto& e : fs::directory_iterator(dir)) entries += e.exists() ? 1 : 0;
+    CHECK(entries == 0);  // the temporary directory is gone too
+}
+
+TEST_CASE("pipeline::sweep: scales in order, lineage between neighbours", "[pipeline]") {
+    const std::string path = test::sample("moon_ldem4_copernicus.tif");
+    pipeline::SegmentOptions options;
+    auto result = pipeline::sweep(pipeline::load_input(path), {2, 0.25, 0.5}, options);
+    REQUIRE(result.scales.size() == 3);
+    CHECK(result.scales[0].name == "0.25");
+    CHECK(result.scales[2].name == "2");
+    for (std::size_t i = 0; i + 1 < result.scales.size(); ++i)
+        CHECK(result.scales[i].segmentation.region_count >=
+              result.scales[i + 1].segmentation.region_count);
+    REQUIRE(result.lineage.size() == 2);
+    for (std::size_t i = 0; i < 2; ++i) {
+        CHECK(result.lineage[i].size() == result.scales[i].segmentation.region_count);
+        for (const auto& r : result.lineage[i]) {
+            double sum = 0;
+            for (const auto& o : r.overlaps) sum += o.fraction;
+            CHECK(sum == Approx(1.0).epsilon(1e-6));
+        }
+    }
+    // A scale of the sweep is the segmentation `segment` gives at that ratio.
+    options.simplify.area_ratio = 0.5;
+    const auto single = pipeline::segment(pipeline::load_input(path), options);
+    CHECK(single.segmentation.labels == result.scales[1].segmentation.labels);
+
+    const auto dir = test::scratch_dir("pipeline_sweep");
+    const auto files = pipeline::write_sweep_directory(result, options, path, dir.string());
+    for (const char* f : {"labels.tif", "regions.gpkg", "lineage.json", "sweep.csv", "run.json"})
+        CHECK(std::find(files.begin(), files.end(), f) != files.end());
+    for (const auto& f : files) CHECK(fs::exists(dir / f));
+}

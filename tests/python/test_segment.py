@@ -1,0 +1,183 @@
+"""terrain.segment: the same labels as the command line, arrays in, errors, progress."""
+
+import threading
+import time
+
+import numpy as np
+import pytest
+from osgeo import gdal, osr
+
+import terrain
+from conftest import SAMPLE_FILES
+
+gdal.UseExceptions()
+
+
+def read_labels(path):
+    return gdal.Open(str(path)).ReadAsArray()
+
+
+@pytest.mark.parametrize("name", sorted(SAMPLE_FILES))
+def test_labels_identical_to_the_cli(name, cli, tmp_path):
+    sample = SAMPLE_FILES[name]
+    out = tmp_path / "seg"
+    done = cli("segment", sample, "-o", out, "-q")
+    assert done.returncode == 0, done.stderr
+    result = terrain.segment(sample)
+    expected = read_labels(out / "labels.tif")
+    assert result.labels.shape == expected.shape
+    assert np.array_equal(result.labels, expected)
+    assert result.region_count == len(result.regions["id"]) == int(expected.max())
+    assert str(result.region_count) + " regions" in done.stdout
+
+
+def test_options_reach_the_library(cli, moon, tmp_path):
+    out = tmp_path / "seg"
+    args = ["--persistence", "5", "--area-ratio", "1", "--cost", "standard", "--rings", "3"]
+    assert cli("segment", moon, "-o", out, "-q", *args).returncode == 0
+    result = terrain.segment(moon, persistence=5, area_ratio=1, cost="standard", rings=3)
+    assert np.array_equal(result.labels, read_labels(out / "labels.tif"))
+    default = terrain.segment(moon)
+    assert not np.array_equal(result.labels, default.labels)
+
+
+def test_array_and_geotransform_equal_the_file(moon):
+    from_file = terrain.segment(moon)
+    ds = gdal.Open(moon)
+    band = ds.GetRasterBand(1)
+    values = band.ReadAsArray().astype(np.float64)
+    values[values == band.GetNoDataValue()] = np.nan
+    values = values * (band.GetScale() or 1) + (band.GetOffset() or 0)
+    from_array = terrain.segment(values, ds.GetGeoTransform(), ds.GetProjection())
+    assert np.array_equal(from_array.labels, from_file.labels)
+    # terrain.read_dem's Dem, and its arrays handed back.
+    dem = terrain.read_dem(moon)
+    assert dem.values.shape == from_file.labels.shape
+    assert np.array_equal(terrain.segment(dem).labels, from_file.labels)
+    again = terrain.segment(dem.values, dem.geotransform, dem.crs)
+    assert np.array_equal(again.labels, from_file.labels)
+    for key in ("area_m2", "field_mean", "point_x"):
+        assert np.array_equal(again.regions[key], from_file.regions[key])
+
+
+def test_rasterio_arrays(moon):
+    rasterio = pytest.importorskip("rasterio")
+    with rasterio.open(moon) as src:
+        values = src.read(1, masked=True).astype(np.float64) * src.scales[0] + src.offsets[0]
+        result = terrain.segment(values, src.transform, src.crs)
+    assert np.array_equal(result.labels, terrain.segment(moon).labels)
+
+
+def synthetic_dem(n=64):
+    y, x = np.mgrid[0:n, 0:n] / n
+    z = 200 * np.sin(6 * x) * np.cos(5 * y) + 50 * np.sin(17 * x * y)
+    z[:3, :3] = np.nan  # NoData
+    return z
+
+
+def test_authority_string_equals_wkt_and_file(tmp_path):
+    z = synthetic_dem()
+    gt = (380000.0, 30.0, 0.0, 3800000.0, 0.0, -30.0)
+    srs = osr.SpatialReference()
+    srs.ImportFromEPSG(32611)
+    by_code = terrain.segment(z, gt, "EPSG:32611")
+    by_wkt = terrain.segment(z, gt, srs.ExportToWkt())
+    assert by_code.dem.body == "Earth"
+    assert np.array_equal(by_code.labels, by_wkt.labels)
+    path = tmp_path / "z.tif"
+    ds = gdal.GetDriverByName("GTiff").Create(str(path), z.shape[1], z.shape[0], 1,
+                                              gdal.GDT_Float64)
+    ds.SetGeoTransform(gt)
+    ds.SetProjection(srs.ExportToWkt())
+    ds.GetRasterBand(1).SetNoDataValue(-9999)
+    ds.GetRasterBand(1).WriteArray(np.where(np.isnan(z), -9999, z))
+    ds = None
+    from_file = terrain.segment(path)
+    assert np.array_equal(from_file.labels, by_code.labels)
+    assert np.all(by_code.labels[:3, :3] == 0)  # NoData pixels carry no region
+    assert (by_code.labels[np.isfinite(z)] > 0).mean() > 0.99
+
+
+def test_errors_raise_terrain_error(moon):
+    with pytest.raises(terrain.Error, match=r"^read: '/no/such\.tif' does not exist"):
+        terrain.segment("/no/such.tif")
+    with pytest.raises(terrain.Error, match=r"^segment: --persistence must be a number >= 0$"):
+        terrain.segment(moon, persistence=-1)
+    with pytest.raises(terrain.Error, match=r"^field: unknown field 'slope'"):
+        terrain.segment(moon, field="slope")
+    with pytest.raises(terrain.Error, match="2-D"):
+        terrain.segment(np.zeros(10))
+    with pytest.raises(terrain.Error, match="not a CRS"):
+        terrain.segment(synthetic_dem(), (0, 1, 0, 0, 0, -1), "EPSG:nonsense")
+    with pytest.raises(terrain.Error, match="rings or radius"):
+        terrain.segment(moon, rings=3, radius=100)
+    with pytest.raises(TypeError, match="unknown option 'persistance'"):
+        terrain.segment(moon, persistance=3)
+    assert issubclass(terrain.Error, RuntimeError)
+
+
+def test_progress_and_cancel(moon):
+    seen = []
+    terrain.segment(moon, progress=lambda f, msg: seen.append(f))
+    assert seen and seen[-1] == pytest.approx(1.0)
+    assert all(b >= a - 1e-12 for a, b in zip(seen, seen[1:]))
+    with pytest.raises(terrain.Error, match="cancelled"):
+        terrain.segment(moon, progress=lambda f, msg: f < 0.5)
+
+    class Stop(Exception):
+        pass
+
+    def fail(f, msg):
+        if f > 0.3:
+            raise Stop("from the callback")
+
+    with pytest.raises(Stop, match="from the callback"):
+        terrain.segment(moon, progress=fail)
+
+
+def test_the_gil_is_released_during_the_work():
+    vesta = str(SAMPLE_FILES["vesta"])
+    dem = terrain.read_dem(vesta)
+    done = threading.Event()
+    out = {}
+
+    def work():
+        out["result"] = terrain.segment(dem)
+        done.set()
+
+    thread = threading.Thread(target=work)
+    ticks = 0
+    thread.start()
+    while not done.is_set():
+        ticks += 1
+        time.sleep(0.001)
+    thread.join()
+    assert out["result"].region_count > 1
+    # Holding the GIL for the whole segmentation (~1 s) would leave this thread a few ticks.
+    assert ticks > 50
+
+
+def test_write_gives_the_cli_directory(cli, moon, tmp_path):
+    result = terrain.segment(moon)
+    files = result.write(tmp_path / "py")
+    assert files[0] == "labels.tif" and files[-1] == "run.json"
+    assert cli("segment", moon, "-o", tmp_path / "cli", "-q").returncode == 0
+    for name in ("labels.tif", "regions.geojson", "adjacency.json", "adjacency.graphml"):
+        assert (tmp_path / "py" / name).read_bytes() == (tmp_path / "cli" / name).read_bytes()
+    with pytest.raises(terrain.Error, match="already exists"):
+        result.write(tmp_path / "py")
+
+
+def test_mesh_files(cli, moon, tmp_path):
+    mesh = tmp_path / "moon.ply"
+    assert cli("mesh", moon, "-o", mesh, "-q").returncode == 0
+    result = terrain.segment(mesh)
+    assert result.labels is None
+    assert len(result.vertex_labels) == result.regions["vertex_count"].sum()
+    assert set(np.unique(result.vertex_labels)) == set(result.regions["id"])
+
+
+def test_help_shows_the_options():
+    assert "persistence" in terrain.segment.__doc__
+    assert "geotransform" in terrain.segment.__doc__
+    assert "area_ratios" in terrain.sweep.__doc__ or "area ratio" in terrain.sweep.__doc__
