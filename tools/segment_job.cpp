@@ -13,7 +13,8 @@
 #include "terrain/core/error.hpp"
 #include "terrain/core/json_writer.hpp"
 #include "terrain/core/version.hpp"
-#include "terrain/io/segment_outputs.hpp"
+#include "terrain/io/write_preview.hpp"
+#include "terrain/io/write_segment_outputs.hpp"
 
 namespace terrain::cli {
 

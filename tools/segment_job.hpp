@@ -11,7 +11,7 @@
 #include "cli.hpp"
 #include "field_options.hpp"
 #include "input.hpp"
-#include "terrain/io/segment_outputs.hpp"
+#include "terrain/io/write_preview.hpp"
 #include "terrain/reeb/simplify.hpp"
 #include "terrain/segment/grow_regions.hpp"
 #include "terrain/segment/regions.hpp"
