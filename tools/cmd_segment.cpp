@@ -1,6 +1,7 @@
 // terrain segment INPUT -o OUTDIR [field options] [--persistence 10] [--area-ratio 0.5]
 //                  [--cost graph|standard] [--saddle-penalty 20] [--timings]
-// The main job: field, Reeb graph, simplification, region growing, and every common.output file.
+// The main job: field, Reeb graph, simplification, region growing, then the files of
+// docs/outputs.md (io::write_segment_outputs) and run.json.
 // The outputs are written into a temporary sibling directory that replaces OUTDIR at the end,
 // so OUTDIR appears complete or not at all.
 #include "cli.hpp"
@@ -18,7 +19,6 @@ int run_segment(int argc, char** argv) {
         SegmentOptionValues segment_values;
         po::options_description options("terrain segment options");
         add_common_options(options, common, "OUTDIR: the directory to write");
-        options.add_options();
         add_segment_options(options, segment_values);
         add_field_options(options, field_values);
         add_input_options(options, input_values);
