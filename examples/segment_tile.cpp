@@ -6,7 +6,7 @@
 #include "terrain/core/error.hpp"
 #include "terrain/field/shape_index.hpp"
 #include "terrain/io/read_dem.hpp"
-#include "terrain/io/segment_outputs.hpp"
+#include "terrain/io/write_segment_outputs.hpp"
 #include "terrain/mesh/dem_to_mesh.hpp"
 #include "terrain/reeb/simplify.hpp"
 #include "terrain/segment/grow_regions.hpp"

@@ -10,7 +10,7 @@
 #include "terrain/io/mesh_files.hpp"
 #include "terrain/io/output_file.hpp"
 #include "terrain/io/write_raster.hpp"
-#include "terrain/reeb/reeb_io.hpp"
+#include "terrain/io/write_reeb_graph.hpp"
 #include "terrain/reeb/simplify.hpp"
 
 namespace terrain::cli {
@@ -73,9 +73,9 @@ int run_reeb(int argc, char** argv) {
             simplified = std::move(result.field);
         }
         if (ext == ".dot") {
-            reeb::write_reeb_dot(graph, common.output, common.overwrite);
+            io::write_reeb_dot(graph, common.output, common.overwrite);
         } else {
-            reeb::write_reeb_json(
+            io::write_reeb_json(
                 graph, input.mesh, common.output, common.overwrite,
                 {{"input", JsonWriter::escape(common.input)},
                  {"field", JsonWriter::escape(field_values.name)},

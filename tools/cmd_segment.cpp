@@ -18,7 +18,6 @@ int run_segment(int argc, char** argv) {
         SegmentOptionValues segment_values;
         po::options_description options("terrain segment options");
         add_common_options(options, common, "OUTDIR: the directory to write");
-        options.add_options();
         add_segment_options(options, segment_values);
         add_field_options(options, field_values);
         add_input_options(options, input_values);

@@ -22,7 +22,7 @@
 #include "terrain/field/vertex_field.hpp"
 #include "terrain/geo/georeference.hpp"
 #include "terrain/io/read_dem.hpp"
-#include "terrain/io/segment_outputs.hpp"
+#include "terrain/io/write_region_polygons.hpp"
 #include "terrain/pipeline/segment.hpp"
 #include "terrain/pipeline/sweep.hpp"
 #include "terrain/reeb/simplify.hpp"

@@ -10,7 +10,11 @@
 
 #include "bench_dem.hpp"
 #include "terrain/field/vertex_field.hpp"
-#include "terrain/io/segment_outputs.hpp"
+#include "terrain/io/write_adjacency.hpp"
+#include "terrain/io/write_label_raster.hpp"
+#include "terrain/io/write_preview.hpp"
+#include "terrain/io/write_region_polygons.hpp"
+#include "terrain/io/write_segment_outputs.hpp"
 #include "terrain/mesh/dem_to_mesh.hpp"
 #include "terrain/segment/regions.hpp"
 

@@ -14,6 +14,7 @@
 #include <filesystem>
 #include <vector>
 
+#include "support/cgal_reference_sdf.hpp"
 #include "terrain/field/sdf.hpp"
 #include "terrain/io/mesh_files.hpp"
 
@@ -63,7 +64,8 @@ int main(int argc, char** argv) {
             }
             const double best = best_of_3();
             std::vector<double> cgal;
-            const double cgal_time = seconds([&] { cgal = field::cgal_sdf_face_diameters(mesh); });
+            const double cgal_time =
+                seconds([&] { cgal = test::cgal_sdf_face_diameters(mesh, field::SdfOptions{}); });
             // Agreement of the face diameters, relative to the largest.
             std::vector<double> diff(cgal.size());
             const double scale = *std::max_element(cgal.begin(), cgal.end());

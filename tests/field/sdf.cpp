@@ -9,6 +9,7 @@
 #include <numeric>
 #include <vector>
 
+#include "support/cgal_reference_sdf.hpp"
 #include "support/test_support.hpp"
 #include "terrain/core/error.hpp"
 #include "terrain/field/sdf.hpp"
@@ -252,7 +253,7 @@ TEST_CASE("SDF agrees with CGAL::sdf_values", "[sdf]") {
             field::SdfOptions options;
             options.postprocess = postprocess;
             const auto ours = field::shape_diameter_function(c.mesh, options).face_diameters;
-            auto cgal = field::cgal_sdf_face_diameters(c.mesh, options);
+            auto cgal = test::cgal_sdf_face_diameters(c.mesh, options);
             // Without post-processing CGAL leaves -1 where no ray gave a value (the
             // zero-area face here); we fill those from the neighbours all the same.
             for (std::size_t f = 0; f < cgal.size(); ++f)

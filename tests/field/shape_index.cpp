@@ -7,6 +7,7 @@
 #include <limits>
 
 #include "terrain/field/shape_index.hpp"
+#include "terrain/geo/body.hpp"
 #include "terrain/mesh/dem_to_mesh.hpp"
 
 using namespace terrain;
@@ -19,7 +20,7 @@ Dem analytic(int n, double pixel, const std::function<double(double, double)>& f
     dem.width = dem.height = n;
     dem.transform = {-n * pixel / 2, pixel, 0, n * pixel / 2, 0, -pixel};
     dem.has_transform = true;
-    dem.body = body_from_crs("");
+    dem.body = geo::body_from_crs("");
     for (int r = 0; r < n; ++r)
         for (int c = 0; c < n; ++c) {
             const auto xy = dem.map_xy(c + 0.5, r + 0.5);

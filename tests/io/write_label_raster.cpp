@@ -12,7 +12,8 @@
 #include "support/test_support.hpp"
 #include "terrain/core/error.hpp"
 #include "terrain/io/read_dem.hpp"
-#include "terrain/io/segment_outputs.hpp"
+#include "terrain/io/region_colour.hpp"
+#include "terrain/io/write_label_raster.hpp"
 
 using namespace terrain;
 

@@ -8,7 +8,7 @@
 #include "support/test_support.hpp"
 #include "terrain/core/error.hpp"
 #include "terrain/io/read_dem.hpp"
-#include "terrain/io/segment_outputs.hpp"
+#include "terrain/io/write_mesh_labels.hpp"
 #include "terrain/mesh/dem_to_mesh.hpp"
 
 using namespace terrain;

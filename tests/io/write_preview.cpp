@@ -10,7 +10,7 @@
 #include "terrain/core/error.hpp"
 #include "terrain/field/vertex_field.hpp"
 #include "terrain/io/read_dem.hpp"
-#include "terrain/io/segment_outputs.hpp"
+#include "terrain/io/write_preview.hpp"
 
 using namespace terrain;
 

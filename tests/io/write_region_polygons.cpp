@@ -13,7 +13,7 @@
 #include "support/test_support.hpp"
 #include "terrain/core/error.hpp"
 #include "terrain/io/read_dem.hpp"
-#include "terrain/io/segment_outputs.hpp"
+#include "terrain/io/write_region_polygons.hpp"
 
 using namespace terrain;
 

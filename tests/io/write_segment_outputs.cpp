@@ -4,7 +4,7 @@
 #include "support/test_support.hpp"
 #include "terrain/core/error.hpp"
 #include "terrain/io/read_dem.hpp"
-#include "terrain/io/segment_outputs.hpp"
+#include "terrain/io/write_segment_outputs.hpp"
 
 using namespace terrain;
 

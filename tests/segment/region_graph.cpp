@@ -8,6 +8,7 @@
 #include "support/segment_support.hpp"
 #include "support/test_support.hpp"
 #include "terrain/core/error.hpp"
+#include "terrain/geo/body.hpp"
 #include "terrain/io/read_dem.hpp"
 #include "terrain/mesh/dem_to_mesh.hpp"
 #include "terrain/segment/regions.hpp"
@@ -24,7 +25,7 @@ Dem flat_grid(int w, int h, double pixel) {
     dem.height = h;
     dem.transform = {100, pixel, 0, 200, 0, -pixel};
     dem.has_transform = true;
-    dem.body = body_from_crs("");
+    dem.body = geo::body_from_crs("");
     dem.values.assign(static_cast<std::size_t>(w) * h, 10.0);
     return dem;
 }

@@ -4,13 +4,15 @@
 #include <numbers>
 #include <random>
 
+#include "terrain/geo/body.hpp"
+
 namespace terrain::test {
 
 Dem grid_dem(int w, int h, const std::function<double(int, int)>& height) {
     Dem dem;
     dem.width = w;
     dem.height = h;
-    dem.body = body_from_crs("");
+    dem.body = geo::body_from_crs("");
     dem.values.resize(static_cast<std::size_t>(w) * static_cast<std::size_t>(h));
     for (int r = 0; r < h; ++r)
         for (int c = 0; c < w; ++c) dem.values[dem.index(c, r)] = height(c, r);

@@ -9,6 +9,7 @@
 #include "support/test_support.hpp"
 #include "terrain/core/body.hpp"
 #include "terrain/core/error.hpp"
+#include "terrain/geo/body.hpp"
 #include "terrain/io/read_dem.hpp"
 #include "terrain/synth/crater_field.hpp"
 
@@ -72,7 +73,12 @@ TEST_CASE("a tile is a Vesta radius DEM on the HAMO grid", "[synth]") {
     CHECK(dem.body.name == "Vesta");
     CHECK(dem.body.semi_major_axis == 255000);
     CHECK(dem.body.flattening == 0);
-    CHECK(terrain::body_from_crs(dem.crs_wkt).name == "Vesta");
+    const auto read_body = terrain::geo::body_from_crs(dem.crs_wkt);
+    CHECK(read_body.name == "Vesta");
+    CHECK(dem.body.name == read_body.name);
+    CHECK(dem.body.semi_major_axis == read_body.semi_major_axis);
+    CHECK(dem.body.flattening == read_body.flattening);
+    CHECK(dem.body.has_crs == read_body.has_crs);
     REQUIRE(dem.has_transform);
     // 64 pixels per degree on the 255 km sphere.
     CHECK(dem.transform[1] == Approx(255000.0 * std::numbers::pi / 180.0 / 64.0).epsilon(1e-12));

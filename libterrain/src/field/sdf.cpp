@@ -2,13 +2,10 @@
 // by step (SDF_calculation.h: cone of rays around the inward normal from each face's centroid,
 // Vogel disk samples, first hit through the inside, median/MAD outlier removal; then
 // Surface_mesh_segmentation.h's post-processing: missing values from neighbours, bilateral
-// filtering) with our own BVH and threads. CGAL itself is used only by the reference
-// cgal_sdf_face_diameters, the one CGAL-heavy translation unit of the SDF.
+// filtering) with our own BVH and threads. CGAL itself is not compiled here: the reference
+// the tests compare with is tests/support/cgal_reference_sdf.cpp.
 #include "terrain/field/sdf.hpp"
 
-#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
-#include <CGAL/Surface_mesh.h>
-#include <CGAL/mesh_segmentation.h>
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
@@ -416,34 +413,6 @@ SdfResult shape_diameter_function(const TriangleMesh& mesh, const SdfOptions& op
     result.face_diameters = std::move(value);
     report_progress(progress, 1.0, "sdf");
     return result;
-}
-
-std::vector<double> cgal_sdf_face_diameters(const TriangleMesh& mesh, const SdfOptions& options) {
-    check_options(options);
-    using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
-    using Mesh = CGAL::Surface_mesh<Kernel::Point_3>;
-    Mesh sm;
-    sm.reserve(static_cast<Mesh::size_type>(mesh.vertex_count()), 0,
-               static_cast<Mesh::size_type>(mesh.triangle_count()));
-    for (const auto& p : mesh.positions) sm.add_vertex(Kernel::Point_3(p[0], p[1], p[2]));
-    for (std::size_t f = 0; f < mesh.triangle_count(); ++f) {
-        const Face& t = mesh.triangles[f];
-        if (sm.add_face(Mesh::Vertex_index(t[0]), Mesh::Vertex_index(t[1]),
-                        Mesh::Vertex_index(t[2])) == Mesh::null_face())
-            throw Error("sdf", "CGAL's Surface_mesh cannot hold face " + std::to_string(f) +
-                                   " (a repeated vertex or a non-manifold edge)");
-    }
-    auto sdf = sm.add_property_map<Mesh::Face_index, double>("f:sdf", 0.0).first;
-    const auto [lo, hi] = CGAL::sdf_values(
-        sm, sdf, options.cone_angle, static_cast<std::size_t>(options.rays), options.postprocess);
-    std::vector<double> out(mesh.triangle_count());
-    for (const auto f : sm.faces()) {
-        const double v = sdf[f];
-        // Post-processing normalises to [0,1] and returns the range it mapped (not when the
-        // range is empty).
-        out[f] = options.postprocess && hi > lo ? lo + v * (hi - lo) : v;
-    }
-    return out;
 }
 
 }  // namespace terrain::field

@@ -86,11 +86,3 @@ Body body_from_crs(const std::string& crs_definition) {
 }
 
 }  // namespace terrain::geo
-
-namespace terrain {
-
-Body body_from_crs(const std::string& crs_definition) {
-    return geo::body_from_crs(crs_definition);
-}
-
-}  // namespace terrain

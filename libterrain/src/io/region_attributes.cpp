@@ -3,7 +3,7 @@
 #include <cmath>
 #include <cstdio>
 
-#include "terrain/io/segment_outputs.hpp"
+#include "terrain/io/region_colour.hpp"
 
 namespace terrain::io {
 namespace {

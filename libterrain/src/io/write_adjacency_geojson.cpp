@@ -4,7 +4,7 @@
 #include "lonlat_frame.hpp"
 #include "region_attributes.hpp"
 #include "terrain/core/error.hpp"
-#include "terrain/io/segment_outputs.hpp"
+#include "terrain/io/write_adjacency.hpp"
 
 namespace terrain::io {
 void write_adjacency_geojson(const segment::RegionGraph& graph, const std::string& path,

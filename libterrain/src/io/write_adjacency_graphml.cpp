@@ -4,7 +4,7 @@
 #include "region_attributes.hpp"
 #include "terrain/core/error.hpp"
 #include "terrain/core/json_writer.hpp"
-#include "terrain/io/segment_outputs.hpp"
+#include "terrain/io/write_adjacency.hpp"
 
 namespace terrain::io {
 namespace {

@@ -3,7 +3,7 @@
 #include "region_attributes.hpp"
 #include "terrain/core/error.hpp"
 #include "terrain/core/json_writer.hpp"
-#include "terrain/io/segment_outputs.hpp"
+#include "terrain/io/write_adjacency.hpp"
 
 namespace terrain::io {
 

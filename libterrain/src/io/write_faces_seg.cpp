@@ -1,7 +1,7 @@
 
 #include "dataset_files.hpp"
 #include "terrain/core/error.hpp"
-#include "terrain/io/segment_outputs.hpp"
+#include "terrain/io/write_mesh_labels.hpp"
 
 namespace terrain::io {
 

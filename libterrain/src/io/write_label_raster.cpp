@@ -10,7 +10,8 @@
 #include "region_attributes.hpp"
 #include "terrain/core/error.hpp"
 #include "terrain/io/output_file.hpp"
-#include "terrain/io/segment_outputs.hpp"
+#include "terrain/io/region_colour.hpp"
+#include "terrain/io/write_label_raster.hpp"
 
 namespace terrain::io {
 namespace {

@@ -5,7 +5,7 @@
 #include "dataset_files.hpp"
 #include "gdal_support.hpp"
 #include "terrain/core/error.hpp"
-#include "terrain/io/segment_outputs.hpp"
+#include "terrain/io/write_label_stack.hpp"
 
 namespace terrain::io {
 

@@ -1,6 +1,6 @@
 #include "terrain/core/error.hpp"
 #include "terrain/io/mesh_files.hpp"
-#include "terrain/io/segment_outputs.hpp"
+#include "terrain/io/write_mesh_labels.hpp"
 
 namespace terrain::io {
 

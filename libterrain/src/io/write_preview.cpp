@@ -8,7 +8,7 @@
 #include "terrain/core/error.hpp"
 #include "terrain/io/describe_dem.hpp"
 #include "terrain/io/output_file.hpp"
-#include "terrain/io/segment_outputs.hpp"
+#include "terrain/io/write_preview.hpp"
 
 namespace terrain::io {
 namespace {

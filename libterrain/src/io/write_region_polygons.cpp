@@ -15,7 +15,7 @@
 #include "region_attributes.hpp"
 #include "terrain/core/error.hpp"
 #include "terrain/io/output_file.hpp"
-#include "terrain/io/segment_outputs.hpp"
+#include "terrain/io/write_region_polygons.hpp"
 
 namespace terrain::io {
 namespace {

@@ -9,7 +9,12 @@
 #include "terrain/core/error.hpp"
 #include "terrain/field/vertex_field.hpp"
 #include "terrain/io/output_file.hpp"
-#include "terrain/io/segment_outputs.hpp"
+#include "terrain/io/write_adjacency.hpp"
+#include "terrain/io/write_label_raster.hpp"
+#include "terrain/io/write_mesh_labels.hpp"
+#include "terrain/io/write_preview.hpp"
+#include "terrain/io/write_region_polygons.hpp"
+#include "terrain/io/write_segment_outputs.hpp"
 
 namespace terrain::io {
 namespace {

@@ -11,7 +11,7 @@
 #include "image_module.hpp"
 #include "terrain/core/error.hpp"
 #include "terrain/io/output_file.hpp"
-#include "terrain/io/segment_outputs.hpp"
+#include "terrain/io/write_sweep_plot.hpp"
 
 namespace terrain::io {
 

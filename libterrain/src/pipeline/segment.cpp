@@ -14,7 +14,8 @@
 #include "terrain/core/version.hpp"
 #include "terrain/io/dependency_versions.hpp"
 #include "terrain/io/mesh_files.hpp"
-#include "terrain/io/segment_outputs.hpp"
+#include "terrain/io/write_preview.hpp"
+#include "terrain/io/write_segment_outputs.hpp"
 #include "terrain/mesh/dem_to_mesh.hpp"
 
 namespace terrain::pipeline {

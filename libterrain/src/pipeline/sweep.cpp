@@ -11,7 +11,11 @@
 
 #include "terrain/core/error.hpp"
 #include "terrain/core/json_writer.hpp"
-#include "terrain/io/segment_outputs.hpp"
+#include "terrain/io/write_adjacency.hpp"
+#include "terrain/io/write_label_stack.hpp"
+#include "terrain/io/write_mesh_labels.hpp"
+#include "terrain/io/write_region_polygons.hpp"
+#include "terrain/io/write_sweep_plot.hpp"
 
 namespace terrain::pipeline {
 

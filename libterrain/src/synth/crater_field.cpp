@@ -1,223 +1,29 @@
+// The synthetic Vesta tile: the options checked, the random crater population, and the surface
+// built from the regional relief (tilt, undulation, fractal roughness) and the craters, oldest
+// first, then quantised to the HAMO DN grid.
 #include "terrain/synth/crater_field.hpp"
 
-#include <cpl_conv.h>
-#include <ogr_spatialref.h>
+#include "deterministic.hpp"
 
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <limits>
 #include <numbers>
 #include <string>
 
+#include "crater_shape.hpp"
+#include "fractal_noise.hpp"
+#include "random.hpp"
 #include "terrain/core/body.hpp"
 #include "terrain/core/error.hpp"
-
-// Determinism: the surface is built from IEEE-exact arithmetic and sqrt (no fused
-// multiply-adds, single-threaded, fixed evaluation order) and our own PRNG. libm (sin, cos,
-// asin, exp, pow) only sets up the geometry and the crater sizes; the last-ulp differences
-// between libms vanish under the 2 m DN quantisation.
-#if defined(__clang__)
-#pragma clang fp contract(off)
-#elif defined(__GNUC__)
-#pragma GCC optimize("fp-contract=off")
-#endif
+#include "terrain/synth/vesta_crs.hpp"
+#include "tile_grid.hpp"
 
 namespace terrain::synth {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
 constexpr double kDegree = kPi / 180.0;
-// Ejecta reach, in crater radii: the (r/R)^-3 blanket is tapered to zero between 2 R and 3 R
-// (the continuous ejecta blanket ends about one radius beyond the rim; Melosh 1989, ch. 6).
-constexpr double kReach = 3.0;
-constexpr double kTaperStart = 2.0;
-
-// ---------------------------------------------------------------------------------------
-// Random numbers: splitmix64 (Steele, Lea & Flood 2014) with a 53-bit uniform double, so that
-// the same seed gives the same numbers with any compiler and standard library.
-
-std::uint64_t mix64(std::uint64_t z) {
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-    return z ^ (z >> 31);
-}
-
-double to_unit(std::uint64_t bits) {  // [0,1)
-    return static_cast<double>(bits >> 11) * 0x1.0p-53;
-}
-
-class Rng {
-  public:
-    explicit Rng(std::uint64_t seed) : state_(seed) {}
-    std::uint64_t next() {
-        state_ += 0x9e3779b97f4a7c15ULL;
-        return mix64(state_);
-    }
-    double uniform() { return to_unit(next()); }                                 // [0,1)
-    double uniform(double lo, double hi) { return lo + (hi - lo) * uniform(); }  // [lo,hi)
-
-  private:
-    std::uint64_t state_;
-};
-
-// Independent random streams derived from the seed.
-enum Stream : std::uint64_t { kPopulation = 1, kRelief = 2, kRoughness = 3, kRegolith = 4 };
-
-std::uint64_t stream_seed(std::uint64_t seed, Stream stream) {
-    return mix64(seed ^ mix64(0x632be59bd9b4e019ULL * static_cast<std::uint64_t>(stream)));
-}
-
-// ---------------------------------------------------------------------------------------
-// Fractal roughness: octaves of value noise (smoothly interpolated random lattice values)
-// whose amplitude falls as wavelength^hurst, a self-affine surface (Turcotte 1997, ch. 7).
-
-double lattice_value(std::uint64_t key, std::int64_t ix, std::int64_t iy) {
-    const std::uint64_t h =
-        mix64(key ^ mix64(static_cast<std::uint64_t>(ix) * 0x9e3779b97f4a7c15ULL +
-                          static_cast<std::uint64_t>(iy)));
-    return 2.0 * to_unit(h) - 1.0;  // [-1,1)
-}
-
-double fade(double t) {
-    return t * t * t * (t * (t * 6.0 - 15.0) + 10.0);
-}  // C2 quintic
-
-// One octave: a random lattice of spacing `wavelength`, rotated and shifted so that no
-// direction dominates, its values tabulated over the area where it is evaluated.
-class Octave {
-  public:
-    Octave(std::uint64_t key, double wavelength, double amplitude, double angle, double shift_u,
-           double shift_v)
-        : key_(key),
-          inv_wavelength_(1.0 / wavelength),
-          amplitude_(amplitude),
-          cos_(std::cos(angle)),
-          sin_(std::sin(angle)),
-          shift_u_(shift_u),
-          shift_v_(shift_v) {}
-
-    // Tabulates the lattice over the rectangle [x0,x1] x [y0,y1] of projected metres.
-    void tabulate(double x0, double x1, double y0, double y1) {
-        double u_lo = std::numeric_limits<double>::infinity(), u_hi = -u_lo;
-        double v_lo = u_lo, v_hi = -u_lo;
-        for (double x : {x0, x1})
-            for (double y : {y0, y1}) {
-                u_lo = std::min(u_lo, u(x, y));
-                u_hi = std::max(u_hi, u(x, y));
-                v_lo = std::min(v_lo, v(x, y));
-                v_hi = std::max(v_hi, v(x, y));
-            }
-        u0_ = static_cast<std::int64_t>(std::floor(u_lo)) - 1;
-        v0_ = static_cast<std::int64_t>(std::floor(v_lo)) - 1;
-        nu_ = static_cast<std::int64_t>(std::floor(u_hi)) + 3 - u0_;
-        nv_ = static_cast<std::int64_t>(std::floor(v_hi)) + 3 - v0_;
-        table_.resize(static_cast<std::size_t>(nu_ * nv_));
-        for (std::int64_t j = 0; j < nv_; ++j)
-            for (std::int64_t i = 0; i < nu_; ++i)
-                table_[static_cast<std::size_t>(j * nu_ + i)] =
-                    lattice_value(key_, u0_ + i, v0_ + j);
-    }
-
-    // Value noise: the lattice values interpolated with the quintic fade, times the amplitude.
-    double operator()(double x, double y) const {
-        const double uu = u(x, y), vv = v(x, y);
-        const double fu = std::floor(uu), fv = std::floor(vv);
-        const std::int64_t i =
-            std::clamp(static_cast<std::int64_t>(fu) - u0_, std::int64_t{0}, nu_ - 2);
-        const std::int64_t j =
-            std::clamp(static_cast<std::int64_t>(fv) - v0_, std::int64_t{0}, nv_ - 2);
-        const double* row0 = table_.data() + j * nu_ + i;
-        const double* row1 = row0 + nu_;
-        const double su = fade(uu - fu), sv = fade(vv - fv);
-        const double a = row0[0] + su * (row0[1] - row0[0]);
-        const double b = row1[0] + su * (row1[1] - row1[0]);
-        return amplitude_ * (a + sv * (b - a));
-    }
-
-  private:
-    double u(double x, double y) const {
-        return (cos_ * x - sin_ * y) * inv_wavelength_ + shift_u_;
-    }
-    double v(double x, double y) const {
-        return (sin_ * x + cos_ * y) * inv_wavelength_ + shift_v_;
-    }
-
-    std::uint64_t key_;
-    double inv_wavelength_, amplitude_, cos_, sin_, shift_u_, shift_v_;
-    std::int64_t u0_ = 0, v0_ = 0, nu_ = 0, nv_ = 0;
-    std::vector<double> table_;
-};
-
-// Octaves from `longest` metres down to two pixels, amplitude falling as wavelength^hurst;
-// those longer than `cutoff` are left out. Tabulated over [x0,x1] x [y0,y1].
-std::vector<Octave> make_octaves(std::uint64_t seed, double amplitude_at_longest, double longest,
-                                 double cutoff, double hurst, double pixel, double x0, double x1,
-                                 double y0, double y1) {
-    std::vector<Octave> octaves;
-    if (amplitude_at_longest <= 0) return octaves;
-    Rng rng(seed);
-    for (double wavelength = longest; wavelength >= 2.0 * pixel; wavelength *= 0.5) {
-        const double angle = rng.uniform(0.0, 2.0 * kPi);
-        const std::uint64_t key = rng.next();
-        const double shift_u = rng.uniform(0.0, 1024.0), shift_v = rng.uniform(0.0, 1024.0);
-        if (wavelength > cutoff) continue;
-        octaves.emplace_back(key, wavelength,
-                             amplitude_at_longest * std::pow(wavelength / longest, hurst), angle,
-                             shift_u, shift_v);
-        octaves.back().tabulate(x0, x1, y0, y1);
-    }
-    return octaves;
-}
-
-double fractal(const std::vector<Octave>& octaves, double x, double y) {
-    double z = 0;
-    for (const auto& octave : octaves) z += octave(x, y);
-    return z;
-}
-
-// ---------------------------------------------------------------------------------------
-// Geometry of the tile and of the extended grid (the tile plus a margin wide enough for the
-// largest crater's ejecta) on which the surface is built.
-
-struct Geometry {
-    double radius = kVestaRadius;
-    double pixel = 0;   // metres in the projection (x and y)
-    double lat_ts = 0;  // latitude of true scale, radians
-    double cos_ts = 1;
-    double x_left = 0, y_top = 0;  // tile's top-left corner in projected metres
-    int margin_x = 0, margin_y = 0;
-    int width = 0, height = 0;  // extended grid
-    // Projected coordinates of the centre of extended-grid pixel (col,row).
-    double x_of(double col) const { return x_left + (col - margin_x + 0.5) * pixel; }
-    double y_of(double row) const { return y_top - (row - margin_y + 0.5) * pixel; }
-    // Ground metres per projected metre along a parallel at latitude `lat` (radians).
-    double east_scale(double lat) const { return std::cos(lat) / cos_ts; }
-};
-
-struct Grid {
-    int width = 0, height = 0;
-    std::vector<double> z;
-    double& at(int col, int row) {
-        return z[static_cast<std::size_t>(row) * static_cast<std::size_t>(width) +
-                 static_cast<std::size_t>(col)];
-    }
-    double at(int col, int row) const {
-        return z[static_cast<std::size_t>(row) * static_cast<std::size_t>(width) +
-                 static_cast<std::size_t>(col)];
-    }
-    // Bilinear at a continuous position (pixel centres at +0.5), clamped to the grid.
-    double sample(double col, double row) const {
-        const double u = std::clamp(col - 0.5, 0.0, double(width - 1));
-        const double v = std::clamp(row - 0.5, 0.0, double(height - 1));
-        const int i = std::min(static_cast<int>(u), width - 2);
-        const int j = std::min(static_cast<int>(v), height - 2);
-        const double fu = u - i, fv = v - j;
-        const double a = at(i, j) + fu * (at(i + 1, j) - at(i, j));
-        const double b = at(i, j + 1) + fu * (at(i + 1, j + 1) - at(i, j + 1));
-        return a + fv * (b - a);
-    }
-};
 
 void check(bool ok, const std::string& message) {
     if (!ok) throw Error("synth", message);
@@ -263,176 +69,7 @@ void validate(const VestaTileOptions& o) {
               "degradation in [0, 1)");
 }
 
-Geometry make_geometry(const VestaTileOptions& o) {
-    Geometry g;
-    g.pixel = kDegree * g.radius / o.pixels_per_degree;
-    g.lat_ts = o.standard_parallel.value_or(o.center_lat) * kDegree;
-    g.cos_ts = std::cos(g.lat_ts);
-    // Central meridian through the tile centre; rows on the 1/ppd-degree latitude grid.
-    g.x_left = -0.5 * o.width * g.pixel;
-    g.y_top = std::round((g.radius * o.center_lat * kDegree + 0.5 * o.height * g.pixel) / g.pixel) *
-              g.pixel;
-
-    // The margin follows the random population only (so that adding craters by hand does not
-    // move it); with no population, it covers the added craters.
-    double largest = o.max_diameter;
-    if (o.crater_density <= 0) {
-        largest = 0;
-        for (const auto& c : o.craters) largest = std::max(largest, c.diameter);
-    }
-    const double reach = kReach * 0.5 * largest;
-    g.margin_y = static_cast<int>(std::ceil(reach / g.pixel)) + 1;
-    const double lat_top = (g.y_top + g.margin_y * g.pixel) / g.radius;
-    const double lat_bottom = (g.y_top - (o.height + g.margin_y) * g.pixel) / g.radius;
-    const double worst = std::max(std::abs(lat_top), std::abs(lat_bottom));
-    check(worst < 85 * kDegree,
-          "the tile and its crater margin reach latitude " +
-              std::to_string(static_cast<int>(worst / kDegree)) +
-              " degrees; move the tile equatorward or make it smaller (an equirectangular tile "
-              "must stay within +-85 degrees)");
-    g.margin_x = static_cast<int>(std::ceil(reach / (g.pixel * g.east_scale(worst)))) + 1;
-    const long long cells = (static_cast<long long>(o.width) + 2LL * g.margin_x) *
-                            (static_cast<long long>(o.height) + 2LL * g.margin_y);
-    check(cells <= 200'000'000LL, "the tile with its crater margin would hold " +
-                                      std::to_string(cells) +
-                                      " pixels; make the tile or max_diameter smaller");
-    g.width = o.width + 2 * g.margin_x;
-    g.height = o.height + 2 * g.margin_y;
-    return g;
-}
-
-// Fraction of the relief a crater of diameter `d` has lost after `age` (fraction of the
-// surface age): topographic diffusion degrades a crater on a time scale proportional to D^2
-// (Soderblom 1970; Fassett & Thomson 2014), so 1 - exp(-ln2 * age * (D_half / D)^2).
-double degradation(double d, double age, double d_half) {
-    if (d_half <= 0) return 0;
-    const double r = d_half / d;
-    return 1.0 - std::exp(-std::numbers::ln2 * age * r * r);
-}
-
-// ---------------------------------------------------------------------------------------
-// Craters
-
-double smoothstep(double e0, double e1, double x) {
-    const double t = std::clamp((x - e0) / (e1 - e0), 0.0, 1.0);
-    return t * t * (3.0 - 2.0 * t);
-}
-
-// Polynomial smooth minimum (Quilez): min(a,b) rounded over |a-b| < k, by k/4 where a = b.
-double smooth_min(double a, double b, double k) {
-    const double h = std::max(k - std::abs(a - b), 0.0) / k;
-    return std::min(a, b) - h * h * k * 0.25;
-}
-
-struct Shape {
-    double depth_ratio, rim_ratio;
-};
-
-// Adds one simple crater to the surface. Heights relative to the pre-impact surface, with
-// s = r / R (R the rim-crest radius):
-//  - bowl: a paraboloid, rim-to-floor depth H = 0.2 D for fresh simple craters (Pike 1977,
-//    d = 0.196 D for lunar simple craters; Vincent et al. 2014 find 0.15-0.2 on Vesta; every
-//    crater of this tile is simple, Vesta's simple-to-complex transition being near 30 km);
-//  - rim crest at height h = 0.04 D (Pike 1977: h = 0.036 D^1.014), rounded over a width
-//    growing with degradation;
-//  - ejecta blanket beyond the rim, thickness h (r/R)^-3 (McGetchin, Settle & Head 1973:
-//    t = 0.14 R^0.74 (r/R)^-3.0), tapered to zero between 2 R and 3 R.
-// Inside the rim the crater replaces the old surface (a plane fitted on the old rim) rather than
-// adding to it, so that young craters cut cleanly into old ones; ejecta add to what is there.
-// Degradation q in [0,1) scales the depth by (1-q) and the rim by (1-q)^1.5 (rims and ejecta
-// soften first) and widens the rounding of the rim crest.
-void add_crater(Grid& grid, const Geometry& geo, const Crater& c, const Shape& shape) {
-    const double q = c.degradation;
-    const double radius = 0.5 * c.diameter;
-    const double depth = shape.depth_ratio * c.diameter * (1.0 - q);
-    const double rim = shape.rim_ratio * c.diameter * std::pow(1.0 - q, 1.5);
-    const double rounding = (0.04 + 0.4 * q) * (2.0 * depth + 3.0 * rim);  // smooth_min width
-    if (rounding <= 0) return;
-    // Both branches meet at rim + rounding/4 at s = 1, so that the rounded crest sits at `rim`
-    // and the floor (s = 0) at rim - depth.
-    const double lift = 0.25 * rounding;
-    const double floor_z = rim - depth;
-
-    const double ce = c.col + geo.margin_x, re = c.row + geo.margin_y;
-    const double lat = geo.y_of(re - 0.5) / geo.radius;
-    const double kx = geo.east_scale(lat) * geo.pixel;  // ground metres per column
-    const double ky = geo.pixel;                        // ground metres per row
-
-    // The old surface's plane from eight points on the rim circle.
-    static constexpr double h2 = 0.70710678118654752440;
-    static constexpr std::array<std::array<double, 2>, 8> dirs{
-        {{1, 0}, {h2, h2}, {0, 1}, {-h2, h2}, {-1, 0}, {-h2, -h2}, {0, -1}, {h2, -h2}}};
-    double mean = 0, grad_e = 0, grad_n = 0;
-    for (const auto& d : dirs) {
-        const double z = grid.sample(ce + radius * d[0] / kx, re - radius * d[1] / ky);
-        mean += z;
-        grad_e += z * d[0];
-        grad_n += z * d[1];
-    }
-    mean /= 8.0;
-    grad_e /= 4.0 * radius;
-    grad_n /= 4.0 * radius;
-
-    const double reach = kReach * radius;
-    const int r0 = std::max(0, static_cast<int>(std::floor(re - reach / ky - 0.5)));
-    const int r1 = std::min(grid.height - 1, static_cast<int>(std::ceil(re + reach / ky - 0.5)));
-    const int c0 = std::max(0, static_cast<int>(std::floor(ce - reach / kx - 0.5)));
-    const int c1 = std::min(grid.width - 1, static_cast<int>(std::ceil(ce + reach / kx - 0.5)));
-    const double inv_r = 1.0 / radius;
-    const double erase = 1.0 - q;  // degraded craters let the old surface show through
-    for (int row = r0; row <= r1; ++row) {
-        const double dn = (re - (row + 0.5)) * ky;
-        const double across = reach * reach - dn * dn;
-        if (across <= 0) continue;
-        // Columns within the reach on this row (one spare column each side; s decides).
-        const double half = std::sqrt(across) / kx + 1.0;
-        const int first = std::max(c0, static_cast<int>(std::floor(ce - half - 0.5)));
-        const int last = std::min(c1, static_cast<int>(std::ceil(ce + half - 0.5)));
-        for (int col = first; col <= last; ++col) {
-            const double de = (col + 0.5 - ce) * kx;
-            const double s = std::sqrt(de * de + dn * dn) * inv_r;
-            if (s >= kReach) continue;
-            // Away from the rim one branch is lower by more than the rounding width, where
-            // smooth_min is exactly min: s <= 0.5 is all bowl, s >= 1.6 all ejecta.
-            const double bowl = floor_z + (depth + lift) * s * s;
-            double profile = bowl;
-            if (s > 0.5) {
-                const double t = s;
-                double ejecta = (rim + lift) / (t * t * t);
-                if (s > kTaperStart) ejecta *= 1.0 - smoothstep(kTaperStart, kReach, s);
-                profile = s < 1.6 ? smooth_min(bowl, ejecta, rounding) : ejecta;
-            }
-            double& z = grid.at(col, row);
-            if (s < 1.0) {
-                const double plane = mean + grad_e * de + grad_n * dn;
-                const double w = erase * (s > 0.7 ? 1.0 - smoothstep(0.7, 1.0, s) : 1.0);
-                z += profile + w * (plane - z);
-            } else {
-                z += profile;
-            }
-        }
-    }
-}
-
 }  // namespace
-
-std::string vesta_equirectangular_wkt(double center_lon, double standard_parallel) {
-    // Named as GDAL's PDS driver names the CRS of an EQUIRECTANGULAR label for TARGET_NAME =
-    // VESTA, so that the tile and its PDS3 files carry the same CRS.
-    OGRSpatialReference srs;
-    srs.SetEquirectangular2(0.0, center_lon, standard_parallel, 0.0, 0.0);
-    srs.SetProjCS("EQUIRECTANGULAR VESTA");
-    srs.SetGeogCS("GCS_VESTA", "D_VESTA", "VESTA_localRadius", kVestaRadius, 0.0,
-                  "Reference_Meridian", 0.0);
-    char* wkt = nullptr;
-    const char* options[] = {"FORMAT=WKT2_2019", nullptr};
-    std::string text;
-    if (srs.exportToWkt(&wkt, options) == OGRERR_NONE && wkt) text = wkt;
-    CPLFree(wkt);
-    if (text.empty())
-        throw Error("synth", "cannot build the Vesta equirectangular CRS (GDAL/PROJ)");
-    return text;
-}
 
 std::vector<Crater> vesta_crater_population(const VestaTileOptions& options) {
     validate(options);
@@ -561,7 +198,7 @@ Dem generate_vesta_tile(const VestaTileOptions& options, const ProgressFn& progr
     dem.has_transform = true;
     const double lon0 = options.center_lon - 360.0 * std::floor(options.center_lon / 360.0);
     dem.crs_wkt = vesta_equirectangular_wkt(lon0, geo.lat_ts / kDegree);
-    dem.body = body_from_crs(dem.crs_wkt);
+    dem.body = Body{"Vesta", kVestaRadius, 0.0, true};  // what geo reads from that CRS
     dem.elevation = ElevationKind::radius;
     dem.source = "synthetic Vesta tile (seed " + std::to_string(options.seed) + ")";
     dem.values.resize(static_cast<std::size_t>(dem.width) * static_cast<std::size_t>(dem.height));

@@ -17,8 +17,4 @@ struct Body {
     bool is_local_grid() const { return !has_crs; }
 };
 
-// Compatibility: geo::body_from_crs (terrain/geo/body.hpp), defined by the geo layer. Kept
-// until the last caller outside geo/ and io/ moves to it.
-Body body_from_crs(const std::string& crs_definition);
-
 }  // namespace terrain

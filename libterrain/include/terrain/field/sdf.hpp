@@ -44,11 +44,4 @@ struct SdfResult {
 SdfResult shape_diameter_function(const TriangleMesh& mesh, const SdfOptions& options = {},
                                   const ProgressFn& progress = {});
 
-// Reference: the face diameters (metres) `CGAL::sdf_values` gives on a CGAL Surface_mesh
-// built from `mesh` (un-normalised with the range it returns when post-processing).
-// Single-threaded and slow; for tests and benchmarks. Throws terrain::Error when CGAL's
-// halfedge structure cannot hold the mesh (non-manifold, repeated vertex in a face).
-std::vector<double> cgal_sdf_face_diameters(const TriangleMesh& mesh,
-                                            const SdfOptions& options = {});
-
 }  // namespace terrain::field

@@ -83,12 +83,8 @@ std::vector<Crater> vesta_crater_population(const VestaTileOptions& options = {}
 
 // The tile: radii in metres on the HAMO DN grid, ElevationKind::radius, the geotransform of
 // the equirectangular projection in metres and its CRS (a 255000 m sphere named for Vesta,
-// as GDAL's PDS driver builds it), body Vesta. Throws terrain::Error (stage "synth") on
+// vesta_equirectangular_wkt), body Vesta. Throws terrain::Error (stage "synth") on
 // invalid options, "progress" when the callback cancels.
 Dem generate_vesta_tile(const VestaTileOptions& options = {}, const ProgressFn& progress = {});
-
-// The equirectangular CRS of a Vesta tile (WKT2), with the projection's centre longitude and
-// latitude of true scale in degrees.
-std::string vesta_equirectangular_wkt(double center_lon, double standard_parallel);
 
 }  // namespace terrain::synth

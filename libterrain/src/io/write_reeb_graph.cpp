@@ -1,4 +1,4 @@
-#include "terrain/reeb/reeb_io.hpp"
+#include "terrain/io/write_reeb_graph.hpp"
 
 #include <fstream>
 
@@ -7,7 +7,10 @@
 #include "terrain/io/output_file.hpp"
 #include "terrain/reeb/simplify.hpp"
 
-namespace terrain::reeb {
+namespace terrain::io {
+
+using reeb::NodeKind;
+using reeb::ReebGraph;
 
 namespace {
 
@@ -26,7 +29,7 @@ std::size_t node_size(const ReebGraph& g, std::size_t n) {
 
 template <class Write>
 void write_atomically(const std::string& path, bool overwrite, Write&& write) {
-    io::AtomicOutput out(path, overwrite);
+    AtomicOutput out(path, overwrite);
     {
         std::ofstream file(out.temp_path(), std::ios::binary);
         if (!file) throw Error("write", "cannot write " + path);
@@ -42,10 +45,10 @@ void write_atomically(const std::string& path, bool overwrite, Write&& write) {
 void write_reeb_json(const ReebGraph& g, const TriangleMesh& mesh, const std::string& path,
                      bool overwrite, const JsonParameters& parameters) {
     const auto ids = critical_ids(g);
-    const auto inc = node_arcs(g);
-    const auto metrics = arc_metrics(mesh, g);
+    const auto inc = reeb::node_arcs(g);
+    const auto metrics = reeb::arc_metrics(mesh, g);
     const auto topo = mesh_topology(mesh);
-    const auto summary = summarize(g);
+    const auto summary = reeb::summarize(g);
     write_atomically(path, overwrite, [&](std::ostream& os) {
         JsonWriter j(os);
         j.begin_object();
@@ -57,7 +60,7 @@ void write_reeb_json(const ReebGraph& g, const TriangleMesh& mesh, const std::st
                 .field("id", ids[n])
                 .field("type", to_string(g.node_kinds[n]))
                 .field("class",
-                       to_string(classify_link(g.node_lower_links[n], g.node_upper_links[n])))
+                       to_string(reeb::classify_link(g.node_lower_links[n], g.node_upper_links[n])))
                 .field("value", static_cast<double>(g.node_values[n]))
                 .field("vertex_count", node_size(g, n))
                 .field("lower_links", int{g.node_lower_links[n]})
@@ -134,4 +137,4 @@ void write_reeb_dot(const ReebGraph& g, const std::string& path, bool overwrite)
     });
 }
 
-}  // namespace terrain::reeb
+}  // namespace terrain::io

@@ -1,5 +1,6 @@
 #pragma once
 // The Reeb graph as files: JSON (../shared/CLI.md's `reeb` format) and GraphViz DOT.
+// Atomic (a temporary sibling renamed when complete); throw terrain::Error (stage "write").
 
 #include <string>
 #include <vector>
@@ -7,7 +8,7 @@
 #include "terrain/mesh/triangle_mesh.hpp"
 #include "terrain/reeb/reeb_graph.hpp"
 
-namespace terrain::reeb {
+namespace terrain::io {
 
 // Extra key/value pairs written under "parameters" (already formatted as JSON values).
 using JsonParameters = std::vector<std::pair<std::string, std::string>>;
@@ -20,11 +21,12 @@ using JsonParameters = std::vector<std::pair<std::string, std::string>>;
 //  "summary": {...}, "parameters": {...}}
 // Node ids are the critical nodes numbered 0.. in the graph's order. Atomic; refuses an
 // existing file unless overwrite.
-void write_reeb_json(const ReebGraph& graph, const TriangleMesh& mesh, const std::string& path,
-                     bool overwrite, const JsonParameters& parameters = {});
+void write_reeb_json(const reeb::ReebGraph& graph, const TriangleMesh& mesh,
+                     const std::string& path, bool overwrite,
+                     const JsonParameters& parameters = {});
 
 // The same graph in DOT: minima blue, maxima red, saddles green; arcs labelled with their
 // regular vertex count.
-void write_reeb_dot(const ReebGraph& graph, const std::string& path, bool overwrite);
+void write_reeb_dot(const reeb::ReebGraph& graph, const std::string& path, bool overwrite);
 
-}  // namespace terrain::reeb
+}  // namespace terrain::io

@@ -1,0 +1,20 @@
+#pragma once
+// labels.tif of a sweep: the labels of several scales in one file (docs/sweep.md). Like every
+// writer of io/: atomic, refuses an existing file unless `overwrite`, throws one
+// terrain::Error (stage "write") on failure, and writes the same bytes for the same input.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "terrain/core/dem.hpp"
+
+namespace terrain::io {
+
+// One UInt32 band per scale on the DEM's exact grid, NoData 0, each band's description
+// saying its scale ("area_ratio=0.5"). `bands`: segment::label_pixels() of each scale.
+void write_label_stack(const Dem& dem, const std::vector<std::vector<std::uint32_t>>& bands,
+                       const std::vector<std::string>& descriptions, const std::string& path,
+                       bool overwrite);
+
+}  // namespace terrain::io
