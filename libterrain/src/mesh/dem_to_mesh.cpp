@@ -38,41 +38,14 @@ MeshFrame default_frame(const Dem& dem) {
     return MeshFrame::body;
 }
 
-TriangleMesh dem_to_mesh(const Dem& dem, const DemToMeshOptions& options,
-                         const ProgressFn& progress) {
-    const MeshFrame frame = options.frame.value_or(default_frame(dem));
-    if (frame == MeshFrame::file) throw Error("mesh", "a DEM mesh is in the body or map frame");
-    if (frame == MeshFrame::body && dem.crs_wkt.empty())
-        throw Error("mesh", "'" + dem.source +
-                                "' has no CRS, so it has no body to place it on; use --frame map");
+namespace {
+
+// Vertex numbering: valid pixels in row-major order; a collapsed pole row is one vertex.
+// Returns each pixel's vertex (-1 for NoData) and fills the mesh's vertex -> pixel map and
+// pole vertices.
+std::vector<std::int32_t> number_vertices(const Dem& dem, std::array<bool, 2> pole,
+                                          TriangleMesh& mesh) {
     const int W = dem.width, H = dem.height;
-    const GridGeoref& geo = georef_of(dem);
-    const bool geographic_crs = geo.kind == CrsKind::geographic;
-    const bool need_lonlat = frame == MeshFrame::body || geographic_crs;
-    const LonLatMapping* lonlat = nullptr;  // null: map coordinates are lon/lat already
-    if (need_lonlat && !geographic_crs) {
-        if (!geo.lonlat)
-            throw Error("mesh", "cannot transform the DEM's CRS to longitude/latitude on its body");
-        lonlat = geo.lonlat.get();
-    }
-
-    // A global grid closes in the body frame: seam, and pole rows whose outer edge is a pole.
-    bool wrap = false;
-    std::array<bool, 2> pole{false, false};
-    if (frame == MeshFrame::body && options.close_global && geo.global_longitude) {
-        wrap = true;
-        pole = geo.pole_row;
-    }
-
-    TriangleMesh mesh;
-    mesh.frame = frame;
-    mesh.body = dem.body;
-    mesh.crs_wkt = dem.crs_wkt;
-    mesh.grid_width = W;
-    mesh.grid_height = H;
-    mesh.seam_closed = wrap;
-
-    // Vertex numbering: valid pixels in row-major order; a collapsed pole row is one vertex.
     std::vector<std::int32_t> vertex_of(dem.size(), -1);
     std::int32_t count = 0;
     for (int row = 0; row < H; ++row) {
@@ -96,11 +69,26 @@ TriangleMesh dem_to_mesh(const Dem& dem, const DemToMeshOptions& options,
         }
     }
     if (count < 3) throw Error("mesh", "'" + dem.source + "' has fewer than 3 valid pixels");
-    report_progress(progress, 0.05, "mesh");
+    return vertex_of;
+}
 
-    // Positions in double, per row in parallel (the mapping keeps one PROJ transformation per
-    // thread).
-    std::vector<std::array<double, 3>> xyz(static_cast<std::size_t>(count));
+// Vertex positions in metres in the mesh's frame (docs/mesh.md, "Frames"): body-fixed X,Y,Z
+// from lon/lat and the value (a radius along the geocentric direction, or a height on the
+// ellipsoid); in the map frame easting/northing and height, or a local tangent plane for a
+// lon/lat grid. Rows in parallel (the mapping keeps one PROJ transformation per thread).
+void place_vertices(const Dem& dem, const GridGeoref& geo,
+                    const std::vector<std::int32_t>& vertex_of, TriangleMesh& mesh) {
+    const int W = dem.width, H = dem.height;
+    const MeshFrame frame = mesh.frame;
+    const bool geographic_crs = geo.kind == CrsKind::geographic;
+    const bool need_lonlat = frame == MeshFrame::body || geographic_crs;
+    const LonLatMapping* lonlat = nullptr;  // null: map coordinates are lon/lat already
+    if (need_lonlat && !geographic_crs) {
+        if (!geo.lonlat)
+            throw Error("mesh", "cannot transform the DEM's CRS to longitude/latitude on its body");
+        lonlat = geo.lonlat.get();
+    }
+    std::vector<std::array<double, 3>> xyz(mesh.vertex_pixel.size());
     const double a = dem.body.semi_major_axis, f = dem.body.flattening;
     const double unit = geo.linear_unit_m;
     std::unique_ptr<GeographicLib::Geocentric> earth;
@@ -169,17 +157,20 @@ TriangleMesh dem_to_mesh(const Dem& dem, const DemToMeshOptions& options,
         else
             earth->Forward(lat, 0.0, value, out[0], out[1], out[2]);
     }
-    report_progress(progress, 0.4, "mesh");
-
     set_positions(mesh, xyz);
-    detail::release(xyz);
+}
 
-    // Triangles, block by block. With rows growing southwards and columns eastwards (the
-    // geotransform's determinant negative) the orders below are counter-clockwise seen from
-    // above/outside; otherwise the last two corners swap.
+// Two triangles per 2x2 block of valid pixels, split along the shorter 3-D diagonal (ties
+// to v00-v11), one for three valid pixels, none for fewer (METHOD.md s.1); a closed seam
+// adds the blocks between the last and the first column. With rows growing southwards and
+// columns eastwards (the geotransform's determinant negative) the orders below are
+// counter-clockwise seen from above/outside; otherwise the last two corners swap.
+void triangulate_blocks(const Dem& dem, const std::vector<std::int32_t>& vertex_of,
+                        TriangleMesh& mesh) {
+    const int W = dem.width, H = dem.height;
     const auto& t = dem.transform;
     const bool flip = t[1] * t[5] - t[2] * t[4] > 0;
-    const int block_cols = wrap ? W : W - 1;
+    const int block_cols = mesh.seam_closed ? W : W - 1;
     const int block_rows = H - 1;
     std::vector<std::vector<Triangle>> per_row(static_cast<std::size_t>(block_rows));
     tbb::parallel_for(tbb::blocked_range<int>(0, block_rows, 16), [&](const auto& rows) {
@@ -233,10 +224,40 @@ TriangleMesh dem_to_mesh(const Dem& dem, const DemToMeshOptions& options,
         mesh.triangles.insert(mesh.triangles.end(), r.begin(), r.end());
         detail::release(r);
     }
-    detail::release(per_row);
     if (mesh.triangles.empty())
         throw Error("mesh",
                     "'" + dem.source + "' gives no triangle: no 2x2 block has three valid pixels");
+}
+
+}  // namespace
+
+TriangleMesh dem_to_mesh(const Dem& dem, const DemToMeshOptions& options,
+                         const ProgressFn& progress) {
+    const MeshFrame frame = options.frame.value_or(default_frame(dem));
+    if (frame == MeshFrame::file) throw Error("mesh", "a DEM mesh is in the body or map frame");
+    if (frame == MeshFrame::body && dem.crs_wkt.empty())
+        throw Error("mesh", "'" + dem.source +
+                                "' has no CRS, so it has no body to place it on; use --frame map");
+    const GridGeoref& geo = georef_of(dem);
+
+    TriangleMesh mesh;
+    mesh.frame = frame;
+    mesh.body = dem.body;
+    mesh.crs_wkt = dem.crs_wkt;
+    mesh.grid_width = dem.width;
+    mesh.grid_height = dem.height;
+    // A global grid closes in the body frame: seam, and pole rows whose outer edge is a pole.
+    std::array<bool, 2> pole{false, false};
+    if (frame == MeshFrame::body && options.close_global && geo.global_longitude) {
+        mesh.seam_closed = true;
+        pole = geo.pole_row;
+    }
+
+    const auto vertex_of = number_vertices(dem, pole, mesh);
+    report_progress(progress, 0.05, "mesh");
+    place_vertices(dem, geo, vertex_of, mesh);
+    report_progress(progress, 0.4, "mesh");
+    triangulate_blocks(dem, vertex_of, mesh);
     report_progress(progress, 0.7, "mesh");
 
     // Leave out valid pixels in no triangle (isolated, or only in degenerate blocks).
