@@ -14,6 +14,7 @@
 #include "terrain/core/json_writer.hpp"
 #include "terrain/core/version.hpp"
 #include "terrain/io/segment_outputs.hpp"
+#include "terrain/io/temporary_files.hpp"
 
 namespace terrain::cli {
 
@@ -66,6 +67,7 @@ void check_segment_options(const SegmentOptionValues& v) {
 void compute_field(SegmentJob& job, const field::FieldOptions& options,
                    const ProgressFn& progress) {
     const auto t0 = clock::now();
+    check_field_limits(options, job.input.mesh);
     job.field = field::vertex_field(job.input.mesh, job.dem(), options, progress);
     job.add_time("field", since(t0));
 }
@@ -271,6 +273,7 @@ OutputDirectory::OutputDirectory(std::string path, bool overwrite) : path_(std::
                     "cannot create '" + path_ + "': '" + parent.string() + "' is not writable");
     temp_ = (parent / ("." + p.filename().string() + ".tmp" + std::to_string(::getpid()))).string();
     fs::remove_all(temp_, ec);
+    io::remove_stale_temporaries(path_, true);
     if (!fs::create_directory(temp_, ec))
         throw Error("write", "cannot create a directory beside '" + path_ + "': " + ec.message());
 }
