@@ -125,7 +125,8 @@ case "$mode" in
       echo "setup: fuzzing $target for ${seconds}s"
       ASAN_OPTIONS=detect_leaks=1 "$binary" "$corpus" -max_total_time="$seconds" \
         -rss_limit_mb=2048 -timeout=20 -max_len=65536 -print_final_stats=1 \
-        -artifact_prefix="$fuzz_dir/findings/$target/" 2>&1 | tail -n 14
+        -artifact_prefix="$fuzz_dir/findings/$target/" 2>&1 | tail -n 14 ||
+        echo "setup: fuzz_$target stopped on a finding (above)"
     done
     echo "setup: findings (crashes, leaks, timeouts, out-of-memory) in $fuzz_dir/findings/"
     ;;

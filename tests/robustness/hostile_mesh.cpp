@@ -94,6 +94,10 @@ TEST_CASE("OFF headers and faces declaring more than the file holds are refused"
         {"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n4000000000 0 1 2\n", "cannot hold them"},
         {"OFF\n3 1 0\n0 0 0\n1 0 0\n# a comment, not a vertex or a face\n", "OFF data end"},
         {"OFF\n-3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n", "not a non-negative integer"},
+        // Found by fuzz_mesh_off: CGAL turned the index "0-1" (-1) into a size_t from a double.
+        {"OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 8 1\n3 0 2 1\n3 0-1 3\n3 0 3 2\n3 1 2 3\x1a",
+         "OFF face 1 lists 2 of its 3 vertices"},
+        {"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n", "refers to vertex '3'"},
     };
     int i = 0;
     for (const auto& [text, expected] : cases) {

@@ -364,6 +364,17 @@ MeshFileCounts check_off(std::string_view bytes, const std::string& name) {
             refuse(name, "OFF face " + str(f) + " declares " + str(*n) +
                              " vertices; the file cannot hold them");
         counts.indices += *n;
+        // CGAL converts each index from a floating-point reading: a negative one is
+        // undefined behaviour there, so every index is checked here.
+        if (face.size() < *n + 1)
+            refuse(name, "OFF face " + str(f) + " lists " + str(face.size() - 1) + " of its " +
+                             str(*n) + " vertices");
+        for (std::uint64_t k = 1; k <= *n; ++k) {
+            const auto index = parse_count(face[k]);
+            if (!index || *index >= *nv)
+                refuse(name, "OFF face " + str(f) + " refers to vertex '" + std::string(face[k]) +
+                                 "'; the file has " + str(*nv) + " vertices");
+        }
     }
     return counts;
 }
