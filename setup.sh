@@ -5,6 +5,8 @@
 #   ./setup.sh bench    also install the bench-only packages, build, run the benchmarks
 #   ./setup.sh qgis     also install QGIS, build, install the Processing provider into the
 #                       QGIS profile (QGIS_PROFILE, default: the user's default profile)
+#   ./setup.sh fuzz [SECONDS]  build the libFuzzer targets with clang in build-fuzz and run
+#                       each for SECONDS (default 120) on its seeds (docs/robustness.md)
 # All are idempotent: installed packages are skipped and the build directory is reused.
 # Environment: BUILD_DIR (default build), OUT_DIR (default out), JOBS (default nproc).
 set -euo pipefail
@@ -120,8 +122,39 @@ case "$mode" in
     QT_QPA_PLATFORM=offscreen "$qgis_process" plugins enable terrain_provider >/dev/null
     echo "setup: the terrain provider is in $plugin (Processing toolbox > terrain)"
     ;;
+  fuzz)
+    install_packages "${packages[@]}" clang
+    seconds="${2:-120}"
+    fuzz_dir="${FUZZ_BUILD_DIR:-build-fuzz}"
+    clang="$(command -v clang++-14 || command -v clang++)"
+    launcher=()
+    command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+    if [ ! -f "$fuzz_dir/CMakeCache.txt" ]; then
+      cmake -S . -B "$fuzz_dir" -G Ninja -DCMAKE_BUILD_TYPE=None -DCMAKE_CXX_FLAGS=-O1 -DCMAKE_CXX_COMPILER="$clang" \
+        -DTERRAIN_FUZZ=ON \
+        "${launcher[@]}"
+    fi
+    cmake --build "$fuzz_dir" -j "$jobs"
+    # Working corpora grow in the build directory; the seeds stay in tests/fuzz/seeds.
+    for target in ply off obj dem pds; do
+      corpus="$fuzz_dir/corpus/$target"
+      mkdir -p "$corpus" "$fuzz_dir/findings/$target"
+      case "$target" in
+        dem) cp -n examples/data/*.tif "$corpus/" ;;
+        *) cp -n tests/fuzz/seeds/"$target"/* "$corpus/" ;;
+      esac
+      binary="$fuzz_dir/tests/fuzz/fuzz_$target"
+      [ "$target" = dem ] || [ "$target" = pds ] || binary="$fuzz_dir/tests/fuzz/fuzz_mesh_$target"
+      echo "setup: fuzzing $target for ${seconds}s"
+      ASAN_OPTIONS=detect_leaks=1 "$binary" "$corpus" -max_total_time="$seconds" \
+        -rss_limit_mb=2048 -timeout=20 -max_len=65536 -print_final_stats=1 \
+        -artifact_prefix="$fuzz_dir/findings/$target/" 2>&1 | tail -n 14 ||
+        echo "setup: fuzz_$target stopped on a finding (above)"
+    done
+    echo "setup: findings (crashes, leaks, timeouts, out-of-memory) in $fuzz_dir/findings/"
+    ;;
   *)
-    echo "usage: ./setup.sh [run|test|bench|qgis]" >&2
+    echo "usage: ./setup.sh [run|test|bench|qgis|fuzz [SECONDS]]" >&2
     exit 2
     ;;
 esac

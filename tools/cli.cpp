@@ -4,7 +4,9 @@
 #include <iostream>
 #include <memory>
 
+#include "signals.hpp"
 #include "terrain/core/error.hpp"
+#include "terrain/core/memory_budget.hpp"
 
 namespace terrain::cli {
 
@@ -21,6 +23,8 @@ bool parse(int argc, char** argv, const std::string& usage, const po::options_de
             return false;
         }
         po::notify(vm);
+    } catch (const po::invalid_option_value& e) {  // a bad value: exit 1
+        throw Error("options", std::string(e.what()) + " (see --help)");
     } catch (const po::error& e) {
         throw UsageError(std::string(e.what()) + " (see --help)");
     }
@@ -33,7 +37,8 @@ bool progress_line_open = false;
 }  // namespace
 
 ProgressFn terminal_progress(bool quiet) {
-    if (quiet) return {};
+    // Quiet or not, the callback turns SIGINT/SIGTERM into a cancellation.
+    if (quiet) return [](double, std::string_view) { return pending_signal() == 0; };
     // Prints each tenth once, like GDALTermProgress; shared state lives in the closure.
     auto last = std::make_shared<int>(-1);
     return [last](double fraction, std::string_view) {
@@ -46,7 +51,7 @@ ProgressFn terminal_progress(bool quiet) {
                 std::cerr << *last * 10 << "..." << std::flush;
             progress_line_open = *last != 10;
         }
-        return true;
+        return pending_signal() == 0;
     };
 }
 
@@ -56,18 +61,28 @@ int guarded(const std::string& command, const std::function<int()>& body) {
         progress_line_open = false;
         std::cerr << "terrain " << command << ": " << message << "\n";
     };
+    // Interrupted: the work stopped at a progress callback and the temporaries went with the
+    // unwinding; the status says which signal.
+    auto interrupted = [&] {
+        report("interrupted");
+        return 128 + pending_signal();
+    };
     try {
-        return body();
+        const int status = body();
+        return pending_signal() != 0 ? interrupted() : status;
     } catch (const UsageError& e) {
+        if (pending_signal() != 0) return interrupted();
         report(e.what());
         return kUsageError;
     } catch (const terrain::Error& e) {
+        if (pending_signal() != 0) return interrupted();
         report(e.what());
         return kUserError;
     } catch (const std::bad_alloc&) {
         report("out of memory; try a smaller input");
         return kUserError;
     } catch (const std::exception& e) {
+        if (pending_signal() != 0) return interrupted();
         report(e.what());
         return kUserError;
     }
@@ -88,7 +103,10 @@ void add_dem_options(po::options_description& options, DemOptionValues& values) 
         "nan-nodata", po::bool_switch(&values.nan_nodata),
         "treat NaN/Inf pixels as NoData holes instead of refusing the raster")(
         "pixel-size", po::value(&values.pixel_size),
-        "metres per pixel, for a raster with no geotransform (default 1)");
+        "metres per pixel, for a raster with no geotransform (default 1; at most 1e9)")(
+        "max-memory", po::value(&values.max_memory),
+        "refuse work whose estimated peak memory exceeds this (e.g. 2G, 512M); the memory "
+        "available is always checked");
 }
 
 io::ReadDemOptions to_read_options(const DemOptionValues& values) {
@@ -99,11 +117,12 @@ io::ReadDemOptions to_read_options(const DemOptionValues& values) {
     else if (values.elevation == "height")
         options.elevation = ElevationKind::height;
     else if (values.elevation != "auto")
-        throw UsageError("--elevation must be radius, height or auto, not '" + values.elevation +
-                         "'");
+        throw Error("options",
+                    "--elevation must be radius, height or auto, not '" + values.elevation + "'");
     options.nan_as_nodata = values.nan_nodata;
-    if (values.pixel_size < 0 || !std::isfinite(values.pixel_size))
-        throw UsageError("--pixel-size must be a positive number of metres");
+    if (values.pixel_size < 0 || !std::isfinite(values.pixel_size) || values.pixel_size > 1e9)
+        throw Error("options", "--pixel-size must be a number of metres in (0, 1e9]");
+    if (!values.max_memory.empty()) set_memory_limit(parse_memory_size(values.max_memory));
     if (values.pixel_size > 0) options.pixel_size = values.pixel_size;
     return options;
 }

@@ -85,6 +85,7 @@ int run_field(int argc, char** argv) {
             sdf = field::shape_diameter_function(input.mesh, field_options.sdf, field_progress);
             values = std::move(sdf->values);
         } else {
+            check_field_limits(field_options, input.mesh);
             values = field::vertex_field(input.mesh, input.dem ? &*input.dem : nullptr,
                                          field_options, field_progress);
         }

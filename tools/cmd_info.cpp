@@ -112,8 +112,21 @@ int run_info(int argc, char** argv) {
         po::variables_map vm;
         if (!parse(argc, argv, "terrain info DEM [--json] [options]", options, positional, vm))
             return 0;
-        const Dem dem = io::read_dem(path, to_read_options(dem_values), {});
-        const auto description = io::describe_dem(dem);
+        // The values are summarised row by row, not kept: describing a large or sparse
+        // raster costs the memory of one row.
+        io::DemValueSummary summary;
+        const Dem dem = io::read_dem_summary(path, summary, to_read_options(dem_values),
+                                             terminal_progress(true));
+        auto description = io::describe_dem(dem);
+        const double reference =
+            dem.elevation == ElevationKind::radius ? dem.body.semi_major_axis : 0;
+        description.min_value = summary.min_value;
+        description.max_value = summary.max_value;
+        description.min_height = summary.min_value - reference;
+        description.max_height = summary.max_value - reference;
+        description.valid_pixels = summary.valid_pixels;
+        description.nodata_fraction =
+            1.0 - double(summary.valid_pixels) / (double(dem.width) * double(dem.height));
         if (json)
             write_json(std::cout, description, dem);
         else

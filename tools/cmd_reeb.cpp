@@ -6,6 +6,7 @@
 #include "cli.hpp"
 #include "field_options.hpp"
 #include "input.hpp"
+#include "terrain/core/error.hpp"
 #include "terrain/core/json_writer.hpp"
 #include "terrain/io/mesh_files.hpp"
 #include "terrain/io/output_file.hpp"
@@ -14,6 +15,13 @@
 #include "terrain/reeb/simplify.hpp"
 
 namespace terrain::cli {
+namespace {
+bool same_file(const std::string& a, const std::string& b) {
+    std::error_code ec;
+    return std::filesystem::weakly_canonical(std::filesystem::absolute(a), ec) ==
+           std::filesystem::weakly_canonical(std::filesystem::absolute(b), ec);
+}
+}  // namespace
 
 int run_reeb(int argc, char** argv) {
     return guarded("reeb", [&] {
@@ -48,18 +56,22 @@ int run_reeb(int argc, char** argv) {
         else if (algorithm == "contour-tree")
             reeb_options.algorithm = reeb::ReebAlgorithm::contour_tree;
         else if (algorithm != "auto")
-            throw UsageError("--algorithm must be auto, sweep or contour-tree");
+            throw Error("options",
+                        "--algorithm must be auto, sweep or contour-tree, not '" + algorithm + "'");
         const std::string ext = std::filesystem::path(common.output).extension().string();
         if (ext != ".json" && ext != ".dot")
             throw UsageError("the output must end in .json or .dot");
         io::check_output_path(common.output, common.overwrite);
         if (!field_output.empty()) io::check_output_path(field_output, common.overwrite);
+        if (!field_output.empty() && same_file(field_output, common.output))
+            throw UsageError("--write-field and -o name the same file '" + common.output + "'");
 
         const auto progress = terminal_progress(common.quiet);
         const Input input =
             load_input(common.input, input_values, scaled_progress(progress, 0, 0.3));
         const Dem* dem = input.dem ? &*input.dem : nullptr;
         reeb::check_simplify_options(simplify_options);  // before the long steps
+        check_field_limits(field_options, input.mesh);
         const auto values = field::vertex_field(input.mesh, dem, field_options,
                                                 scaled_progress(progress, 0.3, 0.7));
         auto graph = reeb::build_reeb_graph(input.mesh, values, reeb_options,

@@ -11,6 +11,7 @@ struct DemOptionValues {
     std::string elevation = "auto";
     bool nan_nodata = false;
     double pixel_size = 0;
+    std::string max_memory;  // --max-memory, empty: none
 };
 
 // Adds --band, --elevation, --nan-nodata, --pixel-size bound to `values`.

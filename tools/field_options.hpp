@@ -19,7 +19,15 @@ struct FieldOptionValues {
 // --allow-open bound to `values`.
 void add_field_options(po::options_description& options, FieldOptionValues& values);
 
+// Documented ranges of --rings, --rays and --radius (in mean edge lengths of the mesh).
+constexpr int kMaxRings = 10;
+constexpr int kMaxRays = 1000;
+constexpr double kMaxRadiusEdges = 20;
+
 // The library's options from the parsed values; throws UsageError for contradictions.
 field::FieldOptions to_field_options(const FieldOptionValues& values, const po::variables_map& vm);
+
+// Throws terrain::Error when --radius exceeds kMaxRadiusEdges mean edge lengths of `mesh`.
+void check_field_limits(const field::FieldOptions& options, const TriangleMesh& mesh);
 
 }  // namespace terrain::cli

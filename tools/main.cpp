@@ -6,6 +6,7 @@
 #include <string>
 
 #include "cli.hpp"
+#include "signals.hpp"
 #include "terrain/core/version.hpp"
 #include "terrain/io/dependency_versions.hpp"
 
@@ -60,6 +61,7 @@ int main(int argc, char** argv) {
     // being freed; a fixed threshold gives them back at once (about 16 MB less peak memory
     // for a 1000x1000 DEM).
     mallopt(M_MMAP_THRESHOLD, 256 * 1024);
+    terrain::cli::install_signal_handlers();
     if (argc < 2) {
         print_usage(std::cerr);
         return terrain::cli::kUsageError;

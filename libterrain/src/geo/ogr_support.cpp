@@ -25,7 +25,13 @@ GdalErrorCapture::~GdalErrorCapture() {
 void CPL_STDCALL GdalErrorCapture::handler(CPLErr level, CPLErrorNum, const char* message) {
     if (level < CE_Failure || !message) return;
     auto* self = static_cast<GdalErrorCapture*>(CPLGetErrorHandlerUserData());
-    if (self) self->last_error_ = message;
+    if (!self) return;
+    // One line: GDAL's messages may span several (a PDS label naming a missing image).
+    self->last_error_ = message;
+    for (char& c : self->last_error_)
+        if (c == '\n' || c == '\r') c = ' ';
+    while (!self->last_error_.empty() && self->last_error_.back() == ' ')
+        self->last_error_.pop_back();
 }
 
 }  // namespace terrain::geo

@@ -30,19 +30,30 @@ std::vector<std::string> dataset_files(void* gdal_dataset) {
 }
 
 void commit_dataset(AtomicOutput& output, const std::vector<std::string>& files, bool overwrite) {
-    const std::string temp_stem = stem_path(output.temp_path());
+    // Every file named like the temporary in its directory, whether or not the driver listed
+    // it (a Shapefile's .prj is written after the list is taken; a relative path may be listed
+    // as "./.x.tmp1.dbf").
+    const fs::path temp(output.temp_path());
+    const std::string temp_stem = temp.stem().string() + ".";
     const std::string final_stem = stem_path(output.path());
     std::error_code ec;
-    for (const auto& file : files) {
-        if (fs::path(file) == fs::path(output.temp_path())) continue;
-        if (file.compare(0, temp_stem.size(), temp_stem) != 0 || !fs::exists(file, ec)) continue;
-        const std::string target = final_stem + file.substr(temp_stem.size());
+    const fs::path dir = temp.has_parent_path() ? temp.parent_path() : fs::path(".");
+    std::vector<fs::path> sidecars;
+    for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+        const std::string name = it->path().filename().string();
+        if (name.compare(0, temp_stem.size(), temp_stem) == 0 && name != temp.filename().string())
+            sidecars.push_back(it->path());
+    }
+    (void)files;
+    for (const auto& f : sidecars) {
+        const std::string name = f.filename().string();
+        const std::string target = final_stem + name.substr(temp_stem.size() - 1);
         if (fs::exists(target, ec) && !overwrite)
             throw Error("write", "'" + target + "' already exists; pass --overwrite to replace it");
-        fs::rename(file, target, ec);
+        fs::rename(f, target, ec);
         if (ec)
             throw Error("write",
-                        "cannot rename '" + file + "' to '" + target + "': " + ec.message());
+                        "cannot rename '" + f.string() + "' to '" + target + "': " + ec.message());
     }
     output.commit();
 }

@@ -6,6 +6,7 @@
 #include <system_error>
 
 #include "terrain/core/error.hpp"
+#include "terrain/io/temporary_files.hpp"
 
 namespace terrain::io {
 
@@ -34,9 +35,12 @@ AtomicOutput::AtomicOutput(std::string path, bool overwrite) : path_(std::move(p
     temp_ = (p.parent_path() / ("." + p.stem().string() + ".tmp" + std::to_string(::getpid()) +
                                 p.extension().string()))
                 .string();
+    remove_stale_temporaries(path_);
+    register_temporary(temp_);
 }
 
 AtomicOutput::~AtomicOutput() {
+    unregister_temporary(temp_);
     if (committed_) return;
     std::error_code ec;
     fs::remove(temp_, ec);

@@ -12,7 +12,9 @@
 
 #include "gdal_support.hpp"
 #include "terrain/core/error.hpp"
+#include "terrain/geo/body.hpp"
 #include "terrain/geo/georeference.hpp"
+#include "validate_dem.hpp"
 
 namespace terrain::io {
 
@@ -25,7 +27,11 @@ ElevationKind detect_elevation_kind(const Body& body, double min_value, double m
     return ElevationKind::height;
 }
 
-Dem read_dem(const std::string& path, const ReadDemOptions& options, const ProgressFn& progress) {
+namespace {
+
+// `summary`: statistics only, the values are not kept (Dem::values stays empty).
+Dem read_dem(const std::string& path, const ReadDemOptions& options, const ProgressFn& progress,
+             DemValueSummary* summary) {
     ensure_gdal_registered();
     const GdalErrorCapture errors;
     if (!std::filesystem::exists(path) && path.rfind("/vsi", 0) != 0)
@@ -66,6 +72,10 @@ Dem read_dem(const std::string& path, const ReadDemOptions& options, const Progr
         if (srs->exportToWkt(&wkt, wkt_options) == OGRERR_NONE && wkt) dem.crs_wkt = wkt;
         CPLFree(wkt);
     }
+    // The grid is checked before anything reads it (a hostile geotransform or pixel size
+    // would make the georeference loop or the arrays absurd).
+    dem.body = geo::body_from_crs(dem.crs_wkt);
+    validate_dem_grid(path, dem, dataset->GetSpatialRef());
     geo::georeference(dem);  // the body, and where the pixels lie on it
 
     GDALRasterBand* band = dataset->GetRasterBand(options.band);
@@ -74,18 +84,43 @@ Dem read_dem(const std::string& path, const ReadDemOptions& options, const Progr
     const double offset = band->GetOffset(&has_offset);
     const double a = has_scale ? scale : 1.0;
     const double b = has_offset ? offset : 0.0;
+    validate_scale(path, a, b);
     GDALRasterBand* mask = band->GetMaskBand();
     const bool all_valid = band->GetMaskFlags() == GMF_ALL_VALID;
 
     const std::size_t width = static_cast<std::size_t>(dem.width);
-    dem.values.assign(width * static_cast<std::size_t>(dem.height),
-                      std::numeric_limits<double>::quiet_NaN());
+    check_dem_size(path, dem, *band, summary ? 0.0 : options.planned_bytes_per_pixel);
+    if (!summary)
+        dem.values.assign(width * static_cast<std::size_t>(dem.height),
+                          std::numeric_limits<double>::quiet_NaN());
+    std::vector<double> row_values(summary ? width : 0);
     std::vector<unsigned char> mask_row(all_valid ? 0 : width);
     std::size_t valid = 0, not_finite = 0;
     double lo = std::numeric_limits<double>::infinity(), hi = -lo;
     int first_bad_col = -1, first_bad_row = -1;
+    // A summary reads one row of blocks at a time, drops GDAL's cached blocks after each, and
+    // skips the blocks a sparse file does not hold (all NoData, or all zero without NoData).
+    int block_width = 0, block_height = 0;
+    band->GetBlockSize(&block_width, &block_height);
+    block_height = std::max(1, block_height);
+    const bool known_fill = all_valid || band->GetMaskFlags() == GMF_NODATA;
     for (int row = 0; row < dem.height; ++row) {
-        double* out = dem.values.data() + static_cast<std::size_t>(row) * width;
+        if (summary && row % block_height == 0) {
+            if (row > 0) dataset->FlushCache(false);
+            const int rows = std::min(block_height, dem.height - row);
+            if (known_fill && band->GetDataCoverageStatus(0, row, dem.width, rows, 0, nullptr) ==
+                                  GDAL_DATA_COVERAGE_STATUS_EMPTY) {
+                if (all_valid) {
+                    lo = std::min(lo, b);
+                    hi = std::max(hi, b);
+                    valid += width * static_cast<std::size_t>(rows);
+                }
+                row += rows - 1;
+                continue;
+            }
+        }
+        double* out =
+            summary ? row_values.data() : dem.values.data() + static_cast<std::size_t>(row) * width;
         if (band->RasterIO(GF_Read, 0, row, dem.width, 1, out, dem.width, 1, GDT_Float64, 0, 0) !=
             CE_None)
             throw Error("read", "cannot read row " + std::to_string(row) + " of '" + path + "'" +
@@ -128,6 +163,8 @@ Dem read_dem(const std::string& path, const ReadDemOptions& options, const Progr
     if (valid < 3)
         throw Error("read", "'" + path + "' has only " + std::to_string(valid) +
                                 " valid pixel(s); a surface needs at least three");
+    validate_value_range(path, lo, hi);
+    if (summary) *summary = {lo, hi, valid};
 
     if (options.elevation) {
         dem.elevation = *options.elevation;
@@ -141,6 +178,17 @@ Dem read_dem(const std::string& path, const ReadDemOptions& options, const Progr
     }
     report_progress(progress, 1.0, "read");
     return dem;
+}
+
+}  // namespace
+
+Dem read_dem(const std::string& path, const ReadDemOptions& options, const ProgressFn& progress) {
+    return read_dem(path, options, progress, nullptr);
+}
+
+Dem read_dem_summary(const std::string& path, DemValueSummary& summary,
+                     const ReadDemOptions& options, const ProgressFn& progress) {
+    return read_dem(path, options, progress, &summary);
 }
 
 }  // namespace terrain::io

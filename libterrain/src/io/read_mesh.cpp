@@ -12,7 +12,9 @@
 #include <filesystem>
 #include <limits>
 
+#include "mesh_header_check.hpp"
 #include "terrain/core/error.hpp"
+#include "terrain/core/memory_budget.hpp"
 #include "terrain/io/mesh_files.hpp"
 
 namespace terrain::io {
@@ -108,6 +110,12 @@ TriangleMesh read_mesh(const std::string& path, const ReadMeshOptions& options,
     if (!std::filesystem::exists(path))
         throw Error("mesh", "'" + path + "' does not exist; check the path");
     if (!is_mesh_file(path)) throw Error("mesh", "'" + path + "' is not a .off, .ply or .obj mesh");
+    // Headers and counts checked before CGAL's parser sees the file; the peak of reading,
+    // repairing and checking estimated from them.
+    const auto counts = check_mesh_file(path, lower_extension(path));
+    check_memory("reading the mesh '" + path + "'", 200.0 * double(counts.vertices) +
+                                                        300.0 * double(counts.faces) +
+                                                        16.0 * double(counts.indices));
     std::vector<Point> points;
     std::vector<Polygon> polygons;
     bool ok = false;
@@ -124,6 +132,10 @@ TriangleMesh read_mesh(const std::string& path, const ReadMeshOptions& options,
             !std::isfinite(points[v].z()))
             throw Error("mesh", "vertex " + std::to_string(v) + " of '" + path +
                                     "' has a NaN or infinite coordinate");
+        else if (std::max({std::abs(points[v].x()), std::abs(points[v].y()),
+                           std::abs(points[v].z())}) > kMaxMeshCoordinate)
+            throw Error("mesh", "vertex " + std::to_string(v) + " of '" + path +
+                                    "' has a coordinate beyond 1e9; not a surface in metres");
     report_progress(progress, 0.3, "read mesh");
 
     if (options.repair) {

@@ -5,6 +5,7 @@
 #include <system_error>
 
 #include "terrain/core/error.hpp"
+#include "terrain/io/temporary_files.hpp"
 #include "terrain/pipeline/segment.hpp"
 
 namespace terrain::pipeline {
@@ -30,6 +31,7 @@ OutputDirectory::OutputDirectory(std::string path, bool overwrite) : path_(std::
                     "cannot create '" + path_ + "': '" + parent.string() + "' is not writable");
     temp_ = (parent / ("." + p.filename().string() + ".tmp" + std::to_string(::getpid()))).string();
     fs::remove_all(temp_, ec);
+    io::remove_stale_temporaries(path_, true);  // of runs that died (interrupted, killed)
     if (!fs::create_directory(temp_, ec))
         throw Error("write", "cannot create a directory beside '" + path_ + "': " + ec.message());
 }

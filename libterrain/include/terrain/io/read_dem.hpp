@@ -14,6 +14,9 @@ struct ReadDemOptions {
     std::optional<ElevationKind> elevation;  // unset: detect (docs/bodies-and-elevation.md)
     bool nan_as_nodata = false;              // NaN/Inf pixels become holes instead of an error
     std::optional<double> pixel_size;        // metres per pixel for rasters with no geotransform
+    // Peak bytes per pixel of the work planned on the grid (8: the grid alone), checked
+    // against the memory budget (terrain/core/memory_budget.hpp) before anything is read.
+    double planned_bytes_per_pixel = 8;
 };
 
 // Scale and offset of the band are applied; NoData (and the band's mask) become NaN.
@@ -22,6 +25,17 @@ struct ReadDemOptions {
 // finite (unless nan_as_nodata).
 Dem read_dem(const std::string& path, const ReadDemOptions& options = {},
              const ProgressFn& progress = {});
+
+// The valid values of a DEM: their range (scale and offset applied) and count.
+struct DemValueSummary {
+    double min_value = 0, max_value = 0;
+    std::size_t valid_pixels = 0;
+};
+// read_dem without keeping the values: the grid, CRS and body as read_dem gives them (with
+// Dem::values empty) and `summary` of the values, read one row at a time (for describing a
+// large or sparse raster in the memory of one row).
+Dem read_dem_summary(const std::string& path, DemValueSummary& summary,
+                     const ReadDemOptions& options = {}, const ProgressFn& progress = {});
 
 // The radius/height decision of docs/bodies-and-elevation.md for valid values in
 // [min_value, max_value] on `body`.

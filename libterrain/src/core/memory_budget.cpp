@@ -1,0 +1,86 @@
+#include "terrain/core/memory_budget.hpp"
+
+#include <atomic>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+
+#include "terrain/core/error.hpp"
+
+namespace terrain {
+namespace {
+std::atomic<std::uint64_t> limit_bytes{0};
+}  // namespace
+
+std::optional<std::uint64_t> available_memory() {
+    std::ifstream in("/proc/meminfo");
+    std::string key, unit;
+    std::uint64_t value = 0;
+    while (in >> key >> value) {
+        std::getline(in, unit);
+        if (key == "MemAvailable:") return value * 1024;
+    }
+    return std::nullopt;
+}
+
+void set_memory_limit(std::uint64_t bytes) {
+    limit_bytes = bytes;
+}
+
+std::uint64_t memory_limit() {
+    return limit_bytes;
+}
+
+std::uint64_t parse_memory_size(const std::string& text) {
+    std::istringstream in(text);
+    double value = 0;
+    std::string unit;
+    if (!(in >> value) || !std::isfinite(value) || value <= 0)
+        throw Error("memory", "'" + text + "' is not a memory size; give e.g. 512M or 4G");
+    in >> unit;
+    for (auto& c : unit) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+    if (unit.size() == 2 && unit[1] == 'B') unit.pop_back();
+    double factor = 1;
+    if (unit == "" || unit == "B")
+        factor = 1;
+    else if (unit == "K")
+        factor = 1024.0;
+    else if (unit == "M")
+        factor = 1024.0 * 1024;
+    else if (unit == "G")
+        factor = 1024.0 * 1024 * 1024;
+    else if (unit == "T")
+        factor = 1024.0 * 1024 * 1024 * 1024;
+    else
+        throw Error("memory", "'" + text + "' is not a memory size; give e.g. 512M or 4G");
+    std::string rest;
+    if (in >> rest || value * factor > 1.8e19)
+        throw Error("memory", "'" + text + "' is not a memory size; give e.g. 512M or 4G");
+    return static_cast<std::uint64_t>(value * factor);
+}
+
+std::string format_bytes(double bytes) {
+    char text[64];
+    const char* units[] = {"B", "KB", "MB", "GB", "TB", "PB", "EB"};
+    int u = 0;
+    while (bytes >= 1024 && u < 6) {
+        bytes /= 1024;
+        ++u;
+    }
+    std::snprintf(text, sizeof text, u == 0 ? "%.0f %s" : "%.3g %s", bytes, units[u]);
+    return text;
+}
+
+void check_memory(const std::string& what, double bytes) {
+    const std::uint64_t limit = limit_bytes;
+    if (limit > 0 && bytes > double(limit))
+        throw Error("memory", what + " needs about " + format_bytes(bytes) + ", over the " +
+                                  format_bytes(double(limit)) + " of --max-memory");
+    if (const auto available = available_memory(); available && bytes > double(*available))
+        throw Error("memory", what + " needs about " + format_bytes(bytes) + " but only " +
+                                  format_bytes(double(*available)) +
+                                  " are available; use a smaller input or free memory");
+}
+
+}  // namespace terrain

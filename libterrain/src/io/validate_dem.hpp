@@ -1,0 +1,40 @@
+#pragma once
+// Checks that a raster can describe a surface, before and after its values are read: a
+// finite, non-degenerate geotransform with plausible pixel sizes (latitudes inside +-90 on
+// a geographic grid), a declared size the file and the memory can back, and finite values
+// of plausible magnitude after scale and offset. Each problem is one terrain::Error line.
+
+#include <string>
+
+#include "terrain/core/dem.hpp"
+
+class GDALRasterBand;
+class OGRSpatialReference;
+
+namespace terrain::io {
+
+// Largest magnitude of an elevation value, in metres (a million kilometres: every body of
+// the solar system, the Sun's radius of 696 000 km included, fits).
+constexpr double kMaxElevationMagnitude = 1e9;
+// Pixel sizes in metres (for grids without a body: any CRS unit converted to metres).
+constexpr double kMinPixelMetres = 1e-6;
+constexpr double kMaxPixelMetres = 1e9;
+// Pixel sizes in degrees for geographic grids.
+constexpr double kMinPixelDegrees = 1e-9;
+
+// The grid of `dem` (width, height, transform, body) under `srs` (null: no CRS).
+void validate_dem_grid(const std::string& path, const Dem& dem, const OGRSpatialReference* srs);
+
+// The band's declared size against the memory budget (`bytes_per_pixel` of peak memory; 0:
+// not checked), and its last row read back (a raster whose data end early, such as a PDS
+// label declaring more rows than its image holds, is refused before the grid is allocated).
+void check_dem_size(const std::string& path, const Dem& dem, GDALRasterBand& band,
+                    double bytes_per_pixel);
+
+// Scale and offset of the band (before reading).
+void validate_scale(const std::string& path, double scale, double offset);
+
+// The range of the valid values after scale and offset.
+void validate_value_range(const std::string& path, double min_value, double max_value);
+
+}  // namespace terrain::io

@@ -1,0 +1,162 @@
+// Rasters that hung, exhausted memory or gave silent garbage (exit 0 with inf or NaN areas):
+// each is now refused with one line naming the problem, or read in bounded memory.
+#include <gdal_priv.h>
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <memory>
+
+#include "hostile_support.hpp"
+
+using Catch::Matchers::Contains;
+using namespace terrain::test;
+
+namespace {
+
+std::vector<double> ramp(int n) {
+    std::vector<double> v(static_cast<std::size_t>(n));
+    for (int i = 0; i < n; ++i) v[static_cast<std::size_t>(i)] = i % 7;
+    return v;
+}
+
+// info, mesh and segment on `input` each exit 1 with one line containing `expected`.
+void check_refused(const std::string& input, const std::filesystem::path& dir,
+                   const std::string& expected) {
+    const std::vector<std::vector<std::string>> commands = {
+        {"info", input},
+        {"mesh", input, "-o", (dir / "m.ply").string(), "-q"},
+        {"segment", input, "-o", (dir / "seg").string(), "-q"}};
+    for (const auto& args : commands) {
+        INFO(args[0] << " " << input);
+        const auto r = run_limited(args, 30, 2048);
+        CHECK(r.status == 1);
+        CHECK(line_count(r.err) == 1);
+        CHECK_THAT(r.err, Contains(expected));
+    }
+    CHECK_FALSE(std::filesystem::exists(dir / "m.ply"));
+    CHECK_FALSE(std::filesystem::exists(dir / "seg"));
+}
+
+}  // namespace
+
+TEST_CASE("absurd pixel sizes are refused before anything loops", "[robustness][dem]") {
+    const auto dir = scratch_dir("hostile_pixel_size");
+    // 1e19 degrees hung info, mesh and segment; 1e10 took 7.7 s.
+    for (double size : {1e19, 1e10}) {
+        RasterSpec spec;
+        spec.width = spec.height = 8;
+        spec.values = ramp(64);
+        spec.crs = "EPSG:4326";
+        spec.geotransform = {0, size, 0, 0, 0, -size};
+        check_refused(write_raster(dir / "huge_degrees.tif", spec), dir, "degrees");
+    }
+    // A PDS label with MAP_SCALE = 1e30 <KM/PIXEL> hung the same way.
+    const auto huge = edited_vesta_label(dir, "scale1e30.lbl", "0.06954046238414907", "1e30");
+    check_refused(huge, dir, "half the circumference of Vesta");
+    // MAP_SCALE = 0: pixels of no area gave an area of 0 and one flat region.
+    const auto zero = edited_vesta_label(dir, "scale0.lbl", "0.06954046238414907", "0");
+    check_refused(zero, dir, "degenerate geotransform");
+}
+
+TEST_CASE("geographic grids beyond the poles are refused", "[robustness][dem]") {
+    const auto dir = scratch_dir("hostile_latitudes");
+    RasterSpec spec;
+    spec.width = spec.height = 8;
+    spec.values = ramp(64);
+    spec.crs = "EPSG:4326";
+    spec.geotransform = {0, 10, 0, 95, 0, -80};  // latitudes 95 to -545: "the seam closes"
+    check_refused(write_raster(dir / "poles.tif", spec), dir, "inside +-90");
+}
+
+TEST_CASE("values are checked after scale and offset", "[robustness][dem]") {
+    const auto dir = scratch_dir("hostile_values");
+    RasterSpec scaled;
+    scaled.width = scaled.height = 8;
+    scaled.values = ramp(64);
+    for (auto& v : scaled.values) v += 1;
+    scaled.scale = 1e308;  // values inf, area -nan, one region
+    check_refused(write_raster(dir / "scale.tif", scaled), dir, "after scale and offset");
+
+    RasterSpec huge;
+    huge.width = huge.height = 8;
+    huge.type = "Float64";
+    huge.values = ramp(64);
+    huge.values[27] = 1e300;
+    huge.values[28] = -1e300;
+    check_refused(write_raster(dir / "e300.tif", huge), dir, "not a surface");
+
+    RasterSpec one;
+    one.width = one.height = 8;
+    one.values = ramp(64);
+    one.values[18] = 1e30;
+    check_refused(write_raster(dir / "e30.tif", one), dir, "not a surface");
+}
+
+TEST_CASE("a sparse 20000x20000 GeoTIFF is described in bounded memory", "[robustness][dem]") {
+    const auto dir = scratch_dir("hostile_sparse");
+    const std::string path = (dir / "sparse.tif").string();
+    {
+        GDALAllRegister();
+        const char* options[] = {"SPARSE_OK=TRUE", "TILED=YES", nullptr};
+        std::unique_ptr<GDALDataset> ds(GetGDALDriverManager()->GetDriverByName("GTiff")->Create(
+            path.c_str(), 20000, 20000, 1, GDT_Float32, const_cast<char**>(options)));
+        REQUIRE(ds);
+        double gt[6] = {0, 1, 0, 0, 0, -1};
+        ds->SetGeoTransform(gt);
+    }
+    REQUIRE(std::filesystem::file_size(path) < 100000);
+    // info cost 3.47 GB; 700 MB of address space here.
+    const auto info = run_limited({"info", path}, 60, 700);
+    CHECK(info.status == 0);
+    CHECK_THAT(info.out, Contains("400000000 valid"));
+    // The mesh of 4e8 pixels would need far more than the machine has: refused up front.
+    const auto mesh = run_limited({"mesh", path, "-o", (dir / "m.ply").string(), "-q"}, 30, 700);
+    CHECK(mesh.status == 1);
+    CHECK(line_count(mesh.err) == 1);
+    CHECK_THAT(mesh.err, Contains("needs about"));
+}
+
+TEST_CASE("a PDS label declaring more than its image holds is one line, fast",
+          "[robustness][dem]") {
+    const auto dir = scratch_dir("hostile_pds_size");
+    const auto label =
+        edited_vesta_label(dir, "claim.lbl", "LINES                      = 512", "LINES = 20000");
+    std::string text = file_bytes(label);
+    const std::string samples = "LINE_SAMPLES               = 512";
+    const auto at = text.find(samples);
+    REQUIRE(at != std::string::npos);
+    text.replace(at, samples.size(), "LINE_SAMPLES = 20000");
+    write_bytes(label, text);
+    // It cost 3.18 GB before "cannot read row 6".
+    const auto r = run_limited({"info", label}, 30, 700);
+    CHECK(r.status == 1);
+    CHECK(line_count(r.err) == 1);
+    CHECK_THAT(r.err, Contains("declares 20000x20000 pixels"));
+}
+
+TEST_CASE("a PDS label pointing to a missing image is one line", "[robustness][dem]") {
+    const auto dir = scratch_dir("hostile_pds_missing");
+    const auto label =
+        edited_vesta_label(dir, "missing.lbl", "\"vesta_hamo_tile.img\"", "\"missing.img\"");
+    const auto r = run_limited({"info", label}, 30);
+    CHECK(r.status == 1);
+    CHECK(line_count(r.err) == 1);
+    CHECK_THAT(r.err, Contains("missing.img"));
+}
+
+TEST_CASE("a limit given with --max-memory refuses work over it with one line",
+          "[robustness][dem]") {
+    const auto dir = scratch_dir("max_memory");
+    const auto input = sample("vesta_hamo_tile.lbl");
+    auto r = run_limited({"mesh", input, "-o", (dir / "m.ply").string(), "--max-memory", "1M"});
+    CHECK(r.status == 1);
+    CHECK(line_count(r.err) == 1);
+    CHECK_THAT(r.err, Contains("--max-memory"));
+    CHECK_FALSE(std::filesystem::exists(dir / "m.ply"));
+    r = run_limited({"mesh", input, "-o", (dir / "m.ply").string(), "--max-memory", "lots"});
+    CHECK(r.status == 1);
+    r = run_limited({"mesh", input, "-o", (dir / "m.ply").string(), "--max-memory", "1G", "-q"});
+    CHECK(r.status == 0);
+    CHECK(std::filesystem::exists(dir / "m.ply"));
+}

@@ -1,0 +1,156 @@
+// Mesh files that crashed or exhausted memory inside the third-party parser: each is now one
+// error line and exit 1, within seconds and a bounded amount of memory.
+#include <catch2/catch.hpp>
+
+#include <cstdint>
+#include <cstring>
+
+#include "hostile_support.hpp"
+#include "terrain/core/error.hpp"
+#include "terrain/io/mesh_files.hpp"
+
+using Catch::Matchers::Contains;
+using namespace terrain::test;
+
+namespace {
+
+std::string le32(std::uint32_t v) {
+    std::string s(4, '\0');
+    for (int i = 0; i < 4; ++i) s[i] = static_cast<char>((v >> (8 * i)) & 0xFF);
+    return s;
+}
+std::string lef(float f) {
+    std::uint32_t v;
+    std::memcpy(&v, &f, 4);
+    return le32(v);
+}
+
+// A binary PLY triangle whose face list declares `entries` indices (the file holds three).
+std::string binary_ply_with_list(std::uint32_t entries) {
+    std::string s =
+        "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\n"
+        "property float y\nproperty float z\nelement face 1\n"
+        "property list uint int vertex_indices\nend_header\n";
+    for (float f : {0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f, 0.f}) s += lef(f);
+    s += le32(entries);
+    for (std::uint32_t i : {0u, 1u, 2u}) s += le32(i);
+    return s;
+}
+
+// Every command that reads a mesh, with an output in `dir`.
+std::vector<std::vector<std::string>> mesh_commands(const std::string& input,
+                                                    const std::filesystem::path& dir) {
+    return {{"mesh", input, "-o", (dir / "m.ply").string(), "-q"},
+            {"field", input, "-o", (dir / "f.ply").string(), "-q"},
+            {"reeb", input, "-o", (dir / "g.json").string(), "-q"},
+            {"segment", input, "-o", (dir / "seg").string(), "-q"},
+            {"sweep", input, "-o", (dir / "sweep").string(), "--area-ratios", "1,2", "-q"}};
+}
+
+void check_refused_everywhere(const std::string& input, const std::filesystem::path& dir,
+                              const std::string& expected, int memory_mb = 3072) {
+    for (const auto& args : mesh_commands(input, dir)) {
+        INFO(args[0]);
+        const auto r = run_limited(args, 60, memory_mb);
+        CHECK(r.status == 1);
+        CHECK(line_count(r.err) == 1);
+        CHECK_THAT(r.err, Contains(expected));
+    }
+    CHECK(std::filesystem::is_empty(std::filesystem::path(input).parent_path() / "out"));
+}
+
+}  // namespace
+
+TEST_CASE("a PLY property before any element is one error line, not a crash",
+          "[robustness][mesh]") {
+    const auto dir = scratch_dir("hostile_ply_property");
+    std::filesystem::create_directories(dir / "out");
+    // The 49 bytes that crashed CGAL's PLY reader in every command.
+    const std::string bytes = "ply\nformat ascii 1.0\nproperty float x\nend_header\n";
+    REQUIRE(bytes.size() == 49);
+    const auto input = write_bytes(dir / "property_first.ply", bytes);
+    check_refused_everywhere(input, dir / "out", "property before any element");
+    CHECK_THROWS_AS(terrain::io::read_mesh(input), terrain::Error);
+}
+
+TEST_CASE("a binary PLY face list longer than the file is refused without allocating it",
+          "[robustness][mesh]") {
+    const auto dir = scratch_dir("hostile_ply_list");
+    std::filesystem::create_directories(dir / "out");
+    // 0xFFFFFFF0 entries grew the commands to 14-16 GB; 2^28 cost 1.08 GB. 512 MB here.
+    for (std::uint32_t entries : {0xFFFFFFF0u, 1u << 28}) {
+        const auto input = write_bytes(dir / ("list" + std::to_string(entries) + ".ply"),
+                                       binary_ply_with_list(entries));
+        check_refused_everywhere(input, dir / "out", "the rest of the file cannot hold them", 512);
+    }
+}
+
+TEST_CASE("OFF headers and faces declaring more than the file holds are refused",
+          "[robustness][mesh]") {
+    const auto dir = scratch_dir("hostile_off");
+    const std::pair<const char*, const char*> cases[] = {
+        {"OFF\n3 2000000000 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n", "cannot hold them"},
+        {"OFF\n2000000000 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n", "cannot hold them"},
+        {"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n4000000000 0 1 2\n", "cannot hold them"},
+        {"OFF\n3 1 0\n0 0 0\n1 0 0\n# a comment, not a vertex or a face\n", "OFF data end"},
+        {"OFF\n-3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n", "not a non-negative integer"},
+        // Found by fuzz_mesh_off: CGAL turned the index "0-1" (-1) into a size_t from a double.
+        {"OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 8 1\n3 0 2 1\n3 0-1 3\n3 0 3 2\n3 1 2 3\x1a",
+         "OFF face 1 lists 2 of its 3 vertices"},
+        {"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n", "refers to vertex '3'"},
+    };
+    int i = 0;
+    for (const auto& [text, expected] : cases) {
+        const auto input = write_bytes(dir / ("case" + std::to_string(i++) + ".off"), text);
+        const auto r = run_limited({"mesh", input, "-o", (dir / "m.ply").string(), "-q"}, 30, 512);
+        INFO(text);
+        CHECK(r.status == 1);
+        CHECK(line_count(r.err) == 1);
+        CHECK_THAT(r.err, Contains(expected));
+    }
+    CHECK_FALSE(std::filesystem::exists(dir / "m.ply"));
+}
+
+TEST_CASE("PLY headers that lie or break the grammar are refused by the reader",
+          "[robustness][mesh]") {
+    const auto dir = scratch_dir("hostile_ply_headers");
+    const std::pair<std::string, const char*> cases[] = {
+        {"ply\nformat ascii 1.0\nelement vertex 99999999999\nproperty float x\nend_header\n",
+         "the file holds"},
+        {"ply\nelement vertex 3\nproperty float x\nend_header\n", "before the format"},
+        {"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n", "no end_header"},
+        {"ply\nformat ascii 1.0\nelement vertex 1\nproperty quad x\nend_header\n1\n",
+         "unknown PLY property type"},
+        {"ply\nformat ascii 1.0\nelement face 1\nproperty list uchar int v\nend_header\n200 1 2\n",
+         "cannot hold them"},
+        {"ply\nformat ascii 1.0\nelement face 1\nproperty list uchar int v\nend_header\n-3 1 2 3\n",
+         "not a non-negative integer"},
+        {"ply\nformat binary_little_endian 1.0\nelement vertex 10\nproperty double x\n"
+         "end_header\n" +
+             std::string(40, 'x'),
+         "data end inside vertex"},
+    };
+    int i = 0;
+    for (const auto& [text, expected] : cases) {
+        const auto input = write_bytes(dir / ("case" + std::to_string(i++) + ".ply"), text);
+        INFO(text);
+        try {
+            (void)terrain::io::read_mesh(input);
+            FAIL("read_mesh accepted it");
+        } catch (const terrain::Error& e) {
+            CHECK_THAT(std::string(e.what()), Contains(expected));
+        }
+    }
+}
+
+TEST_CASE("mesh coordinates of 1e308 are refused instead of giving NaN areas",
+          "[robustness][mesh]") {
+    const auto dir = scratch_dir("hostile_mesh_coordinates");
+    const auto input =
+        write_bytes(dir / "far.off", "OFF\n3 1 0\n0 0 0\n1e308 0 0\n0 1 0\n3 0 1 2\n");
+    const auto r = run_limited({"segment", input, "-o", (dir / "seg").string(), "-q"}, 30);
+    CHECK(r.status == 1);
+    CHECK(line_count(r.err) == 1);
+    CHECK_THAT(r.err, Contains("beyond 1e9"));
+    CHECK_FALSE(std::filesystem::exists(dir / "seg"));
+}
