@@ -234,6 +234,8 @@ SegmentResult segment(Input input, const SegmentOptions& options, const Progress
     result.regions =
         segment::region_graph(result.input.mesh, result.field, result.segmentation.labels,
                               result.segmentation.region_count, result.dem());
+    // On a DEM, with the regions of valid pixels in no triangle (segment::label_pixels).
+    result.segmentation.region_count = static_cast<std::uint32_t>(result.regions.regions.size());
     result.add_time("grow", scale.grow_seconds + since(t1));
     return result;
 }

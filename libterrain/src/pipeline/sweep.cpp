@@ -165,6 +165,9 @@ SweepResult run_sweep(Input input, const std::vector<ScaleSpec>& specs,
         scales[i].regions =
             segment::region_graph(base.input.mesh, base.field, scales[i].segmentation.labels,
                                   scales[i].segmentation.region_count, base.dem());
+        // On a DEM, with the regions of valid pixels in no triangle (segment::label_pixels).
+        scales[i].segmentation.region_count =
+            static_cast<std::uint32_t>(scales[i].regions.regions.size());
         scales[i].seconds = since(s0);
     });
     // lineage: scale i -> scale i+1.

@@ -108,6 +108,8 @@ struct SegmentResult {
     std::vector<float> field;         // per mesh vertex, as computed
     std::size_t critical_before = 0;  // critical nodes of the unsimplified Reeb graph
     reeb::ReebSummary after;          // the simplified graph of the segmentation
+    // Its region_count counts every region of the table: on a DEM, after the vertices'
+    // regions, those of valid pixels in no triangle (segment::label_pixels).
     segment::Segmentation segmentation;
     segment::RegionGraph regions;
     std::vector<StageTime> timings;         // read, mesh, field, reeb, simplify, grow, write
