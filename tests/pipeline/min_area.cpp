@@ -46,7 +46,8 @@ TEST_CASE("parse_area reads m^2, km2, ha and refuses what is not an area", "[pip
     CHECK_THROWS_AS(pipeline::parse_min_areas(""), Error);
 }
 
-TEST_CASE("--min-area X is --area-ratio 100 X / A on a mesh of area A", "[pipeline][min-area]") {
+TEST_CASE("min_area X gives the labels of area ratio 100 X / A on a mesh of area A",
+          "[pipeline][min-area]") {
     auto input = pipeline::load_input(test::sample("moon_ldem4_copernicus.tif"));
     const double A = reeb::total_area(input.mesh);
     double sum = 0;
