@@ -1,4 +1,5 @@
-// terrain reeb INPUT [field options] [--persistence P] [--area-ratio A] -o GRAPH.json|.dot
+// terrain reeb INPUT [field options] [--persistence P] [--area-ratio A | --min-area AREA]
+//                    -o GRAPH.json|.dot
 //                    [--write-field OUT]: the (simplified) Reeb graph of the field.
 #include <cstdio>
 #include <filesystem>
@@ -12,6 +13,7 @@
 #include "terrain/io/output_file.hpp"
 #include "terrain/io/write_raster.hpp"
 #include "terrain/io/write_reeb_graph.hpp"
+#include "terrain/pipeline/segment.hpp"
 #include "terrain/reeb/simplify.hpp"
 
 namespace terrain::cli {
@@ -26,7 +28,7 @@ bool same_file(const std::string& a, const std::string& b) {
 int run_reeb(int argc, char** argv) {
     return guarded("reeb", [&] {
         CommonValues common;
-        std::string field_output, algorithm = "auto";
+        std::string field_output, algorithm = "auto", min_area;
         InputOptionValues input_values;
         FieldOptionValues field_values;
         reeb::SimplifyOptions simplify_options;
@@ -37,19 +39,25 @@ int run_reeb(int argc, char** argv) {
                               "cancel arcs whose persistence is below P (field units)")(
             "area-ratio", po::value(&simplify_options.area_ratio)->default_value(0.0),
             "cancel arcs whose area ratio is below A percent of the surface")(
-            "write-field", po::value(&field_output),
-            "also write the simplified field (OUT.tif for a DEM, OUT.ply)")(
+            "min-area", po::value(&min_area),
+            "instead of --area-ratio: cancel arcs whose area on the body is below AREA (m^2, or "
+            "5km2, 2000m2, 3ha)")("write-field", po::value(&field_output),
+                                  "also write the simplified field (OUT.tif for a DEM, OUT.ply)")(
             "algorithm", po::value(&algorithm)->default_value("auto"),
             "auto, sweep or contour-tree (disks and spheres only)");
         add_field_options(options, field_values);
         add_input_options(options, input_values);
         po::variables_map vm;
         if (!parse_command(argc, argv,
-                           "terrain reeb INPUT [--field F] [--persistence P] [--area-ratio A] -o "
+                           "terrain reeb INPUT [--field F] [--persistence P] [--area-ratio A | "
+                           "--min-area AREA] -o "
                            "GRAPH.json [--write-field OUT]",
                            options, vm))
             return 0;
         const auto field_options = to_field_options(field_values, vm);
+        if (vm.count("min-area") && !vm["area-ratio"].defaulted())
+            throw UsageError("give --area-ratio or --min-area, not both");
+        const double min_area_m2 = min_area.empty() ? 0.0 : pipeline::parse_area(min_area);
         reeb::ReebOptions reeb_options;
         if (algorithm == "sweep")
             reeb_options.algorithm = reeb::ReebAlgorithm::sweep;
@@ -70,6 +78,8 @@ int run_reeb(int argc, char** argv) {
         const Input input =
             load_input(common.input, input_values, scaled_progress(progress, 0, 0.3));
         const Dem* dem = input.dem ? &*input.dem : nullptr;
+        if (!min_area.empty())
+            simplify_options.area_ratio = reeb::area_ratio_for_area(input.mesh, min_area_m2);
         reeb::check_simplify_options(simplify_options);  // before the long steps
         check_field_limits(field_options, input.mesh);
         const auto values = field::vertex_field(input.mesh, dem, field_options,
@@ -87,13 +97,18 @@ int run_reeb(int argc, char** argv) {
         if (ext == ".dot") {
             io::write_reeb_dot(graph, common.output, common.overwrite);
         } else {
-            io::write_reeb_json(
-                graph, input.mesh, common.output, common.overwrite,
-                {{"input", JsonWriter::escape(common.input)},
-                 {"field", JsonWriter::escape(field_values.name)},
-                 {"persistence", JsonWriter::number(simplify_options.persistence)},
-                 {"area_ratio_percent", JsonWriter::number(simplify_options.area_ratio)},
-                 {"critical_nodes_before_simplification", std::to_string(before.critical)}});
+            std::vector<std::pair<std::string, std::string>> extra = {
+                {"input", JsonWriter::escape(common.input)},
+                {"field", JsonWriter::escape(field_values.name)},
+                {"persistence", JsonWriter::number(simplify_options.persistence)},
+                {"area_ratio_percent", JsonWriter::number(simplify_options.area_ratio)}};
+            if (!min_area.empty()) {
+                extra.emplace_back("min_area", JsonWriter::escape(min_area));
+                extra.emplace_back("min_area_m2", JsonWriter::number(min_area_m2));
+            }
+            extra.emplace_back("critical_nodes_before_simplification",
+                               std::to_string(before.critical));
+            io::write_reeb_json(graph, input.mesh, common.output, common.overwrite, extra);
         }
         if (!field_output.empty()) {
             if (io::is_mesh_file(field_output)) {

@@ -1,4 +1,5 @@
-// terrain segment INPUT -o OUTDIR [field options] [--persistence 10] [--area-ratio 0.5]
+// terrain segment INPUT -o OUTDIR [field options] [--persistence 10]
+//                  [--area-ratio 0.5 | --min-area AREA]
 //                  [--cost graph|standard] [--saddle-penalty 20] [--timings]
 // The main job: field, Reeb graph, simplification, region growing, and every output file
 // (terrain/pipeline/segment.hpp does the work). The outputs are written into a temporary
@@ -23,11 +24,13 @@ int run_segment(int argc, char** argv) {
         add_input_options(options, input_values);
         po::variables_map vm;
         if (!parse_command(argc, argv,
-                           "terrain segment INPUT -o OUTDIR [--persistence 10] [--area-ratio 0.5] "
+                           "terrain segment INPUT -o OUTDIR [--persistence 10] [--area-ratio 0.5 | "
+                           "--min-area AREA] "
                            "[--cost graph|standard] [--saddle-penalty 20] [--timings]",
                            options, vm))
             return 0;
         to_field_options(field_values, vm);  // refuses contradictions (exit status 2)
+        check_one_area_threshold(vm, "min-area");
         const auto segment_options = to_pipeline_options(field_values, segment_values);
         pipeline::OutputDirectory dir(common.output, common.overwrite);
 

@@ -10,6 +10,9 @@ void add_segment_options(po::options_description& options, SegmentOptionValues& 
                           "cancel arcs whose persistence is below P (field units)")(
         "area-ratio", po::value(&values.simplify.area_ratio)->default_value(0.5),
         "cancel arcs whose area ratio is below A percent of the surface")(
+        "min-area", po::value(&values.min_area),
+        "instead of --area-ratio: cancel arcs whose area on the body is below AREA (m^2, or "
+        "5km2, 2000m2, 3ha)")(
         "cost", po::value(&values.cost)->default_value("auto"),
         "graph (Reeb-graph constrained), standard, or auto: graph for DEMs, standard for meshes")(
         "saddle-penalty", po::value(&values.grow.saddle_penalty)->default_value(20.0),
@@ -17,6 +20,11 @@ void add_segment_options(po::options_description& options, SegmentOptionValues& 
         "format", po::value(&values.format)->default_value("GeoJSON"),
         "OGR driver of the region polygons (GeoJSON, GPKG, ...)")(
         "timings", po::bool_switch(&values.timings), "print the time of each stage");
+}
+
+void check_one_area_threshold(const po::variables_map& vm, const std::string& area_option) {
+    if (vm.count(area_option) && vm.count("area-ratio") && !vm["area-ratio"].defaulted())
+        throw UsageError("give --area-ratio or --" + area_option + ", not both");
 }
 
 pipeline::SegmentOptions to_pipeline_options(const FieldOptionValues& field,
@@ -29,6 +37,7 @@ pipeline::SegmentOptions to_pipeline_options(const FieldOptionValues& field,
     out.postprocess = !field.no_postprocess;
     out.allow_open = field.options.sdf.allow_open;
     out.simplify = values.simplify;
+    out.min_area = values.min_area;
     out.cost = values.cost;
     out.saddle_penalty = values.grow.saddle_penalty;
     out.format = values.format;

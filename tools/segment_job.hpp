@@ -14,14 +14,18 @@ namespace terrain::cli {
 
 struct SegmentOptionValues {
     reeb::SimplifyOptions simplify;
+    std::string min_area;  // --min-area as given, or empty
     segment::GrowOptions grow;
     std::string cost = "auto";
     std::string format = "GeoJSON";
     bool timings = false;
 };
 
-// --persistence, --area-ratio, --cost, --saddle-penalty, --format, --timings.
+// --persistence, --area-ratio, --min-area, --cost, --saddle-penalty, --format, --timings.
 void add_segment_options(po::options_description& options, SegmentOptionValues& values);
+
+// Throws UsageError (exit status 2) when both --area-ratio and `area_option` are given.
+void check_one_area_threshold(const po::variables_map& vm, const std::string& area_option);
 
 // The pipeline's options from the parsed field and segment options; checked before any
 // long work (terrain::Error, exit status 1).

@@ -385,6 +385,17 @@ PYBIND11_MODULE(_terrain, m) {
         .def_property(
             "area_ratio", [](const pipeline::SegmentOptions& o) { return o.simplify.area_ratio; },
             [](pipeline::SegmentOptions& o, double v) { o.simplify.area_ratio = v; })
+        .def_property(
+            "min_area", [](const pipeline::SegmentOptions& o) { return o.min_area; },
+            [](pipeline::SegmentOptions& o, const py::object& v) {
+                // An area as text ("5km2") or a number of m^2; None clears it.
+                if (v.is_none())
+                    o.min_area.clear();
+                else if (py::isinstance<py::str>(v))
+                    o.min_area = v.cast<std::string>();
+                else
+                    o.min_area = py::str(py::float_(v)).cast<std::string>();
+            })
         .def_readwrite("cost", &pipeline::SegmentOptions::cost)
         .def_readwrite("saddle_penalty", &pipeline::SegmentOptions::saddle_penalty)
         .def_readwrite("format", &pipeline::SegmentOptions::format)
@@ -489,6 +500,13 @@ PYBIND11_MODULE(_terrain, m) {
                                    for (const auto& s : r.scales) v.push_back(s.ratio);
                                    return v;
                                })
+        .def_property_readonly("min_areas",
+                               [](const pipeline::SweepResult& r) {
+                                   // m^2 of each scale of a sweep over areas; 0 otherwise
+                                   std::vector<double> v;
+                                   for (const auto& s : r.scales) v.push_back(s.min_area_m2);
+                                   return v;
+                               })
         .def_property_readonly(
             "critical_before",
             [](const pipeline::SweepResult& r) { return r.base.critical_before; })
@@ -559,12 +577,19 @@ PYBIND11_MODULE(_terrain, m) {
         [](const py::object& source, const std::vector<double>& ratios,
            const pipeline::SegmentOptions& options, int band, const std::string& elevation,
            bool nan_nodata, std::optional<double> pixel_size, const std::string& frame, bool repair,
-           const py::object& progress) {
+           const py::object& progress, const std::vector<std::string>& min_areas) {
             pipeline::check_options(options);
+            // A sweep over areas when min_areas is given (ratios are then ignored).
+            std::vector<pipeline::AreaThreshold> areas;
+            for (const auto& a : min_areas)
+                areas.push_back({a, pipeline::parse_area(a, "min_areas")});
             const auto in = input_options(band, elevation, nan_nodata, pixel_size, frame, repair);
             const Source s = to_source(source);
             return run(progress, [&](const ProgressFn& fn) {
                 auto input = load(s, in, scaled_progress(fn, 0, 0.2));
+                if (!areas.empty())
+                    return pipeline::sweep(std::move(input), areas, options,
+                                           scaled_progress(fn, 0.2, 1));
                 return pipeline::sweep(std::move(input), ratios, options,
                                        scaled_progress(fn, 0.2, 1));
             });
@@ -572,7 +597,7 @@ PYBIND11_MODULE(_terrain, m) {
         py::arg("source"), py::arg("ratios"), py::arg("options"), py::arg("band") = 1,
         py::arg("elevation") = "auto", py::arg("nan_nodata") = false,
         py::arg("pixel_size") = py::none(), py::arg("frame") = "auto", py::arg("repair") = false,
-        py::arg("progress") = py::none());
+        py::arg("progress") = py::none(), py::arg("min_areas") = std::vector<std::string>{});
 
     m.def(
         "field",
@@ -608,8 +633,9 @@ PYBIND11_MODULE(_terrain, m) {
                 r.input = load(s, in, scaled_progress(fn, 0, 0.2));
                 pipeline::compute_field(r, options, scaled_progress(fn, 0.2, 0.6));
                 graph = pipeline::compute_reeb(r, scaled_progress(fn, 0.6, 0.8));
-                if (options.simplify.persistence > 0 || options.simplify.area_ratio > 0)
-                    graph = reeb::simplify(r.input.mesh, std::move(graph), options.simplify,
+                const auto thresholds = pipeline::simplify_options(options, r.input.mesh);
+                if (thresholds.persistence > 0 || thresholds.area_ratio > 0)
+                    graph = reeb::simplify(r.input.mesh, std::move(graph), thresholds,
                                            scaled_progress(fn, 0.8, 1))
                                 .graph;
                 return 0;

@@ -40,7 +40,7 @@ __all__ = [
 # The options of `terrain segment` (docs/cli.md), as keyword arguments.
 _SEGMENT_OPTIONS = (
     "field", "rings", "radius", "rays", "cone_angle", "postprocess", "allow_open",
-    "persistence", "area_ratio", "cost", "saddle_penalty", "format",
+    "persistence", "area_ratio", "min_area", "cost", "saddle_penalty", "format",
 )
 # How the input is read and meshed.
 _INPUT_OPTIONS = ("band", "elevation", "nan_nodata", "pixel_size", "frame", "repair")
@@ -96,6 +96,8 @@ def _split_options(options, allowed):
     read = {}
     if "rings" in options and options.get("radius", 0):
         raise Error("field: give rings or radius, not both")
+    if options.get("area_ratio") is not None and options.get("min_area") is not None:
+        raise Error("segment: give area_ratio or min_area, not both")
     for name, value in options.items():
         if name in allowed:
             setattr(native, name, value)
@@ -210,7 +212,9 @@ def segment(dem, geotransform=None, crs=None, *, progress=None, **options):
         affine.Affine) and `crs` (WKT, "EPSG:32611", "IAU_2015:30100", or a CRS object).
     options (keywords, the command line's defaults): field="shape-index" (or "sdf",
         "height"), rings=2, radius=0, rays=25, cone_angle=120, postprocess=True,
-        allow_open=False, persistence=10, area_ratio=0.5 (percent), cost="auto" ("graph",
+        allow_open=False, persistence=10, area_ratio=0.5 (percent) or min_area (an area on
+        the body: m^2 as a number, or "5km2", "2000m2", "3ha"; an arc is cancelled when its
+        area is below it, whatever the tile's extent), cost="auto" ("graph",
         "standard"), saddle_penalty=20, format="GeoJSON"; reading: band=1,
         elevation="auto", nan_nodata=False, pixel_size=None, frame="auto", repair=False.
     progress: optional callable progress(fraction, message); return False to cancel.
@@ -224,12 +228,14 @@ def segment(dem, geotransform=None, crs=None, *, progress=None, **options):
 
 
 class SweepScale:
-    """One scale of a sweep: ratio, labels, vertex_labels, regions, graph, region_count."""
+    """One scale of a sweep: ratio (percent), min_area (m^2, a sweep over areas; else None),
+    labels, vertex_labels, regions, graph, region_count."""
 
     def __init__(self, sweep, index):
         self._sweep = sweep
         self._index = index
         self.ratio = sweep.ratios[index]
+        self.min_area = sweep.min_areas[index] or None
         self.regions = sweep.region_columns(index)
         self.graph = RegionGraph(self.regions, sweep.edge_columns(index))
         self.region_count = sweep.region_count(index)
@@ -265,14 +271,23 @@ class SweepResult:
                                   self._input_path, progress)
 
 
-def sweep(dem, geotransform=None, crs=None, *, area_ratios=(0.1, 0.25, 0.5, 1, 2),
+def sweep(dem, geotransform=None, crs=None, *, area_ratios=None, min_areas=None,
           progress=None, **options):
-    """Segment at several area ratios (percent) from one field and Reeb graph, as
-    `terrain sweep` does; the other options are segment()'s. Returns a SweepResult."""
+    """Segment at several area ratios (percent; default 0.1, 0.25, 0.5, 1, 2) or at several
+    areas on the body (min_areas: m^2 numbers or texts such as "1km2", as `terrain sweep
+    --min-areas`) from one field and Reeb graph, as `terrain sweep` does; the other options
+    are segment()'s. Returns a SweepResult."""
+    if area_ratios is not None and min_areas is not None:
+        raise Error("sweep: give area_ratios or min_areas, not both")
+    if area_ratios is None:
+        area_ratios = (0.1, 0.25, 0.5, 1, 2)
+    areas = [a if isinstance(a, str) else repr(float(a)) for a in (min_areas or [])]
+    if min_areas is not None and not areas:
+        raise Error("sweep: --min-areas needs at least one value")
     native_options, read = _split_options(options, _SEGMENT_OPTIONS)
     source = _source(dem, geotransform, crs, read.pop("elevation"))
     native = _terrain.sweep(source, [float(r) for r in area_ratios], native_options,
-                            progress=progress, **read)
+                            progress=progress, min_areas=areas, **read)
     return SweepResult(native, native_options, _input_path(source))
 
 
@@ -317,12 +332,19 @@ class ReebGraph:
         return g
 
 
-def reeb_graph(dem, geotransform=None, crs=None, *, persistence=0.0, area_ratio=0.0,
-               progress=None, **options):
+def reeb_graph(dem, geotransform=None, crs=None, *, persistence=0.0, area_ratio=None,
+               min_area=None, progress=None, **options):
     """The Reeb graph of the field (shape index by default) on the DEM's mesh, simplified
-    when persistence or area_ratio (percent) is above 0, as `terrain reeb` builds it.
-    Field and reading options as in segment(). Returns a ReebGraph."""
-    options = dict(options, persistence=persistence, area_ratio=area_ratio)
+    when persistence, area_ratio (percent) or min_area (as in segment()) is above 0, as
+    `terrain reeb` builds it. Field and reading options as in segment(). Returns a
+    ReebGraph."""
+    if area_ratio is not None and min_area is not None:
+        raise Error("segment: give area_ratio or min_area, not both")
+    options = dict(options, persistence=persistence)
+    if min_area is not None:
+        options["min_area"] = min_area
+    else:
+        options["area_ratio"] = 0.0 if area_ratio is None else area_ratio
     native_options, read = _split_options(options, _SEGMENT_OPTIONS)
     source = _source(dem, geotransform, crs, read.pop("elevation"))
     nodes, arcs, before = _terrain.reeb_graph(source, native_options, progress=progress, **read)

@@ -181,3 +181,25 @@ def test_help_shows_the_options():
     assert "persistence" in terrain.segment.__doc__
     assert "geotransform" in terrain.segment.__doc__
     assert "area_ratios" in terrain.sweep.__doc__ or "area ratio" in terrain.sweep.__doc__
+
+
+def test_min_area_is_the_cli_and_an_area_ratio(cli, moon, tmp_path):
+    out = tmp_path / "seg"
+    assert cli("segment", moon, "-o", out, "-q", "--min-area", "150km2").returncode == 0
+    by_text = terrain.segment(moon, min_area="150km2")
+    by_number = terrain.segment(moon, min_area=1.5e8)
+    assert np.array_equal(by_text.labels, read_labels(out / "labels.tif"))
+    assert np.array_equal(by_number.labels, by_text.labels)
+    import json
+    ratio = json.loads((out / "run.json").read_text())["parameters"]["area_ratio_percent"]
+    by_ratio = terrain.segment(moon, area_ratio=ratio)
+    assert np.array_equal(by_ratio.labels, by_text.labels)
+    with pytest.raises(terrain.Error, match="not both"):
+        terrain.segment(moon, min_area="150km2", area_ratio=0.5)
+    with pytest.raises(terrain.Error, match="min-area"):
+        terrain.segment(moon, min_area="150 acres")
+    sweep = terrain.sweep(moon, min_areas=["150km2", "50km2"])
+    assert [s.min_area for s in sweep.scales] == [5e7, 1.5e8]
+    assert np.array_equal(sweep.scales[1].labels, by_text.labels)
+    graph = terrain.reeb_graph(moon, min_area="150km2")
+    assert graph.critical_before > len(graph.nodes["node"])

@@ -2,6 +2,8 @@
 
 #include <malloc.h>
 
+#include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -83,6 +85,42 @@ void check_options(const SegmentOptions& o) {
     if (!std::isfinite(o.saddle_penalty) || o.saddle_penalty < 0)
         throw Error("segment", "--saddle-penalty must be a number >= 0");
     if (o.cost != "auto") segment::parse_grow_cost(o.cost);
+    if (!o.min_area.empty()) parse_area(o.min_area);
+}
+
+double parse_area(const std::string& text, const std::string& option) {
+    std::size_t used = 0;
+    double value = 0;
+    try {
+        value = std::stod(text, &used);
+    } catch (const std::exception&) {
+        used = 0;
+    }
+    std::string unit = used > 0 ? text.substr(used) : std::string();
+    unit.erase(0, unit.find_first_not_of(' '));
+    std::transform(unit.begin(), unit.end(), unit.begin(),
+                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    double scale = 0;
+    if (unit.empty() || unit == "m2" || unit == "m^2")
+        scale = 1;
+    else if (unit == "km2" || unit == "km^2")
+        scale = 1e6;
+    else if (unit == "ha")
+        scale = 1e4;
+    const double m2 = value * scale;
+    if (used == 0 || scale == 0 || !std::isfinite(m2) || m2 <= 0)
+        throw Error("segment", option +
+                                   " takes an area above 0 in m^2 or with a unit (5km2, "
+                                   "2000m2, 3ha); '" +
+                                   text + "' is not one");
+    return m2;
+}
+
+reeb::SimplifyOptions simplify_options(const SegmentOptions& options, const TriangleMesh& mesh) {
+    reeb::SimplifyOptions out = options.simplify;
+    if (!options.min_area.empty())
+        out.area_ratio = reeb::area_ratio_for_area(mesh, parse_area(options.min_area));
+    return out;
 }
 
 field::FieldOptions field_options(const SegmentOptions& o) {
@@ -165,8 +203,8 @@ ScaleResult grow_scale(const Input& input, const SegmentOptions& options,
 ScaleResult segment_scale(const Input& input, const reeb::ReebGraph& graph,
                           const SegmentOptions& options, const ProgressFn& progress) {
     const auto t0 = clock::now();
-    const auto simplified =
-        reeb::simplify(input.mesh, graph, options.simplify, scaled_progress(progress, 0, 0.3));
+    const auto simplified = reeb::simplify(input.mesh, graph, simplify_options(options, input.mesh),
+                                           scaled_progress(progress, 0, 0.3));
     return grow_scale(input, options, simplified, since(t0), scaled_progress(progress, 0.3, 1));
 }
 
@@ -182,7 +220,9 @@ SegmentResult segment(Input input, const SegmentOptions& options, const Progress
     // One scale only: the simplification takes the graph and frees what it no longer needs,
     // which lowers the peak memory.
     const auto t0 = clock::now();
-    const auto simplified = reeb::simplify(result.input.mesh, std::move(graph), options.simplify,
+    const auto thresholds = simplify_options(options, result.input.mesh);
+    result.area_ratio_percent = thresholds.area_ratio;
+    const auto simplified = reeb::simplify(result.input.mesh, std::move(graph), thresholds,
                                            scaled_progress(progress, 45.0 / 55, 48.0 / 55));
     const double seconds = since(t0);
     auto scale = grow_scale(result.input, options, simplified, seconds,
@@ -194,6 +234,8 @@ SegmentResult segment(Input input, const SegmentOptions& options, const Progress
     result.regions =
         segment::region_graph(result.input.mesh, result.field, result.segmentation.labels,
                               result.segmentation.region_count, result.dem());
+    // On a DEM, with the regions of valid pixels in no triangle (segment::label_pixels).
+    result.segmentation.region_count = static_cast<std::uint32_t>(result.regions.regions.size());
     result.add_time("grow", scale.grow_seconds + since(t1));
     return result;
 }
@@ -262,8 +304,11 @@ void write_run_json(const SegmentResult& result, const std::string& input_path,
         .field("rings", options.shape_index.rings)
         .field("radius", options.shape_index.radius)
         .field("persistence", options.simplify.persistence)
-        .field("area_ratio_percent", options.simplify.area_ratio)
-        .field("cost", options.cost == "auto" ? (dem ? "graph" : "standard") : options.cost.c_str())
+        .field("area_ratio_percent",
+               options.min_area.empty() ? options.simplify.area_ratio : result.area_ratio_percent);
+    if (!options.min_area.empty())
+        j.field("min_area", options.min_area).field("min_area_m2", parse_area(options.min_area));
+    j.field("cost", options.cost == "auto" ? (dem ? "graph" : "standard") : options.cost.c_str())
         .field("saddle_penalty", options.saddle_penalty)
         .field("format", options.format)
         .field("frame", to_string(result.input.mesh.frame));

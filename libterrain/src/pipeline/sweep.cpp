@@ -68,6 +68,42 @@ std::vector<double> parse_area_ratios(const std::string& text) {
     return out;
 }
 
+std::vector<AreaThreshold> parse_min_areas(const std::string& text) {
+    std::vector<AreaThreshold> out;
+    std::stringstream ss(text);
+    std::string item;
+    while (std::getline(ss, item, ',')) {
+        try {
+            out.push_back({item, parse_area(item, "--min-areas")});
+        } catch (const Error& e) {
+            // The same message, from the sweep's stage.
+            throw Error("sweep", std::string(e.what()).substr(e.stage().size() + 2));
+        }
+    }
+    if (out.empty()) throw Error("sweep", "--min-areas needs at least one value");
+    std::stable_sort(out.begin(), out.end(),
+                     [](const AreaThreshold& a, const AreaThreshold& b) { return a.m2 < b.m2; });
+    out.erase(
+        std::unique(out.begin(), out.end(),
+                    [](const AreaThreshold& a, const AreaThreshold& b) { return a.m2 == b.m2; }),
+        out.end());
+    return out;
+}
+
+namespace {
+
+// One scale to run: its area ratio, name and area threshold (0 for a sweep over ratios).
+struct ScaleSpec {
+    double ratio = 0;
+    std::string name;
+    double min_area_m2 = 0;
+};
+
+SweepResult run_sweep(Input input, const std::vector<ScaleSpec>& specs,
+                      const SegmentOptions& options, const ProgressFn& progress);
+
+}  // namespace
+
 SweepResult sweep(Input input, const std::vector<double>& area_ratios,
                   const SegmentOptions& options, const ProgressFn& progress) {
     check_options(options);
@@ -75,7 +111,33 @@ SweepResult sweep(Input input, const std::vector<double>& area_ratios,
     std::vector<double> ratios = area_ratios;
     std::sort(ratios.begin(), ratios.end());
     ratios.erase(std::unique(ratios.begin(), ratios.end()), ratios.end());
+    std::vector<ScaleSpec> specs;
+    for (const double r : ratios) specs.push_back({r, JsonWriter::number(r), 0});
+    return run_sweep(std::move(input), specs, options, progress);
+}
 
+SweepResult sweep(Input input, const std::vector<AreaThreshold>& min_areas,
+                  const SegmentOptions& options, const ProgressFn& progress) {
+    check_options(options);
+    if (min_areas.empty()) throw Error("sweep", "--min-areas needs at least one value");
+    std::vector<AreaThreshold> areas = min_areas;
+    for (const auto& a : areas)
+        if (!std::isfinite(a.m2) || a.m2 <= 0)
+            throw Error("sweep", "--min-areas takes areas above 0; '" + a.text + "' is not one");
+    std::stable_sort(areas.begin(), areas.end(),
+                     [](const AreaThreshold& a, const AreaThreshold& b) { return a.m2 < b.m2; });
+    std::vector<ScaleSpec> specs;
+    for (const auto& a : areas) {
+        if (!specs.empty() && specs.back().min_area_m2 == a.m2) continue;
+        specs.push_back({reeb::area_ratio_for_area(input.mesh, a.m2), a.text, a.m2});
+    }
+    return run_sweep(std::move(input), specs, options, progress);
+}
+
+namespace {
+
+SweepResult run_sweep(Input input, const std::vector<ScaleSpec>& specs,
+                      const SegmentOptions& options, const ProgressFn& progress) {
     SweepResult out;
     auto& base = out.base;
     base.input = std::move(input);
@@ -87,20 +149,25 @@ SweepResult sweep(Input input, const std::vector<double>& area_ratios,
 
     // Every scale from the same unsimplified graph, as `segment` would do it.
     auto& scales = out.scales;
-    scales.resize(ratios.size());
+    scales.resize(specs.size());
     const auto t0 = clock::now();
     tbb::parallel_for(std::size_t{0}, scales.size(), [&](std::size_t i) {
         const auto s0 = clock::now();
         SegmentOptions scale_options = options;
-        scale_options.simplify.area_ratio = ratios[i];
+        scale_options.simplify.area_ratio = specs[i].ratio;
+        scale_options.min_area.clear();
         auto result = segment_scale(base.input, graph, scale_options);
-        scales[i].ratio = ratios[i];
-        scales[i].name = JsonWriter::number(ratios[i]);
+        scales[i].ratio = specs[i].ratio;
+        scales[i].name = specs[i].name;
+        scales[i].min_area_m2 = specs[i].min_area_m2;
         scales[i].after = result.after;
         scales[i].segmentation = std::move(result.segmentation);
         scales[i].regions =
             segment::region_graph(base.input.mesh, base.field, scales[i].segmentation.labels,
                                   scales[i].segmentation.region_count, base.dem());
+        // On a DEM, with the regions of valid pixels in no triangle (segment::label_pixels).
+        scales[i].segmentation.region_count =
+            static_cast<std::uint32_t>(scales[i].regions.regions.size());
         scales[i].seconds = since(s0);
     });
     // lineage: scale i -> scale i+1.
@@ -117,6 +184,8 @@ SweepResult sweep(Input input, const std::vector<double>& area_ratios,
     return out;
 }
 
+}  // namespace
+
 std::vector<std::string> write_sweep_directory(SweepResult& result, const SegmentOptions& options,
                                                const std::string& input_path,
                                                const std::string& dir_path,
@@ -127,12 +196,13 @@ std::vector<std::string> write_sweep_directory(SweepResult& result, const Segmen
     const auto w0 = clock::now();
     std::vector<std::string> files;
     const Dem* dem = base.dem();
+    const bool by_area = !scales.empty() && scales.front().min_area_m2 > 0;
     if (dem) {
         std::vector<std::vector<std::uint32_t>> bands;
         std::vector<std::string> descriptions;
         for (const auto& s : scales) {
             bands.push_back(segment::label_pixels(base.input.mesh, *dem, s.segmentation.labels));
-            descriptions.push_back("area_ratio=" + s.name);
+            descriptions.push_back((s.min_area_m2 > 0 ? "min_area=" : "area_ratio=") + s.name);
         }
         io::write_label_stack(*dem, bands, descriptions, d + "labels.tif", false);
         files.push_back("labels.tif");
@@ -181,6 +251,11 @@ std::vector<std::string> write_sweep_directory(SweepResult& result, const Segmen
         j.key("scales").begin_array();
         for (const auto& s : scales) j.value(s.ratio);
         j.end_array();
+        if (by_area) {
+            j.key("min_areas_m2").begin_array();
+            for (const auto& s : scales) j.value(s.min_area_m2);
+            j.end_array();
+        }
         j.field("area_unit", dem ? "m^2 of pixel footprints on the body" : "m^2 of mesh surface");
         j.key("links").begin_array();
         for (std::size_t i = 0; i < result.lineage.size(); ++i) {
@@ -210,16 +285,19 @@ std::vector<std::string> write_sweep_directory(SweepResult& result, const Segmen
     }
     // sweep.csv and sweep.png.
     std::vector<double> xs, counts, means;
-    std::string csv =
-        "area_ratio_percent,regions,critical_nodes,mean_region_area_m2,total_area_m2\n";
+    std::string csv = std::string(
+                          "area_ratio_percent,regions,critical_nodes,mean_region_area_m2,"
+                          "total_area_m2") +
+                      (by_area ? ",min_area_m2\n" : "\n");
     for (const auto& s : scales) {
         double total = 0;
         for (const auto& r : s.regions.regions) total += r.area_m2;
         const double n = s.segmentation.region_count;
         const double mean = n > 0 ? total / n : 0;
-        csv += s.name + "," + std::to_string(s.segmentation.region_count) + "," +
-               std::to_string(s.after.critical) + "," + JsonWriter::number(mean) + "," +
-               JsonWriter::number(total) + "\n";
+        csv += JsonWriter::number(s.ratio) + "," + std::to_string(s.segmentation.region_count) +
+               "," + std::to_string(s.after.critical) + "," + JsonWriter::number(mean) + "," +
+               JsonWriter::number(total) +
+               (by_area ? "," + JsonWriter::number(s.min_area_m2) + "\n" : "\n");
         xs.push_back(s.ratio);
         counts.push_back(n);
         means.push_back(mean);
@@ -239,7 +317,11 @@ std::vector<std::string> write_sweep_directory(SweepResult& result, const Segmen
     std::string per_scale = "[";
     for (std::size_t i = 0; i < scales.size(); ++i) {
         const auto& s = scales[i];
-        per_scale += std::string(i ? "," : "") + "{\"area_ratio_percent\":" + s.name +
+        per_scale += std::string(i ? "," : "") +
+                     "{\"area_ratio_percent\":" + JsonWriter::number(s.ratio) +
+                     (by_area ? ",\"min_area\":" + JsonWriter::escape(s.name) +
+                                    ",\"min_area_m2\":" + JsonWriter::number(s.min_area_m2)
+                              : std::string()) +
                      ",\"regions\":" + std::to_string(s.segmentation.region_count) +
                      ",\"critical_nodes_after\":" + std::to_string(s.after.critical) +
                      ",\"relaxed_nodes\":" + std::to_string(s.segmentation.relaxed_nodes) +
@@ -247,7 +329,12 @@ std::vector<std::string> write_sweep_directory(SweepResult& result, const Segmen
     }
     per_scale += "]";
     SegmentOptions recorded = options;
-    if (!scales.empty()) recorded.simplify.area_ratio = scales.back().ratio;
+    recorded.min_area.clear();
+    if (!scales.empty()) {
+        recorded.simplify.area_ratio = scales.back().ratio;
+        base.area_ratio_percent = scales.back().ratio;
+        if (by_area) recorded.min_area = scales.back().name;
+    }
     write_run_json(base, input_path, recorded, files, d + "run.json", {{"scales", per_scale}});
     files.push_back("run.json");
     report_progress(progress, 1.0);

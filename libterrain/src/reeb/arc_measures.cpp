@@ -4,6 +4,7 @@
 
 #include "arc_measures.hpp"
 
+#include <algorithm>
 #include <vector>
 
 #include "../core/indices.hpp"
@@ -49,6 +50,17 @@ ArcMetrics arc_metrics(const TriangleMesh& mesh, const ReebGraph& g) {
                                  static_cast<double>(inc.degree(hi)), add_list_area, total);
     }
     return m;
+}
+
+double total_area(const TriangleMesh& mesh) {
+    if (mesh.vertex_areas.empty()) return internal::mesh_area_or_one(double(mesh.vertex_count()));
+    double total = 0;
+    for (const double a : mesh.vertex_areas) total += a;
+    return internal::mesh_area_or_one(total);
+}
+
+double area_ratio_for_area(const TriangleMesh& mesh, double min_area) {
+    return std::min(100.0, 100.0 * min_area / total_area(mesh));
 }
 
 }  // namespace terrain::reeb

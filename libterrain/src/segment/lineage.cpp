@@ -14,6 +14,17 @@ std::vector<RegionLineage> region_lineage(const TriangleMesh& mesh, const Dem* d
                                           std::uint32_t from_count,
                                           const std::vector<std::uint32_t>& to,
                                           std::uint32_t to_count) {
+    // On a DEM, label_pixels may add regions of pixels in no triangle after the vertices'.
+    std::vector<std::uint32_t> pa, pb;
+    if (dem && from.size() == mesh.vertex_count() && to.size() == mesh.vertex_count()) {
+        pa = label_pixels(mesh, *dem, from);
+        pb = label_pixels(mesh, *dem, to);
+        std::uint32_t top_a = 0, top_b = 0;
+        for (const auto l : from) top_a = std::max(top_a, l);
+        for (const auto l : to) top_b = std::max(top_b, l);
+        for (const auto l : pa) from_count = std::max(from_count, l > top_a ? l : 0u);
+        for (const auto l : pb) to_count = std::max(to_count, l > top_b ? l : 0u);
+    }
     if (from.size() != mesh.vertex_count() || to.size() != mesh.vertex_count())
         throw Error("segment", "lineage: the labels do not match the mesh");
     std::map<std::pair<std::uint32_t, std::uint32_t>, double> shared;
@@ -23,7 +34,6 @@ std::vector<RegionLineage> region_lineage(const TriangleMesh& mesh, const Dem* d
         shared[{a, b}] += area;
     };
     if (dem) {
-        const auto pa = label_pixels(mesh, *dem, from), pb = label_pixels(mesh, *dem, to);
         const PixelAreas areas(*dem);
         for (int row = 0; row < dem->height; ++row)
             for (int col = 0; col < dem->width; ++col) {

@@ -130,8 +130,10 @@ std::unordered_map<std::uint64_t, EdgeSums> boundary_sums(
     return sums;
 }
 
-// Position of each region's representative vertex (see Region::point).
-void set_points(RegionGraph& graph, const TriangleMesh& mesh, const Dem* dem) {
+// Position of each region's representative vertex (see Region::point); on a DEM, of the
+// first pixel of a region of pixels in no triangle (first_pixel, by region index).
+void set_points(RegionGraph& graph, const TriangleMesh& mesh, const Dem* dem,
+                const std::vector<std::size_t>& first_pixel) {
     if (!dem) {
         graph.point_frame = PointFrame::mesh;
         for (auto& r : graph.regions) r.point = mesh.position(std::size_t(r.representative_vertex));
@@ -139,8 +141,12 @@ void set_points(RegionGraph& graph, const TriangleMesh& mesh, const Dem* dem) {
     }
     std::vector<double> x, y;
     for (auto& r : graph.regions) {
-        const auto pixel = mesh.vertex_pixel[std::size_t(r.representative_vertex)];
-        const int col = pixel % dem->width, row = pixel / dem->width;
+        const auto pixel =
+            r.representative_vertex >= 0
+                ? std::size_t(mesh.vertex_pixel[std::size_t(r.representative_vertex)])
+                : first_pixel[r.id - 1];
+        const int col = int(pixel % std::size_t(dem->width)),
+                  row = int(pixel / std::size_t(dem->width));
         const auto xy = dem->map_xy(col + 0.5, row + 0.5);
         x.push_back(xy[0]);
         y.push_back(xy[1]);
@@ -161,6 +167,99 @@ void set_points(RegionGraph& graph, const TriangleMesh& mesh, const Dem* dem) {
     for (std::size_t i = 0; i < graph.regions.size(); ++i) {
         graph.regions[i].point[0] = x[i];
         graph.regions[i].point[1] = y[i];
+    }
+}
+
+// The 8 neighbours of pixel (col, row) that lie on the grid (columns wrap on a closed seam).
+template <class F>
+void for_each_neighbour(const Dem& dem, bool wrap, int col, int row, F&& f) {
+    for (int dr = -1; dr <= 1; ++dr)
+        for (int dc = -1; dc <= 1; ++dc) {
+            if (dr == 0 && dc == 0) continue;
+            const int r = row + dr;
+            int c = col + dc;
+            if (r < 0 || r >= dem.height) continue;
+            if (c < 0 || c >= dem.width) {
+                if (!wrap) continue;
+                c = (c + dem.width) % dem.width;
+            }
+            f(dem.index(c, r));
+        }
+}
+
+// Valid pixels in no triangle (labelled 0 so far) get a label. Ring by ring outwards from the
+// labelled pixels, each takes the most common label among its 8-neighbours labelled in an
+// earlier ring (ties: the lowest); pixels no ring reaches form regions of their own, one per
+// 8-connected group, numbered from first_new in row-major order of their first pixel.
+void label_unmeshed_pixels(const Dem& dem, bool wrap, std::vector<std::uint32_t>& out,
+                           std::uint32_t first_new) {
+    std::vector<std::size_t> pending;
+    for (std::size_t p = 0; p < out.size(); ++p)
+        if (out[p] == 0 && !std::isnan(dem.values[p])) pending.push_back(p);
+    if (pending.empty()) return;
+    const auto col_of = [&](std::size_t p) { return int(p % std::size_t(dem.width)); };
+    const auto row_of = [&](std::size_t p) { return int(p / std::size_t(dem.width)); };
+    std::vector<std::uint8_t> queued(out.size(), 0);
+    std::vector<std::size_t> ring;
+    for (const auto p : pending) {
+        bool touches = false;
+        for_each_neighbour(dem, wrap, col_of(p), row_of(p),
+                           [&](std::size_t q) { touches = touches || out[q] != 0; });
+        if (touches) {
+            ring.push_back(p);
+            queued[p] = 1;
+        }
+    }
+    std::vector<std::uint32_t> chosen;
+    while (!ring.empty()) {
+        chosen.assign(ring.size(), 0);
+        for (std::size_t i = 0; i < ring.size(); ++i) {
+            std::uint32_t label[8];
+            int count[8], n = 0;
+            for_each_neighbour(dem, wrap, col_of(ring[i]), row_of(ring[i]), [&](std::size_t q) {
+                if (out[q] == 0) return;
+                int k = 0;
+                while (k < n && label[k] != out[q]) ++k;
+                if (k == n) {
+                    label[n] = out[q];
+                    count[n++] = 0;
+                }
+                ++count[k];
+            });
+            int best = 0;
+            for (int k = 1; k < n; ++k)
+                if (count[k] > count[best] || (count[k] == count[best] && label[k] < label[best]))
+                    best = k;
+            chosen[i] = label[best];
+        }
+        std::vector<std::size_t> next;
+        for (std::size_t i = 0; i < ring.size(); ++i) out[ring[i]] = chosen[i];
+        for (const auto p : ring)
+            for_each_neighbour(dem, wrap, col_of(p), row_of(p), [&](std::size_t q) {
+                if (out[q] != 0 || queued[q] || std::isnan(dem.values[q])) return;
+                queued[q] = 1;
+                next.push_back(q);
+            });
+        std::sort(next.begin(), next.end());
+        ring.swap(next);
+    }
+    // Groups out of reach of every labelled pixel.
+    std::uint32_t id = first_new;
+    std::vector<std::size_t> stack;
+    for (const auto p : pending) {
+        if (out[p] != 0) continue;
+        out[p] = id;
+        stack.assign(1, p);
+        while (!stack.empty()) {
+            const auto v = stack.back();
+            stack.pop_back();
+            for_each_neighbour(dem, wrap, col_of(v), row_of(v), [&](std::size_t q) {
+                if (out[q] != 0 || std::isnan(dem.values[q])) return;
+                out[q] = id;
+                stack.push_back(q);
+            });
+        }
+        ++id;
     }
 }
 
@@ -189,6 +288,9 @@ std::vector<std::uint32_t> label_pixels(const TriangleMesh& mesh, const Dem& dem
     std::vector<std::uint32_t> out(vertex.size(), 0);
     for (std::size_t p = 0; p < vertex.size(); ++p)
         if (vertex[p] >= 0) out[p] = labels[static_cast<std::size_t>(vertex[p])];
+    std::uint32_t top = 0;
+    for (const auto l : labels) top = std::max(top, l);
+    label_unmeshed_pixels(dem, mesh.seam_closed, out, top + 1);
     return out;
 }
 
@@ -196,10 +298,17 @@ RegionGraph region_graph(const TriangleMesh& mesh, const std::vector<float>& fie
                          const std::vector<std::uint32_t>& labels, std::uint32_t region_count,
                          const Dem* dem) {
     check_inputs(mesh, field, labels, region_count, dem);
+    // On a DEM, the regions of valid pixels in no triangle come after the vertices' regions.
+    std::vector<std::uint32_t> pixels;
+    std::uint32_t total = region_count;
+    if (dem) {
+        pixels = label_pixels(mesh, *dem, labels);
+        for (const auto l : pixels) total = std::max(total, l);
+    }
     RegionGraph graph;
-    graph.regions.resize(region_count);
+    graph.regions.resize(total);
     std::vector<double> weighted(region_count, 0.0), plain(region_count, 0.0);
-    for (std::uint32_t i = 0; i < region_count; ++i) {
+    for (std::uint32_t i = 0; i < total; ++i) {
         graph.regions[i].id = i + 1;
         graph.regions[i].field_min = std::numeric_limits<double>::infinity();
         graph.regions[i].field_max = -std::numeric_limits<double>::infinity();
@@ -225,8 +334,15 @@ RegionGraph region_graph(const TriangleMesh& mesh, const std::vector<float>& fie
         r.area_m2 = r.surface_area_m2;
     }
 
+    // Regions of pixels only: no vertex, no field (NaN), no mesh area.
+    for (std::uint32_t i = region_count; i < total; ++i) {
+        auto& r = graph.regions[i];
+        r.field_mean = r.field_min = r.field_max = std::numeric_limits<double>::quiet_NaN();
+        r.landform = landform_of(r.field_mean);
+    }
+
+    std::vector<std::size_t> first_pixel(total, 0);
     if (dem) {
-        const auto pixels = label_pixels(mesh, *dem, labels);
         const PixelAreas pixel_area(*dem);
         for (auto& r : graph.regions) r.area_m2 = 0;
         for (int row = 0; row < dem->height; ++row)
@@ -234,7 +350,7 @@ RegionGraph region_graph(const TriangleMesh& mesh, const std::vector<float>& fie
                 const auto l = pixels[dem->index(col, row)];
                 if (l == 0) continue;
                 auto& r = graph.regions[l - 1];
-                ++r.pixel_count;
+                if (r.pixel_count++ == 0) first_pixel[l - 1] = dem->index(col, row);
                 r.area_m2 += pixel_area(col, row);
             }
     }
@@ -242,7 +358,7 @@ RegionGraph region_graph(const TriangleMesh& mesh, const std::vector<float>& fie
     const auto best = representative_vertices(mesh, labels, region_count);
     for (std::uint32_t i = 0; i < region_count; ++i)
         graph.regions[i].representative_vertex = best[i];
-    set_points(graph, mesh, dem);
+    set_points(graph, mesh, dem, first_pixel);
 
     const auto sums = boundary_sums(mesh, labels);
     graph.edges.reserve(sums.size());

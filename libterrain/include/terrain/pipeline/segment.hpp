@@ -63,6 +63,11 @@ struct SegmentOptions {
     bool postprocess = true;                    // sdf: bilateral smoothing of the face values
     bool allow_open = false;                    // sdf: a mesh with holes is accepted
     reeb::SimplifyOptions simplify{10.0, 0.5};  // persistence, area ratio (percent)
+    // The area threshold in the user's units ("5km2", "2000m2", "3ha", "1e6": m^2), or empty.
+    // When set it replaces simplify.area_ratio: an arc is cancelled when its area on the body
+    // is below it, applied as the equivalent ratio 100 * min_area / (the mesh's area) percent
+    // (reeb::area_ratio_for_area), so the same landform is kept whatever the tile's extent.
+    std::string min_area;
     std::string cost = "auto";  // graph, standard, or auto: graph for DEMs, standard for meshes
     double saddle_penalty = 20;
     std::string format = "GeoJSON";  // OGR driver of the region polygons
@@ -70,6 +75,14 @@ struct SegmentOptions {
 
 // Thresholds and names, checked before any long work; throws terrain::Error.
 void check_options(const SegmentOptions& options);
+
+// An area with an optional unit, in m^2: "5km2" (or km^2), "2000m2" (or m^2), "3ha", or a
+// plain number of m^2; above 0. Throws terrain::Error (stage "segment") naming `option`
+// otherwise.
+double parse_area(const std::string& text, const std::string& option = "--min-area");
+// The simplification thresholds applied on `mesh`: options.simplify, with the area ratio
+// given by options.min_area when it is set.
+reeb::SimplifyOptions simplify_options(const SegmentOptions& options, const TriangleMesh& mesh);
 // The field library's options.
 field::FieldOptions field_options(const SegmentOptions& options);
 // The cost `auto` resolves to: graph for a DEM, standard for a mesh file.
@@ -95,10 +108,13 @@ struct SegmentResult {
     std::vector<float> field;         // per mesh vertex, as computed
     std::size_t critical_before = 0;  // critical nodes of the unsimplified Reeb graph
     reeb::ReebSummary after;          // the simplified graph of the segmentation
+    // Its region_count counts every region of the table: on a DEM, after the vertices'
+    // regions, those of valid pixels in no triangle (segment::label_pixels).
     segment::Segmentation segmentation;
     segment::RegionGraph regions;
     std::vector<StageTime> timings;         // read, mesh, field, reeb, simplify, grow, write
     std::optional<MeshCounts> mesh_counts;  // kept by release_large_data for run.json
+    double area_ratio_percent = 0;          // the area-ratio threshold applied (percent)
 
     const Dem* dem() const { return input.dem ? &*input.dem : nullptr; }
     void add_time(const std::string& name, double seconds);

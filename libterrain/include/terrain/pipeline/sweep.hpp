@@ -17,9 +17,21 @@ namespace terrain::pipeline {
 // "sweep") otherwise.
 std::vector<double> parse_area_ratios(const std::string& text);
 
+// An area threshold as given ("5km2") and in m^2.
+struct AreaThreshold {
+    std::string text;
+    double m2 = 0;
+};
+// "1km2,5km2,20km2" into thresholds sorted by area, equal areas once; throws terrain::Error
+// (stage "sweep") for an empty list or a value parse_area refuses.
+std::vector<AreaThreshold> parse_min_areas(const std::string& text);
+
 struct SweepScale {
-    double ratio = 0;
-    std::string name;  // the ratio as written in file names ("0.25")
+    double ratio = 0;  // the area-ratio threshold applied (percent)
+    // The scale as written in file names and band descriptions: the ratio ("0.25") or, for a
+    // sweep over areas, the area as given ("5km2").
+    std::string name;
+    double min_area_m2 = 0;  // a sweep over areas: the area threshold; 0 otherwise
     segment::Segmentation segmentation;
     reeb::ReebSummary after;  // of its simplified graph
     segment::RegionGraph regions;
@@ -40,6 +52,11 @@ struct SweepResult {
 // field and unsimplified Reeb graph. Throws terrain::Error as segment() does, and (stage
 // "sweep") for an empty or out-of-range list of ratios.
 SweepResult sweep(Input input, const std::vector<double>& area_ratios,
+                  const SegmentOptions& options, const ProgressFn& progress = {});
+// The same over area thresholds on the body (SegmentOptions::min_area, which is ignored
+// here): each becomes the equivalent area ratio on the input's mesh. Scales are named by the
+// areas as given.
+SweepResult sweep(Input input, const std::vector<AreaThreshold>& min_areas,
                   const SegmentOptions& options, const ProgressFn& progress = {});
 
 // Every output of `terrain sweep` into the existing directory `dir`: labels.tif (one band

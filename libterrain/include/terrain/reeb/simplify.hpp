@@ -58,4 +58,14 @@ struct ArcMetrics {
 };
 ArcMetrics arc_metrics(const TriangleMesh& mesh, const ReebGraph& graph);
 
+// The area that area ratios divide by: the sum of the mesh's vertex areas (1 per vertex on a
+// mesh without areas), in the mesh's units squared (m^2 on DEM meshes).
+double total_area(const TriangleMesh& mesh);
+
+// The area-ratio threshold (percent) equivalent to an area threshold on this mesh: an arc's
+// area ratio is its area over total_area(mesh), so "area below min_area" is "area ratio below
+// 100 * min_area / total_area(mesh) percent" (equal up to rounding). Capped at 100 percent
+// (a min_area at or above the whole surface cancels as far as the area ratio can).
+double area_ratio_for_area(const TriangleMesh& mesh, double min_area);
+
 }  // namespace terrain::reeb

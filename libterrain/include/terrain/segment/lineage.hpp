@@ -24,7 +24,8 @@ struct RegionLineage {
 // For each region of `from` (ids 1..from_count), the regions of `to` it overlaps. Areas are
 // measured as region_graph measures area_m2: pixel footprints on the body for a DEM mesh
 // (dem != nullptr), vertex areas for a mesh file; so one region's overlaps add up to its
-// area.
+// area. On a DEM the regions of pixels in no triangle that label_pixels adds are counted
+// too (after from_count / to_count when these count the vertices' regions only).
 std::vector<RegionLineage> region_lineage(const TriangleMesh& mesh, const Dem* dem,
                                           const std::vector<std::uint32_t>& from,
                                           std::uint32_t from_count,

@@ -77,15 +77,23 @@ struct RegionGraph {
 };
 
 // The regions of `labels` (one per vertex, 1..region_count, every id used) with their
-// properties and adjacency. `dem` is the DEM the mesh was made from, or nullptr for a mesh
+// properties and adjacency; on a DEM, followed by the regions of pixels only that
+// label_pixels adds (vertex_count 0, field values NaN, representative_vertex -1, the point
+// at their first pixel, no neighbours), and the pixel counts and areas include every pixel
+// label_pixels gives a region. `dem` is the DEM the mesh was made from, or nullptr for a mesh
 // read from a file. Throws terrain::Error (stage "segment") on sizes that do not match,
 // labels out of range or unused ids.
 RegionGraph region_graph(const TriangleMesh& mesh, const std::vector<float>& field,
                          const std::vector<std::uint32_t>& labels, std::uint32_t region_count,
                          const Dem* dem);
 
-// The label of each DEM pixel (row-major), 0 where the DEM has NoData or the pixel is in no
-// triangle; the pixels of a collapsed pole row take the pole vertex's label.
+// The label of each DEM pixel (row-major), 0 where the DEM has NoData; the pixels of a
+// collapsed pole row take the pole vertex's label. Every valid pixel has a label: a pixel in
+// no triangle (isolated, or touching the others only at a corner) takes, ring by ring
+// outwards from the labelled pixels, the most common label among its 8-neighbours labelled
+// in an earlier ring (ties: the lowest id); pixels that no ring reaches (no valid 8-path to a
+// mesh vertex) form regions of their own, one per 8-connected group, numbered after the
+// largest label in `labels` in row-major order of their first pixel.
 std::vector<std::uint32_t> label_pixels(const TriangleMesh& mesh, const Dem& dem,
                                         const std::vector<std::uint32_t>& labels);
 
