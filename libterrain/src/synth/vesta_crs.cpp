@@ -31,8 +31,8 @@ std::string vesta_equirectangular_wkt(double center_lon, double standard_paralle
            R"(PARAMETER["Longitude of natural origin",)" + wkt_number(center_lon) + "," + degree +
            R"(,ID["EPSG",8802]],PARAMETER["False easting",0,)" + metre +
            R"(,ID["EPSG",8806]],PARAMETER["False northing",0,)" + metre +
-           R"(,ID["EPSG",8807]]],CS[Cartesian,2],AXIS["(E)",east,ORDER[1],)" + metre_id +
-           R"(],AXIS["(N)",north,ORDER[2],)" + metre_id + "]]";
+           R"w(,ID["EPSG",8807]]],CS[Cartesian,2],AXIS["(E)",east,ORDER[1],)w" + metre_id +
+           R"w(],AXIS["(N)",north,ORDER[2],)w" + metre_id + "]]";
 }
 
 }  // namespace terrain::synth
