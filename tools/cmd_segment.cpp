@@ -1,5 +1,6 @@
 // terrain segment INPUT -o OUTDIR [field options] [--persistence 10] [--area-ratio 0.5]
-//                  [--cost graph|standard] [--saddle-penalty 20] [--timings]
+//                  [--cost graph|standard] [--saddle-penalty 20] [--format GeoJSON]
+//                  [--timings]
 // The main job: field, Reeb graph, simplification, region growing, and every output file
 // (terrain/pipeline/segment.hpp does the work). The outputs are written into a temporary
 // sibling directory that replaces OUTDIR at the end, so OUTDIR appears complete or not at all.
@@ -22,10 +23,12 @@ int run_segment(int argc, char** argv) {
         add_field_options(options, field_values);
         add_input_options(options, input_values);
         po::variables_map vm;
-        if (!parse_command(argc, argv,
-                           "terrain segment INPUT -o OUTDIR [--persistence 10] [--area-ratio 0.5] "
-                           "[--cost graph|standard] [--saddle-penalty 20] [--timings]",
-                           options, vm))
+        if (!parse_command(
+                argc, argv,
+                "terrain segment INPUT -o OUTDIR [--persistence 10] [--area-ratio 0.5] "
+                "[--cost graph|standard] [--saddle-penalty 20] [--format GeoJSON|GPKG|...] "
+                "[--timings]",
+                options, vm))
             return 0;
         to_field_options(field_values, vm);  // refuses contradictions (exit status 2)
         const auto segment_options = to_pipeline_options(field_values, segment_values);
@@ -33,6 +36,7 @@ int run_segment(int argc, char** argv) {
 
         const auto progress = terminal_progress(common.quiet);
         auto input = load_input(common.input, input_values, scaled_progress(progress, 0, 0.15));
+        print_input_warnings("segment", input);
         auto result = pipeline::segment(to_pipeline_input(std::move(input)), segment_options,
                                         scaled_progress(progress, 0.15, 0.7));
         pipeline::WriteOptions write;

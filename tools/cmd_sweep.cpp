@@ -44,6 +44,7 @@ int run_sweep(int argc, char** argv) {
 
         const auto progress = terminal_progress(common.quiet);
         auto input = load_input(common.input, input_values, scaled_progress(progress, 0, 0.15));
+        print_input_warnings("sweep", input);
         auto result = pipeline::sweep(to_pipeline_input(std::move(input)), ratios, segment_options,
                                       scaled_progress(progress, 0.15, 0.75));
         pipeline::write_sweep_directory(result, segment_options, common.input, dir.temp_path(),

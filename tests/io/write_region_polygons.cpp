@@ -141,7 +141,12 @@ TEST_CASE("regions.geojson on the Moon: lon/lat on the Moon, CRS recorded, areas
     dem_srs.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
     std::unique_ptr<OGRSpatialReference> geographic(dem_srs.CloneGeogCS());
     geographic->SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
-    CHECK(same_crs(*srs, *geographic));
+    // Stated as the Moon's IAU_2015 CRS (the same sphere), by its code.
+    CHECK(std::string(srs->GetAuthorityName(nullptr)) == "IAU_2015");
+    CHECK(std::string(srs->GetAuthorityCode(nullptr)) == "30100");
+    OGRSpatialReference iau;
+    REQUIRE(iau.SetFromUserInput("IAU_2015:30100") == OGRERR_NONE);
+    CHECK(same_crs(*srs, iau));
     std::unique_ptr<OGRCoordinateTransformation> ct(
         OGRCreateCoordinateTransformation(&dem_srs, geographic.get()));
     check_features(r, t, [&](double x, double y) {
@@ -219,8 +224,13 @@ TEST_CASE("regions.geojson without CRS is in the DEM's map coordinates",
     const auto dir = test::scratch_dir("write_region_polygons_mars");
     const auto path = (dir / "regions.geojson").string();
     io::write_region_polygons(t.dem, t.pixels, t.graph, path, false);
-    CHECK(test::file_bytes(path).find("\"crs\"") == std::string::npos);
+    // A local engineering CRS is named, so that no reader takes the metres for WGS 84.
+    CHECK(test::file_bytes(path).find("\"crs\"") != std::string::npos);
     const auto r = read_features(path);
+    const OGRSpatialReference* srs = r.ds->GetLayer(0)->GetSpatialRef();
+    REQUIRE(srs);
+    CHECK(srs->IsLocal());
+    CHECK_FALSE(srs->IsGeographic());
     check_features(r, t, [](double x, double y) { return std::array<double, 2>{x, y}; });
     double sum = 0;
     for (const auto& f : r.features) {

@@ -70,6 +70,11 @@ struct SegmentOptions {
 
 // Thresholds and names, checked before any long work; throws terrain::Error.
 void check_options(const SegmentOptions& options);
+// What the caller should tell the user, once, about a DEM's georeference before segmenting
+// it (the library never prints): a raster with no geotransform (an image: its pixels are
+// taken as squares of the --pixel-size, 1 m by default) or no CRS (the outputs are in
+// local map metres, with no longitude/latitude). Empty for a georeferenced DEM.
+std::vector<std::string> georeference_warnings(const Dem& dem);
 // The field library's options.
 field::FieldOptions field_options(const SegmentOptions& options);
 // The cost `auto` resolves to: graph for a DEM, standard for a mesh file.
