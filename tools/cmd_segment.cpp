@@ -1,6 +1,6 @@
 // terrain segment INPUT -o OUTDIR [field options] [--persistence 10]
-//                  [--area-ratio 0.5 | --min-area AREA]
-//                  [--cost graph|standard] [--saddle-penalty 20] [--timings]
+//                  [--area-ratio 0.5 | --min-area AREA] [--cost graph|standard]
+//                  [--saddle-penalty 20] [--format GeoJSON] [--timings]
 // The main job: field, Reeb graph, simplification, region growing, and every output file
 // (terrain/pipeline/segment.hpp does the work). The outputs are written into a temporary
 // sibling directory that replaces OUTDIR at the end, so OUTDIR appears complete or not at all.
@@ -25,8 +25,8 @@ int run_segment(int argc, char** argv) {
         po::variables_map vm;
         if (!parse_command(argc, argv,
                            "terrain segment INPUT -o OUTDIR [--persistence 10] [--area-ratio 0.5 | "
-                           "--min-area AREA] "
-                           "[--cost graph|standard] [--saddle-penalty 20] [--timings]",
+                           "--min-area AREA] [--cost graph|standard] [--saddle-penalty 20] "
+                           "[--format GeoJSON|GPKG|...] [--timings]",
                            options, vm))
             return 0;
         to_field_options(field_values, vm);  // refuses contradictions (exit status 2)
@@ -37,6 +37,7 @@ int run_segment(int argc, char** argv) {
         const auto progress = terminal_progress(common.quiet);
         auto input = load_input(common.input, input_values, scaled_progress(progress, 0, 0.15));
         check_field_limits(field_values.options, input.mesh);  // --radius against the mesh
+        print_input_warnings("segment", input);
         auto result = pipeline::segment(to_pipeline_input(std::move(input)), segment_options,
                                         scaled_progress(progress, 0.15, 0.7));
         pipeline::WriteOptions write;

@@ -60,6 +60,7 @@ int run_sweep(int argc, char** argv) {
         const auto progress = terminal_progress(common.quiet);
         auto input = load_input(common.input, input_values, scaled_progress(progress, 0, 0.15));
         check_field_limits(field_values.options, input.mesh);  // --radius against the mesh
+        print_input_warnings("sweep", input);
         auto result = by_area
                           ? pipeline::sweep(to_pipeline_input(std::move(input)), areas,
                                             segment_options, scaled_progress(progress, 0.15, 0.75))

@@ -54,6 +54,12 @@ pipeline::Input to_pipeline_input(Input input) {
     return out;
 }
 
+void print_input_warnings(const char* command, const Input& input) {
+    if (!input.dem) return;
+    for (const auto& w : pipeline::georeference_warnings(*input.dem))
+        std::fprintf(stderr, "terrain %s: warning: %s\n", command, w.c_str());
+}
+
 void print_summary(const pipeline::SegmentResult& result, const std::string& output, bool timings) {
     std::printf(
         "%s: %u regions on %zu vertices (critical nodes %zu -> %zu)\n", output.c_str(),

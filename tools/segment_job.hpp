@@ -35,6 +35,9 @@ pipeline::SegmentOptions to_pipeline_options(const FieldOptionValues& field,
 // The input loaded by load_input, for the pipeline.
 pipeline::Input to_pipeline_input(Input input);
 
+// The input's georeference warnings (pipeline::georeference_warnings), one line each on
+// stderr: "terrain <command>: warning: ...".
+void print_input_warnings(const char* command, const Input& input);
 void print_summary(const pipeline::SegmentResult& result, const std::string& output, bool timings);
 // The stage table (the paper's Table 2): one line per stage and the total.
 void print_timings(const std::vector<pipeline::StageTime>& timings);

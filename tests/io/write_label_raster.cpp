@@ -29,7 +29,7 @@ test::SegmentedTile vesta_tile() {
 
 }  // namespace
 
-TEST_CASE("labels.tif: UInt32 on the DEM's grid, labels where the DEM is valid, NoData 0",
+TEST_CASE("labels.tif: UInt16 on the DEM's grid, labels where the DEM is valid, NoData 0",
           "[write_label_raster]") {
     const auto t = vesta_tile();
     const auto dir = test::scratch_dir("write_label_raster");
@@ -44,12 +44,15 @@ TEST_CASE("labels.tif: UInt32 on the DEM's grid, labels where the DEM is valid, 
     GeoTransform gt{};
     REQUIRE(ds->GetGeoTransform(gt.data()) == CE_None);
     CHECK(gt == t.dem.transform);
-    OGRSpatialReference dem_srs;
+    // The DEM's projection on Vesta's IAU_2015 sphere (the same radius).
+    OGRSpatialReference dem_srs, vesta;
     dem_srs.SetFromUserInput(t.dem.crs_wkt.c_str());
+    REQUIRE(vesta.SetFromUserInput("IAU_2015:200000400") == OGRERR_NONE);
+    REQUIRE(dem_srs.CopyGeogCSFrom(&vesta) == OGRERR_NONE);
     REQUIRE(ds->GetSpatialRef());
     CHECK(ds->GetSpatialRef()->IsSame(&dem_srs));
     GDALRasterBand* band = ds->GetRasterBand(1);
-    CHECK(band->GetRasterDataType() == GDT_UInt32);
+    CHECK(band->GetRasterDataType() == GDT_UInt16);
     int has_nodata = 0;
     CHECK(band->GetNoDataValue(&has_nodata) == 0);
     CHECK(has_nodata);
@@ -92,12 +95,21 @@ TEST_CASE("labels.tif: UInt32 on the DEM's grid, labels where the DEM is valid, 
         CHECK(rat->GetValueAsInt(row, column("Blue")) == colour[2]);
         CHECK(rat->GetValueAsInt(row, column("Alpha")) == 255);
     }
-    // GeoTIFF cannot hold a colour table on a 32-bit band: the colours are the RAT's, and
-    // GDAL turns them into a colour table indexed by id.
-    CHECK(band->GetColorTable() == nullptr);
+    // The band's colour table holds the region colours; GDAL also turns the RAT's colours into
+    // the same table indexed by id.
+    const GDALColorTable* band_table = band->GetColorTable();
+    REQUIRE(band_table);
+    CHECK(band->GetColorInterpretation() == GCI_PaletteIndex);
+    CHECK(band_table->GetColorEntry(0)->c4 == 0);
     std::unique_ptr<GDALColorTable> table(rat->TranslateToColorTable(-1));
     REQUIRE(table);
     CHECK(table->GetColorEntryCount() == int(t.region_count) + 1);
+    for (std::uint32_t id = 1; id <= t.region_count; ++id) {
+        const GDALColorEntry* e = band_table->GetColorEntry(int(id));
+        const auto colour = io::region_colour(id);
+        CHECK(std::array<int, 4>{e->c1, e->c2, e->c3, e->c4} ==
+              std::array<int, 4>{colour[0], colour[1], colour[2], colour[3]});
+    }
     for (std::uint32_t id = 1; id <= t.region_count; ++id) {
         const GDALColorEntry* e = table->GetColorEntry(int(id));
         const auto colour = io::region_colour(id);
@@ -105,6 +117,15 @@ TEST_CASE("labels.tif: UInt32 on the DEM's grid, labels where the DEM is valid, 
               std::array<int, 4>{colour[0], colour[1], colour[2], colour[3]});
     }
     CHECK(std::filesystem::exists(path + ".aux.xml"));
+    // The QGIS style beside it: one palette entry per region.
+    const auto qml = test::file_bytes(io::label_style_path(path));
+    CHECK(io::label_style_path(path) == (dir / "labels.qml").string());
+    CHECK(qml.find("type=\"paletted\"") != std::string::npos);
+    std::size_t entries = 0;
+    for (auto at = qml.find("<paletteEntry"); at != std::string::npos;
+         at = qml.find("<paletteEntry", at + 1))
+        ++entries;
+    CHECK(entries == t.region_count);
 }
 
 TEST_CASE("labels.tif: colours are distinct and id 0 is transparent", "[write_label_raster]") {
@@ -134,7 +155,7 @@ TEST_CASE("labels.tif: same bytes again, existing files kept unless overwrite, n
         ++files;
         CHECK(e.path().filename().string()[0] != '.');
     }
-    CHECK(files == 2);
+    CHECK(files == 3);  // labels.tif, its .aux.xml and labels.qml
     CHECK_THROWS_AS(
         io::write_label_raster(t.dem, t.pixels, t.graph, (dir / "no/such/l.tif").string(), false),
         Error);

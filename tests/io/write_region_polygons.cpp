@@ -69,6 +69,7 @@ bool same_crs(const OGRSpatialReference& a, const OGRSpatialReference& b) {
 
 struct Read {
     std::unique_ptr<GDALDataset> ds;
+    OGRLayer* layer = nullptr;  // the polygons (a GeoPackage also holds layer_styles)
     std::vector<std::unique_ptr<OGRFeature>> features;
 };
 
@@ -77,8 +78,13 @@ Read read_features(const std::string& path) {
     Read r;
     r.ds.reset(GDALDataset::Open(path.c_str(), GDAL_OF_VECTOR));
     REQUIRE(r.ds);
-    REQUIRE(r.ds->GetLayerCount() == 1);
-    OGRLayer* layer = r.ds->GetLayer(0);
+    const bool styles = r.ds->GetLayerByName("layer_styles") != nullptr;
+    REQUIRE(r.ds->GetLayerCount() == (styles ? 2 : 1));
+    for (int k = 0; k < r.ds->GetLayerCount(); ++k)
+        if (std::string(r.ds->GetLayer(k)->GetName()) != "layer_styles")
+            r.layer = r.ds->GetLayer(k);
+    REQUIRE(r.layer);
+    OGRLayer* layer = r.layer;
     for (std::unique_ptr<OGRFeature> f(layer->GetNextFeature()); f;
          f.reset(layer->GetNextFeature()))
         r.features.push_back(std::move(f));
@@ -132,7 +138,7 @@ TEST_CASE("regions.geojson on the Moon: lon/lat on the Moon, CRS recorded, areas
     io::write_region_polygons(t.dem, t.pixels, t.graph, path, false);
     const auto r = read_features(path);
 
-    const OGRSpatialReference* srs = r.ds->GetLayer(0)->GetSpatialRef();
+    const OGRSpatialReference* srs = r.layer->GetSpatialRef();
     REQUIRE(srs);
     CHECK(srs->IsGeographic());
     CHECK(srs->GetSemiMajor() == Approx(1737400));
@@ -141,7 +147,13 @@ TEST_CASE("regions.geojson on the Moon: lon/lat on the Moon, CRS recorded, areas
     dem_srs.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
     std::unique_ptr<OGRSpatialReference> geographic(dem_srs.CloneGeogCS());
     geographic->SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
-    CHECK(same_crs(*srs, *geographic));
+    // Stated as the Moon's IAU_2015 CRS (the same sphere), by its code.
+    // (OGR names the authority "IAU", WKT1's form of IAU_2015.)
+    CHECK(std::string(srs->GetAuthorityName(nullptr)).rfind("IAU", 0) == 0);
+    CHECK(std::string(srs->GetAuthorityCode(nullptr)) == "30100");
+    OGRSpatialReference iau;
+    REQUIRE(iau.SetFromUserInput("IAU_2015:30100") == OGRERR_NONE);
+    CHECK(same_crs(*srs, iau));
     std::unique_ptr<OGRCoordinateTransformation> ct(
         OGRCreateCoordinateTransformation(&dem_srs, geographic.get()));
     check_features(r, t, [&](double x, double y) {
@@ -178,7 +190,7 @@ TEST_CASE("regions.geojson on Earth is RFC 7946 lon/lat", "[write_region_polygon
     const auto text = test::file_bytes(path);
     CHECK(text.find("\"crs\"") == std::string::npos);
     const auto r = read_features(path);
-    const OGRSpatialReference* srs = r.ds->GetLayer(0)->GetSpatialRef();
+    const OGRSpatialReference* srs = r.layer->GetSpatialRef();
     REQUIRE(srs);
     OGRSpatialReference wgs84;
     wgs84.importFromEPSG(4326);
@@ -219,8 +231,13 @@ TEST_CASE("regions.geojson without CRS is in the DEM's map coordinates",
     const auto dir = test::scratch_dir("write_region_polygons_mars");
     const auto path = (dir / "regions.geojson").string();
     io::write_region_polygons(t.dem, t.pixels, t.graph, path, false);
-    CHECK(test::file_bytes(path).find("\"crs\"") == std::string::npos);
+    // A local engineering CRS is named, so that no reader takes the metres for WGS 84.
+    CHECK(test::file_bytes(path).find("\"crs\"") != std::string::npos);
     const auto r = read_features(path);
+    const OGRSpatialReference* srs = r.layer->GetSpatialRef();
+    REQUIRE(srs);
+    CHECK(srs->IsLocal());
+    CHECK_FALSE(srs->IsGeographic());
     check_features(r, t, [](double x, double y) { return std::array<double, 2>{x, y}; });
     double sum = 0;
     for (const auto& f : r.features) {
@@ -246,12 +263,20 @@ TEST_CASE("regions.gpkg keeps the DEM's full CRS, the same bytes every run",
     io::write_region_polygons(t.dem, t.pixels, t.graph, path, false, options);
     {
         const auto r = read_features(path);
-        OGRSpatialReference dem_srs;
+        // The DEM's projection on Vesta's IAU_2015 sphere (the same radius).
+        OGRSpatialReference dem_srs, iau_vesta;
         dem_srs.SetFromUserInput(t.dem.crs_wkt.c_str());
-        const OGRSpatialReference* srs = r.ds->GetLayer(0)->GetSpatialRef();
+        REQUIRE(iau_vesta.SetFromUserInput("IAU_2015:200000400") == OGRERR_NONE);
+        REQUIRE(dem_srs.CopyGeogCSFrom(&iau_vesta) == OGRERR_NONE);
+        const OGRSpatialReference* srs = r.layer->GetSpatialRef();
         REQUIRE(srs);
         CHECK(srs->IsProjected());
         CHECK(srs->IsSame(&dem_srs));
+        CHECK(std::string(srs->GetAuthorityCode("GEOGCS")) == "200000400");
+        // QGIS's default style of the layer: one layer_styles row.
+        OGRLayer* styles = r.ds->GetLayerByName("layer_styles");
+        REQUIRE(styles);
+        CHECK(styles->GetFeatureCount() == 1);
         check_features(r, t, [](double x, double y) { return std::array<double, 2>{x, y}; });
         for (const auto& f : r.features)
             CHECK(wkbFlatten(f->GetGeometryRef()->getGeometryType()) == wkbMultiPolygon);

@@ -1,6 +1,7 @@
 // `terrain sweep`: the scales, their lineage, and agreement with plain `segment` runs.
 #include <cpl_json.h>
 #include <gdal_priv.h>
+#include <ogrsf_frmts.h>
 #include <catch2/catch.hpp>
 
 #include <filesystem>
@@ -79,12 +80,15 @@ TEST_CASE("terrain sweep: scales agree with segment, counts fall, lineage adds u
             CHECK(fraction == Approx(1.0).epsilon(1e-9));
         }
     }
-    // The GeoPackage has one layer per scale.
+    // The GeoPackage has one layer per scale, and layer_styles with a style for each.
     std::unique_ptr<GDALDataset> gpkg(GDALDataset::FromHandle(GDALOpenEx(
         (out / "regions.gpkg").string().c_str(), GDAL_OF_VECTOR, nullptr, nullptr, nullptr)));
     REQUIRE(gpkg);
-    CHECK(gpkg->GetLayerCount() == 5);
+    CHECK(gpkg->GetLayerCount() == 6);
     CHECK(gpkg->GetLayerByName("regions_0.25") != nullptr);
+    OGRLayer* styles = gpkg->GetLayerByName("layer_styles");
+    REQUIRE(styles);
+    CHECK(styles->GetFeatureCount() == 5);
     // Bad scales: one line, status 1; --area-ratio is not the sweep's option.
     r = run_cli({"sweep", dem, "-o", (dir / "bad").string(), "-q", "--area-ratios", "0.1,abc"});
     CHECK(r.status == 1);

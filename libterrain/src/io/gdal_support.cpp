@@ -33,8 +33,10 @@ std::unique_ptr<GDALDataset> create_grid_tiff(const Dem& grid, bool with_transfo
         ds->SetGeoTransform(t.data());
     }
     if (!grid.crs_wkt.empty()) {
+        // A planetary CRS as the IAU_2015 CRS of its body, when PROJ holds it.
         OGRSpatialReference srs;
-        if (srs.SetFromUserInput(grid.crs_wkt.c_str()) == OGRERR_NONE) ds->SetSpatialRef(&srs);
+        if (srs.SetFromUserInput(geo::output_crs_wkt(grid.crs_wkt).c_str()) == OGRERR_NONE)
+            ds->SetSpatialRef(&srs);
     }
     return ds;
 }

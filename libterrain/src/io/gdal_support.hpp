@@ -5,15 +5,22 @@
 #include <ogr_spatialref.h>
 
 #include <gdal_priv.h>
+#include <gdal_rat.h>
 
 #include <cstddef>
 #include <memory>
 #include <string>
 
+#include "../geo/iau_crs.hpp"
 #include "../geo/ogr_support.hpp"
 #include "terrain/core/dem.hpp"
+#include "terrain/segment/regions.hpp"
 
 namespace terrain::io {
+
+// The regions' raster attribute table (labels.tif, each band of a sweep's): thematic, one row
+// per region in id order, every property but "fill", and the colour as Red/Green/Blue/Alpha.
+GDALDefaultRasterAttributeTable region_attribute_table(const segment::RegionGraph& graph);
 
 // GDALAllRegister once per process.
 void ensure_gdal_registered();

@@ -4,6 +4,14 @@
 
 namespace terrain::io {
 
+const std::string& local_grid_crs_wkt() {
+    static const std::string wkt =
+        "ENGCRS[\"terrain local grid\",EDATUM[\"unknown\"],CS[Cartesian,2],"
+        "AXIS[\"easting (X)\",east,ORDER[1],LENGTHUNIT[\"metre\",1]],"
+        "AXIS[\"northing (Y)\",north,ORDER[2],LENGTHUNIT[\"metre\",1]]]";
+    return wkt;
+}
+
 GeoJsonFile::GeoJsonFile(std::ostream& out, std::string_view name, const std::string& crs_name,
                          int decimals)
     : out_(out), scale_(std::pow(10.0, decimals)) {

@@ -14,6 +14,11 @@
 
 namespace terrain::io {
 
+// The CRS of a DEM without one: a local engineering CRS (WKT2 ENGCRS, easting and northing
+// in metres, no datum on any body), so that GDAL and its clients read the coordinates as a
+// local grid rather than longitude/latitude. Also the polygons' SRS in GPKG and other formats.
+const std::string& local_grid_crs_wkt();
+
 class GeoJsonFile {
   public:
     // `crs_name`: empty for none (RFC 7946 lon/lat, or coordinates without CRS). Coordinates

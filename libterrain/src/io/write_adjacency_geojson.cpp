@@ -1,4 +1,5 @@
 
+#include "../geo/iau_crs.hpp"
 #include "dataset_files.hpp"
 #include "geojson_file.hpp"
 #include "lonlat_frame.hpp"
@@ -13,7 +14,10 @@ void write_adjacency_geojson(const segment::RegionGraph& graph, const std::strin
         const bool mesh = graph.point_frame == segment::PointFrame::mesh;
         const bool lonlat = graph.point_frame == segment::PointFrame::lonlat;
         // Earth in RFC 7946 lon/lat; other bodies name their geographic CRS, as regions.geojson.
-        const std::string crs = lonlat ? geojson_crs_name(graph.point_crs_wkt) : "";
+        // A DEM without CRS: its local grid, named, so that no reader takes it for WGS 84.
+        const std::string crs =
+            lonlat ? geojson_crs_name(geo::output_crs_wkt(graph.point_crs_wkt))
+                   : (graph.point_frame == segment::PointFrame::map ? local_grid_crs_wkt() : "");
         GeoJsonFile file(out, "adjacency", crs, lonlat ? 9 : 6);
         auto position = [&](JsonWriter& json, const segment::Region& r) {
             if (mesh)

@@ -2,7 +2,12 @@
 #include <gdal_rat.h>
 #include <ogr_spatialref.h>
 
+#include <algorithm>
+#include <array>
+#include <cstdio>
+#include <filesystem>
 #include <memory>
+#include <ostream>
 #include <variant>
 
 #include "dataset_files.hpp"
@@ -14,11 +19,11 @@
 #include "terrain/io/write_label_raster.hpp"
 
 namespace terrain::io {
-namespace {
+namespace {}  // namespace
 
 // One row per region: its attributes (but "fill") and its colour. Thematic, with the id as
 // the value column, so GDAL and QGIS map pixel values to rows.
-GDALDefaultRasterAttributeTable attribute_table(const segment::RegionGraph& graph) {
+GDALDefaultRasterAttributeTable region_attribute_table(const segment::RegionGraph& graph) {
     GDALDefaultRasterAttributeTable rat;
     rat.SetTableType(GRTT_THEMATIC);
     rat.SetRowCount(static_cast<int>(graph.regions.size()));
@@ -59,7 +64,84 @@ GDALDefaultRasterAttributeTable attribute_table(const segment::RegionGraph& grap
     return rat;
 }
 
+namespace {
+
+// The colour table of a UInt16 band: entry i is the colour of region i (0 transparent).
+GDALColorTable colour_table(std::size_t region_count) {
+    GDALColorTable table(GPI_RGB);
+    for (std::size_t id = 0; id <= region_count; ++id) {
+        const auto c = region_colour(static_cast<std::uint32_t>(id));
+        const GDALColorEntry entry{c[0], c[1], c[2], c[3]};
+        table.SetColorEntry(static_cast<int>(id), &entry);
+    }
+    return table;
+}
+
+// Overview factors 2, 4, 8, ... while the reduced grid keeps 64 pixels on its long side.
+std::vector<int> overview_factors(const Dem& dem) {
+    std::vector<int> factors;
+    const int longest = std::max(dem.width, dem.height);
+    for (int f = 2; longest / f >= 64; f *= 2) factors.push_back(f);
+    return factors;
+}
+
+std::string hex_colour(const std::array<std::uint8_t, 4>& c) {
+    char text[8];
+    std::snprintf(text, sizeof text, "#%02x%02x%02x", c[0], c[1], c[2]);
+    return text;
+}
+
+std::string xml_escape(const std::string& s) {
+    std::string out;
+    for (const char ch : s) {
+        switch (ch) {
+            case '&':
+                out += "&amp;";
+                break;
+            case '<':
+                out += "&lt;";
+                break;
+            case '>':
+                out += "&gt;";
+                break;
+            case '"':
+                out += "&quot;";
+                break;
+            default:
+                out += ch;
+        }
+    }
+    return out;
+}
+
+// A QGIS layer style: the paletted renderer, one entry per region in its colour, labelled
+// "<id> <landform>"; QGIS loads <name>.qml with <name>.tif.
+void write_style(std::ostream& out, const segment::RegionGraph& graph) {
+    out << "<!DOCTYPE qgis PUBLIC 'http://mrcc.com/qgis.dtd' 'SYSTEM'>\n"
+           "<qgis version=\"3.22.0\" styleCategories=\"Symbology\">\n"
+           " <pipe>\n"
+           "  <rasterrenderer type=\"paletted\" band=\"1\" opacity=\"1\" "
+           "alphaBand=\"-1\" nodataColor=\"\">\n"
+           "   <rasterTransparency/>\n"
+           "   <colorPalette>\n";
+    for (const auto& region : graph.regions) {
+        const auto c = region_colour(region.id);
+        out << "    <paletteEntry value=\"" << region.id << "\" color=\"" << hex_colour(c)
+            << "\" alpha=\"" << int(c[3]) << "\" label=\""
+            << xml_escape(std::to_string(region.id) + " " + segment::to_string(region.landform))
+            << "\"/>\n";
+    }
+    out << "   </colorPalette>\n"
+           "  </rasterrenderer>\n"
+           " </pipe>\n"
+           "</qgis>\n";
+}
+
 }  // namespace
+
+std::string label_style_path(const std::string& path) {
+    return std::filesystem::path(path).replace_extension(".qml").string();
+}
 
 void write_label_raster(const Dem& dem, const std::vector<std::uint32_t>& pixels,
                         const segment::RegionGraph& graph, const std::string& path,
@@ -68,18 +150,29 @@ void write_label_raster(const Dem& dem, const std::vector<std::uint32_t>& pixels
     ensure_gdal_registered();
     const GdalErrorCapture errors;
     check_output_path(path + ".aux.xml", overwrite);
+    check_output_path(label_style_path(path), overwrite);
+    // UInt16 with a colour table while the ids fit (GeoTIFF holds colour tables for 8 and
+    // 16-bit bands only), UInt32 beyond.
+    const bool sixteen = graph.regions.size() < 65536;
     AtomicOutput output(path, overwrite);
     TemporaryFiles temporary(output);
     std::vector<std::string> files;
     {
         const char* options[] = {"COMPRESS=DEFLATE", "PREDICTOR=2", "TILED=YES", nullptr};
         // A DEM read without geotransform gets the grid terrain used (docs/outputs.md).
-        auto ds =
-            create_grid_tiff(dem, true, output.temp_path(), path, GDT_UInt32, options, errors);
+        auto ds = create_grid_tiff(dem, true, output.temp_path(), path,
+                                   sixteen ? GDT_UInt16 : GDT_UInt32, options, errors);
         GDALRasterBand* band = ds->GetRasterBand(1);
         band->SetNoDataValue(0);
         band->SetDescription("region id");
-        auto rat = attribute_table(graph);
+        if (sixteen) {
+            const auto table = colour_table(graph.regions.size());
+            band->SetColorInterpretation(GCI_PaletteIndex);
+            if (band->SetColorTable(const_cast<GDALColorTable*>(&table)) != CE_None)
+                throw Error("write",
+                            "cannot store the colour table of '" + path + "'" + errors.suffix());
+        }
+        auto rat = region_attribute_table(graph);
         if (band->SetDefaultRAT(&rat) != CE_None)
             throw Error("write",
                         "cannot store the attribute table of '" + path + "'" + errors.suffix());
@@ -87,6 +180,13 @@ void write_label_raster(const Dem& dem, const std::vector<std::uint32_t>& pixels
                            const_cast<std::uint32_t*>(pixels.data()), dem.width, dem.height,
                            GDT_UInt32, 0, 0) != CE_None)
             throw Error("write", "writing '" + path + "' failed" + errors.suffix());
+        // Internal overviews (nearest: every overview pixel is one region's id).
+        const auto factors = overview_factors(dem);
+        const int bands[] = {1};
+        if (!factors.empty() &&
+            ds->BuildOverviews("NEAREST", static_cast<int>(factors.size()), factors.data(), 1,
+                               bands, nullptr, nullptr, nullptr) != CE_None)
+            throw Error("write", "cannot build the overviews of '" + path + "'" + errors.suffix());
         ds->FlushCache();
         files = dataset_files(ds.get());
         close_dataset(ds, path, errors);  // also writes the .aux.xml
@@ -94,6 +194,8 @@ void write_label_raster(const Dem& dem, const std::vector<std::uint32_t>& pixels
     files.push_back(output.temp_path() + ".aux.xml");
     commit_dataset(output, files, overwrite);
     temporary.release();
+    write_file_atomically(label_style_path(path), overwrite,
+                          [&](std::ostream& out) { write_style(out, graph); });
 }
 
 }  // namespace terrain::io

@@ -12,13 +12,23 @@ namespace terrain::io {
 void write_label_stack(const Dem& dem, const std::vector<std::vector<std::uint32_t>>& bands,
                        const std::vector<std::string>& descriptions, const std::string& path,
                        bool overwrite) {
+    write_label_stack(dem, bands, descriptions, {}, path, overwrite);
+}
+
+void write_label_stack(const Dem& dem, const std::vector<std::vector<std::uint32_t>>& bands,
+                       const std::vector<std::string>& descriptions,
+                       const std::vector<const segment::RegionGraph*>& graphs,
+                       const std::string& path, bool overwrite) {
     const auto n = static_cast<std::size_t>(dem.width) * static_cast<std::size_t>(dem.height);
     if (bands.empty() || bands.size() != descriptions.size())
         throw Error("write", "label stack: one description per band is needed");
     for (const auto& b : bands)
         if (b.size() != n) throw Error("write", "label stack: a band does not match the DEM grid");
+    if (!graphs.empty() && graphs.size() != bands.size())
+        throw Error("write", "label stack: one region graph per band is needed");
     ensure_gdal_registered();
     const GdalErrorCapture errors;
+    if (!graphs.empty()) check_output_path(path + ".aux.xml", overwrite);
     AtomicOutput output(path, overwrite);
     TemporaryFiles temporary(output);
     GDALDriver* gtiff = GetGDALDriverManager()->GetDriverByName("GTiff");
@@ -28,7 +38,7 @@ void write_label_stack(const Dem& dem, const std::vector<std::vector<std::uint32
                                                   const_cast<char**>(options)));
     if (!ds) throw Error("write", "cannot create '" + path + "'" + errors.suffix());
     ds->SetGeoTransform(const_cast<double*>(dem.transform.data()));
-    if (!dem.crs_wkt.empty()) ds->SetProjection(dem.crs_wkt.c_str());
+    if (!dem.crs_wkt.empty()) ds->SetProjection(geo::output_crs_wkt(dem.crs_wkt).c_str());
     for (std::size_t i = 0; i < bands.size(); ++i) {
         GDALRasterBand* band = ds->GetRasterBand(static_cast<int>(i + 1));
         band->SetNoDataValue(0);
@@ -37,12 +47,21 @@ void write_label_stack(const Dem& dem, const std::vector<std::vector<std::uint32
                            const_cast<std::uint32_t*>(bands[i].data()), dem.width, dem.height,
                            GDT_UInt32, 0, 0) != CE_None)
             throw Error("write", "writing '" + path + "' failed" + errors.suffix());
+        if (!graphs.empty()) {
+            auto rat = region_attribute_table(*graphs[i]);
+            if (band->SetDefaultRAT(&rat) != CE_None)
+                throw Error("write", "cannot store the attribute table of band " +
+                                         std::to_string(i + 1) + " of '" + path + "'" +
+                                         errors.suffix());
+        }
     }
-    const auto files = dataset_files(ds.get());
+    ds->FlushCache();
+    auto files = dataset_files(ds.get());
     CPLErrorReset();
     ds.reset();
     if (CPLGetLastErrorType() >= CE_Failure)
         throw Error("write", "closing '" + path + "' failed" + errors.suffix());
+    if (!graphs.empty()) files.push_back(output.temp_path() + ".aux.xml");
     commit_dataset(output, files, overwrite);
     temporary.release();
 }

@@ -6,6 +6,7 @@
 #include <memory>
 #include <optional>
 #include <ostream>
+#include <sstream>
 #include <variant>
 
 #include "dataset_files.hpp"
@@ -15,6 +16,7 @@
 #include "region_attributes.hpp"
 #include "terrain/core/error.hpp"
 #include "terrain/io/output_file.hpp"
+#include "terrain/io/region_colour.hpp"
 #include "terrain/io/write_region_polygons.hpp"
 
 namespace terrain::io {
@@ -134,6 +136,83 @@ void write_geojson(std::ostream& out, const std::vector<Geometry>& polygons,
     file.finish();
 }
 
+// A QGIS style for the polygons: a categorized renderer on "id", each region filled with its
+// colour (io::region_colour, the "fill" property) and labelled "<id> <landform>".
+std::string polygon_style_qml(const segment::RegionGraph& graph) {
+    std::ostringstream qml;
+    qml << "<!DOCTYPE qgis PUBLIC 'http://mrcc.com/qgis.dtd' 'SYSTEM'>\n"
+           "<qgis version=\"3.22.0\" styleCategories=\"Symbology\">\n"
+           " <renderer-v2 type=\"categorizedSymbol\" attr=\"id\" symbollevels=\"0\" "
+           "enableorderby=\"0\" forceraster=\"0\">\n  <categories>\n";
+    for (std::size_t i = 0; i < graph.regions.size(); ++i) {
+        const auto& r = graph.regions[i];
+        qml << "   <category value=\"" << r.id << "\" symbol=\"" << i << "\" label=\"" << r.id
+            << ' ' << segment::to_string(r.landform) << "\" render=\"true\"/>\n";
+    }
+    qml << "  </categories>\n  <symbols>\n";
+    for (std::size_t i = 0; i < graph.regions.size(); ++i) {
+        const auto c = region_colour(graph.regions[i].id);
+        qml << "   <symbol type=\"fill\" name=\"" << i
+            << "\" alpha=\"1\" clip_to_extent=\"1\" force_rhr=\"0\">\n"
+               "    <layer class=\"SimpleFill\" enabled=\"1\" locked=\"0\" pass=\"0\">\n"
+               "     <Option type=\"Map\">\n"
+               "      <Option name=\"color\" type=\"QString\" value=\""
+            << int(c[0]) << ',' << int(c[1]) << ',' << int(c[2]) << ",255\"/>\n"
+            << "      <Option name=\"outline_color\" type=\"QString\" value=\"0,0,0,255\"/>\n"
+               "      <Option name=\"outline_width\" type=\"QString\" value=\"0.1\"/>\n"
+               "      <Option name=\"style\" type=\"QString\" value=\"solid\"/>\n"
+               "     </Option>\n    </layer>\n   </symbol>\n";
+    }
+    qml << "  </symbols>\n </renderer-v2>\n</qgis>\n";
+    return qml.str();
+}
+
+// A GeoPackage's layer_styles row for `layer` (the table QGIS reads a layer's default style
+// from, created as QGIS does when missing), with a fixed time so the bytes repeat.
+void add_layer_style(GDALDataset& ds, const std::string& layer, const std::string& qml,
+                     const std::string& path, const GdalErrorCapture& errors) {
+    OGRLayer* styles = ds.GetLayerByName("layer_styles");
+    if (!styles) {
+        styles = ds.CreateLayer("layer_styles", nullptr, wkbNone, nullptr);
+        if (!styles)
+            throw Error("write", "cannot create layer_styles in '" + path + "'" + errors.suffix());
+        const std::pair<const char*, OGRFieldType> fields[] = {{"f_table_catalog", OFTString},
+                                                               {"f_table_schema", OFTString},
+                                                               {"f_table_name", OFTString},
+                                                               {"f_geometry_column", OFTString},
+                                                               {"styleName", OFTString},
+                                                               {"styleQML", OFTString},
+                                                               {"styleSLD", OFTString},
+                                                               {"useAsDefault", OFTInteger},
+                                                               {"description", OFTString},
+                                                               {"owner", OFTString},
+                                                               {"ui", OFTString},
+                                                               {"update_time", OFTDateTime}};
+        for (const auto& [name, type] : fields) {
+            OGRFieldDefn field(name, type);
+            if (std::string(name) == "useAsDefault") field.SetSubType(OFSTBoolean);
+            if (styles->CreateField(&field) != OGRERR_NONE)
+                throw Error("write",
+                            "cannot create layer_styles in '" + path + "'" + errors.suffix());
+        }
+    }
+    OGRFeature row(styles->GetLayerDefn());
+    row.SetField("f_table_catalog", "");
+    row.SetField("f_table_schema", "");
+    row.SetField("f_table_name", layer.c_str());
+    row.SetField("f_geometry_column", "geom");
+    row.SetField("styleName", layer.c_str());
+    row.SetField("styleQML", qml.c_str());
+    row.SetField("styleSLD", "");
+    row.SetField("useAsDefault", 1);
+    row.SetField("description", "region colours (terrain)");
+    row.SetField("owner", "");
+    row.SetField("ui", "");
+    row.SetField("update_time", 2000, 1, 1, 0, 0, 0.0f, 100);
+    if (styles->CreateFeature(&row) != OGRERR_NONE)
+        throw Error("write", "cannot write the style of '" + path + "'" + errors.suffix());
+}
+
 // Any other OGR driver: one layer "regions", MultiPolygon features, every attribute a field.
 std::vector<std::string> write_ogr(GDALDriver& driver, const std::string& temp,
                                    const std::string& path, std::vector<Geometry>& polygons,
@@ -189,6 +268,8 @@ std::vector<std::string> write_ogr(GDALDriver& driver, const std::string& temp,
     }
     if (transaction && ds->CommitTransaction() != OGRERR_NONE)
         throw Error("write", "writing '" + path + "' failed" + errors.suffix());
+    if (std::string(driver.GetDescription()) == "GPKG")
+        add_layer_style(*ds, layer_name, polygon_style_qml(graph), path, errors);
     auto files = dataset_files(ds.get());
     CPLErrorReset();
     CPLSetThreadLocalConfigOption("OGR_CURRENT_DATE", "2000-01-01T00:00:00.000Z");
@@ -233,7 +314,9 @@ void write_polygons(const Dem& dem, std::vector<Geometry> polygons,
 
     if (geojson) {
         // Lon/lat to 1e-9 degree (0.1 mm on Earth); metres to 1e-6.
-        const std::string crs = frame ? geojson_crs_name(frame->wkt()) : "";
+        // A DEM without CRS names a local grid, so that no reader takes it for WGS 84.
+        const std::string crs =
+            frame ? geojson_crs_name(geo::output_crs_wkt(frame->wkt())) : local_grid_crs_wkt();
         write_file_atomically(path, overwrite, [&](std::ostream& out) {
             write_geojson(out, polygons, graph, crs, frame ? 9 : 6);
         });
@@ -241,12 +324,20 @@ void write_polygons(const Dem& dem, std::vector<Geometry> polygons,
     }
     {
         std::unique_ptr<OGRSpatialReference> srs;
+        // A planetary CRS as the IAU_2015 CRS of its body, when PROJ holds it.
         if (frame) {
-            srs.reset(frame->srs().Clone());
+            srs = std::make_unique<OGRSpatialReference>();
+            srs->SetFromUserInput(geo::output_crs_wkt(frame->wkt()).c_str());
+            srs->SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
         } else if (!dem.crs_wkt.empty()) {
             srs = std::make_unique<OGRSpatialReference>();
-            srs->SetFromUserInput(dem.crs_wkt.c_str());
+            srs->SetFromUserInput(geo::output_crs_wkt(dem.crs_wkt).c_str());
             srs->SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+        } else {
+            // No CRS: a local engineering CRS rather than none (GeoPackage's undefined SRS
+            // 0 is a geographic one).
+            srs = std::make_unique<OGRSpatialReference>();
+            srs->SetFromUserInput(local_grid_crs_wkt().c_str());
         }
         if (options.append_layer) {  // the caller makes the whole directory atomic
             write_ogr(*driver, path, path, polygons, graph, srs.get(), errors, options.layer, true);
@@ -262,6 +353,18 @@ void write_polygons(const Dem& dem, std::vector<Geometry> polygons,
 }
 
 }  // namespace
+
+void check_polygon_format(const Dem& dem, const std::string& driver) {
+    if (driver != "KML" && driver != "LIBKML" && driver != "GPX") return;
+    if (!dem.crs_wkt.empty() && dem.body.name == "Earth") return;
+    const std::string where =
+        dem.crs_wkt.empty()
+            ? std::string("the local metres of a DEM without CRS")
+            : "coordinates on " +
+                  (dem.body.name == "unknown" ? std::string("another body") : dem.body.name);
+    throw Error("write", driver + " holds Earth's WGS 84 longitude/latitude only, not " + where +
+                             ": use --format GPKG (or GeoJSON)");
+}
 
 struct RegionPolygons::Impl {
     std::vector<Geometry> geometries;  // by region id - 1; null for a region with no pixel
@@ -289,6 +392,7 @@ void write_region_polygons(const Dem& dem, const std::vector<std::uint32_t>& pix
                            const segment::RegionGraph& graph, const std::string& path,
                            bool overwrite, const RegionPolygonOptions& options) {
     check_grid_size(dem, pixels.size());
+    check_polygon_format(dem, options.driver);
     GDALDriver* driver = polygon_driver(path, overwrite, options);
     const GdalErrorCapture errors;
     write_polygons(dem, polygonize(dem, pixels, graph.regions.size(), errors), graph, path,
@@ -302,6 +406,7 @@ void write_region_polygons(const Dem& dem, const RegionPolygons& polygons,
         throw Error("write", "the polygons were made for " +
                                  std::to_string(polygons.region_count()) +
                                  " regions, the graph has " + std::to_string(graph.regions.size()));
+    check_polygon_format(dem, options.driver);
     GDALDriver* driver = polygon_driver(path, overwrite, options);
     const GdalErrorCapture errors;
     std::vector<Geometry> copy;

@@ -57,6 +57,7 @@ std::vector<std::string> write_segment_outputs(const std::string& dir, const Tri
     for (const auto& name : names) paths.push_back(in_dir(name));
     for (const auto& p : paths) check_output_path(p, options.overwrite);
     if (dem) check_output_path(paths[0] + ".aux.xml", options.overwrite);
+    if (dem) check_output_path(label_style_path(paths[0]), options.overwrite);
 
     const bool overwrite = options.overwrite;
     const double steps = static_cast<double>(paths.size());

@@ -17,6 +17,7 @@
 #include "terrain/io/dependency_versions.hpp"
 #include "terrain/io/mesh_files.hpp"
 #include "terrain/io/write_preview.hpp"
+#include "terrain/io/write_region_polygons.hpp"
 #include "terrain/io/write_segment_outputs.hpp"
 #include "terrain/mesh/dem_to_mesh.hpp"
 
@@ -123,6 +124,22 @@ reeb::SimplifyOptions simplify_options(const SegmentOptions& options, const Tria
     return out;
 }
 
+std::vector<std::string> georeference_warnings(const Dem& dem) {
+    const std::string name = "'" + (dem.source.empty() ? std::string("the DEM") : dem.source) + "'";
+    if (!dem.has_transform) {
+        const double size = std::abs(dem.transform[1]);
+        const bool given = size != 1.0 || std::abs(dem.transform[5]) != 1.0;
+        return {name + " has no geotransform: its pixels are taken as " + (given ? "" : "1 m ") +
+                "squares" + (given ? " of the given --pixel-size" : " (give --pixel-size)") +
+                " and the outputs are in local metres, with no longitude/latitude"};
+    }
+    if (dem.crs_wkt.empty())
+        return {name +
+                " has no CRS: the outputs are in its local map metres, with no "
+                "longitude/latitude"};
+    return {};
+}
+
 field::FieldOptions field_options(const SegmentOptions& o) {
     field::FieldOptions out;
     out.kind = field::parse_field_kind(o.field);
@@ -210,6 +227,8 @@ ScaleResult segment_scale(const Input& input, const reeb::ReebGraph& graph,
 
 SegmentResult segment(Input input, const SegmentOptions& options, const ProgressFn& progress) {
     check_options(options);
+    // A polygon format that cannot hold the DEM's coordinates is refused before any work.
+    if (input.dem) io::check_polygon_format(*input.dem, options.format);
     SegmentResult result;
     result.input = std::move(input);
     result.timings.push_back({"read", result.input.read_seconds});

@@ -200,11 +200,13 @@ std::vector<std::string> write_sweep_directory(SweepResult& result, const Segmen
     if (dem) {
         std::vector<std::vector<std::uint32_t>> bands;
         std::vector<std::string> descriptions;
+        std::vector<const segment::RegionGraph*> graphs;
         for (const auto& s : scales) {
+            graphs.push_back(&s.regions);
             bands.push_back(segment::label_pixels(base.input.mesh, *dem, s.segmentation.labels));
             descriptions.push_back((s.min_area_m2 > 0 ? "min_area=" : "area_ratio=") + s.name);
         }
-        io::write_label_stack(*dem, bands, descriptions, d + "labels.tif", false);
+        io::write_label_stack(*dem, bands, descriptions, graphs, d + "labels.tif", false);
         files.push_back("labels.tif");
         report_progress(progress, 0.2);
         // Each scale polygonized once; then the GeoPackage's layers one after the other,

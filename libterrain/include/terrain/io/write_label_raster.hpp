@@ -13,11 +13,16 @@
 
 namespace terrain::io {
 
-// `pixels`: segment::label_pixels() of the DEM (row-major, 0 = no region). A UInt32 GeoTIFF
-// on the DEM's exact grid, NoData 0, with a raster attribute table (one row per region: its
-// properties and its colour, io::region_colour, as Red/Green/Blue/Alpha columns) that GDAL
-// keeps in `path`.aux.xml beside it (GeoTIFF holds colour tables for 8 and 16-bit bands only).
+// `pixels`: segment::label_pixels() of the DEM (row-major, 0 = no region). A GeoTIFF on the
+// DEM's exact grid, NoData 0: UInt16 with a colour table (entry i the colour of region i,
+// io::region_colour) below 65536 regions, UInt32 beyond (GeoTIFF holds colour tables for 8
+// and 16-bit bands only); internal overviews (nearest) down to 64 pixels on the long side; a
+// raster attribute table (one row per region: its properties and its colour as
+// Red/Green/Blue/Alpha columns) that GDAL keeps in `path`.aux.xml beside it (GeoTIFF has no
+// attribute tables); and a QGIS style, label_style_path(path), with the region colours.
 void write_label_raster(const Dem& dem, const std::vector<std::uint32_t>& pixels,
                         const segment::RegionGraph& graph, const std::string& path, bool overwrite);
+// The QGIS style beside a label raster: `path` with the extension .qml (labels.qml).
+std::string label_style_path(const std::string& path);
 
 }  // namespace terrain::io

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "terrain/core/dem.hpp"
+#include "terrain/segment/regions.hpp"
 
 namespace terrain::io {
 
@@ -16,5 +17,11 @@ namespace terrain::io {
 void write_label_stack(const Dem& dem, const std::vector<std::vector<std::uint32_t>>& bands,
                        const std::vector<std::string>& descriptions, const std::string& path,
                        bool overwrite);
+// The same with each band's raster attribute table (`graphs[i]` describes band i; as
+// labels.tif's, docs/outputs.md), which GDAL keeps in `path`.aux.xml beside the GeoTIFF.
+void write_label_stack(const Dem& dem, const std::vector<std::vector<std::uint32_t>>& bands,
+                       const std::vector<std::string>& descriptions,
+                       const std::vector<const segment::RegionGraph*>& graphs,
+                       const std::string& path, bool overwrite);
 
 }  // namespace terrain::io

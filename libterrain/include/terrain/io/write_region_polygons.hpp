@@ -24,6 +24,14 @@ struct RegionPolygonOptions {
     bool append_layer = false;
 };
 
+// Refuses (terrain::Error, stage "write", one line naming the format to use) a driver that
+// cannot hold the DEM's coordinates: KML, LIBKML and GPX store WGS 84 longitude/latitude
+// only, so a DEM on another body, or without CRS, cannot be written to them (their readers
+// would take the body's coordinates, or local metres, for Earth's). Earth DEMs are
+// reprojected to WGS 84 by those drivers. Called by write_region_polygons; callers check it
+// before long work.
+void check_polygon_format(const Dem& dem, const std::string& driver);
+
 // One feature per region (Polygon, MultiPolygon where its pixels touch only at corners; null
 // when it has no pixel) made with GDALPolygonize, with the region's properties. `pixels`:
 // segment::label_pixels() of the DEM (row-major, 0 = no region). A DEM without CRS gives its

@@ -83,6 +83,12 @@ double parse_area(const std::string& text, const std::string& option = "--min-ar
 // The simplification thresholds applied on `mesh`: options.simplify, with the area ratio
 // given by options.min_area when it is set.
 reeb::SimplifyOptions simplify_options(const SegmentOptions& options, const TriangleMesh& mesh);
+
+// What the caller should tell the user, once, about a DEM's georeference before segmenting
+// it (the library never prints): a raster with no geotransform (an image: its pixels are
+// taken as squares of the --pixel-size, 1 m by default) or no CRS (the outputs are in
+// local map metres, with no longitude/latitude). Empty for a georeferenced DEM.
+std::vector<std::string> georeference_warnings(const Dem& dem);
 // The field library's options.
 field::FieldOptions field_options(const SegmentOptions& options);
 // The cost `auto` resolves to: graph for a DEM, standard for a mesh file.
