@@ -9,12 +9,24 @@ namespace terrain::test {
 
 CliResult run_limited(const std::vector<std::string>& args, int seconds, int memory_mb) {
     const char* override_cli = std::getenv("TERRAIN_TEST_CLI");
+#ifdef TERRAIN_SANITIZE
+    // AddressSanitizer reserves terabytes of address space for its shadow memory, so an
+    // address-space limit stops it at start: its own resident-memory limit bounds the run.
+    std::vector<std::string> all = {
+        "-s",
+        "KILL",
+        std::to_string(seconds),
+        "env",
+        "ASAN_OPTIONS=detect_leaks=0:hard_rss_limit_mb=" + std::to_string(memory_mb),
+        override_cli ? override_cli : TERRAIN_CLI};
+#else
     std::vector<std::string> all = {"-s",
                                     "KILL",
                                     std::to_string(seconds),
                                     "prlimit",
                                     "--as=" + std::to_string(std::int64_t(memory_mb) << 20),
                                     override_cli ? override_cli : TERRAIN_CLI};
+#endif
     all.insert(all.end(), args.begin(), args.end());
     return run_program("timeout", all);
 }
