@@ -38,7 +38,7 @@ int run_segment(int argc, char** argv) {
         auto input = load_input(common.input, input_values, scaled_progress(progress, 0, 0.15));
         check_field_limits(field_values.options, input.mesh);  // --radius against the mesh
         print_input_warnings("segment", input);
-        auto result = pipeline::segment(to_pipeline_input(std::move(input)), segment_options,
+        auto result = pipeline::segment(std::move(input), segment_options,
                                         scaled_progress(progress, 0.15, 0.7));
         pipeline::WriteOptions write;
         write.release_memory = true;

@@ -61,11 +61,10 @@ int run_sweep(int argc, char** argv) {
         auto input = load_input(common.input, input_values, scaled_progress(progress, 0, 0.15));
         check_field_limits(field_values.options, input.mesh);  // --radius against the mesh
         print_input_warnings("sweep", input);
-        auto result = by_area
-                          ? pipeline::sweep(to_pipeline_input(std::move(input)), areas,
-                                            segment_options, scaled_progress(progress, 0.15, 0.75))
-                          : pipeline::sweep(to_pipeline_input(std::move(input)), ratios,
-                                            segment_options, scaled_progress(progress, 0.15, 0.75));
+        auto result = by_area ? pipeline::sweep(std::move(input), areas, segment_options,
+                                                scaled_progress(progress, 0.15, 0.75))
+                              : pipeline::sweep(std::move(input), ratios, segment_options,
+                                                scaled_progress(progress, 0.15, 0.75));
         pipeline::write_sweep_directory(result, segment_options, common.input, dir.temp_path(),
                                         scaled_progress(progress, 0.75, 0.99));
         dir.commit();

@@ -1,10 +1,7 @@
 #include "input.hpp"
 
-#include <chrono>
-
 #include "terrain/core/error.hpp"
 #include "terrain/io/mesh_files.hpp"
-#include "terrain/mesh/dem_to_mesh.hpp"
 
 namespace terrain::cli {
 namespace {
@@ -25,35 +22,16 @@ void add_input_options(po::options_description& options, InputOptionValues& valu
 
 Input load_input(const std::string& path, const InputOptionValues& values,
                  const ProgressFn& progress) {
-    Input input;
-    using clock = std::chrono::steady_clock;
-    const auto t0 = clock::now();
-    auto seconds = [](clock::time_point a, clock::time_point b) {
-        return std::chrono::duration<double>(b - a).count();
-    };
-    if (io::is_mesh_file(path)) {
-        to_read_options(values.dem);  // checks the values, sets --max-memory
-        io::ReadMeshOptions read_options;
-        read_options.repair = values.repair;
-        input.mesh = io::read_mesh(path, read_options, progress);
-        input.read_seconds = seconds(t0, clock::now());
-        return input;
+    pipeline::InputOptions options;
+    options.dem = to_read_options(values.dem);  // checks the values, sets --max-memory
+    options.dem.planned_bytes_per_pixel = kPipelineBytesPerPixel;
+    options.repair = values.repair;
+    if (!io::is_mesh_file(path)) {
+        if (values.frame != "body" && values.frame != "map" && values.frame != "auto")
+            throw Error("options", "--frame must be body, map or auto, not '" + values.frame + "'");
+        options.frame = values.frame;
     }
-    mesh::DemToMeshOptions mesh_options;
-    if (values.frame == "body")
-        mesh_options.frame = MeshFrame::body;
-    else if (values.frame == "map")
-        mesh_options.frame = MeshFrame::map;
-    else if (values.frame != "auto")
-        throw Error("options", "--frame must be body, map or auto, not '" + values.frame + "'");
-    auto read_options = to_read_options(values.dem);
-    read_options.planned_bytes_per_pixel = kPipelineBytesPerPixel;
-    input.dem = io::read_dem(path, read_options, scaled_progress(progress, 0, 0.3));
-    const auto t1 = clock::now();
-    input.read_seconds = seconds(t0, t1);
-    input.mesh = mesh::dem_to_mesh(*input.dem, mesh_options, scaled_progress(progress, 0.3, 1));
-    input.mesh_seconds = seconds(t1, clock::now());
-    return input;
+    return pipeline::load_input(path, options, progress);
 }
 
 }  // namespace terrain::cli

@@ -7,7 +7,7 @@
 
 #include "cli.hpp"
 #include "dem_options.hpp"
-#include "terrain/mesh/triangle_mesh.hpp"
+#include "terrain/pipeline/segment.hpp"
 
 namespace terrain::cli {
 
@@ -20,13 +20,11 @@ struct InputOptionValues {
 // Adds the DEM options plus --frame and --repair.
 void add_input_options(po::options_description& options, InputOptionValues& values);
 
-struct Input {
-    std::optional<Dem> dem;  // set for DEM input
-    TriangleMesh mesh;
-    double read_seconds = 0, mesh_seconds = 0;  // wall time of reading and triangulating
-};
+using Input = pipeline::Input;
 
-// Reads `path` as a mesh file (.off/.ply/.obj) or a DEM and builds the mesh.
+// Reads `path` as a mesh file (.off/.ply/.obj) or a DEM and builds the mesh
+// (pipeline::load_input, with the options checked and the DEM's memory planned for the
+// pipeline's stages).
 Input load_input(const std::string& path, const InputOptionValues& values,
                  const ProgressFn& progress);
 

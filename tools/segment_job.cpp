@@ -45,15 +45,6 @@ pipeline::SegmentOptions to_pipeline_options(const FieldOptionValues& field,
     return out;
 }
 
-pipeline::Input to_pipeline_input(Input input) {
-    pipeline::Input out;
-    out.dem = std::move(input.dem);
-    out.mesh = std::move(input.mesh);
-    out.read_seconds = input.read_seconds;
-    out.mesh_seconds = input.mesh_seconds;
-    return out;
-}
-
 void print_input_warnings(const char* command, const Input& input) {
     if (!input.dem) return;
     for (const auto& w : pipeline::georeference_warnings(*input.dem))

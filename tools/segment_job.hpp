@@ -32,9 +32,6 @@ void check_one_area_threshold(const po::variables_map& vm, const std::string& ar
 pipeline::SegmentOptions to_pipeline_options(const FieldOptionValues& field,
                                              const SegmentOptionValues& values);
 
-// The input loaded by load_input, for the pipeline.
-pipeline::Input to_pipeline_input(Input input);
-
 // The input's georeference warnings (pipeline::georeference_warnings), one line each on
 // stderr: "terrain <command>: warning: ...".
 void print_input_warnings(const char* command, const Input& input);
