@@ -12,6 +12,7 @@
 #include "dataset_files.hpp"
 #include "gdal_support.hpp"
 #include "geojson_file.hpp"
+#include "global_outline.hpp"
 #include "lonlat_frame.hpp"
 #include "region_attributes.hpp"
 #include "terrain/core/error.hpp"
@@ -73,14 +74,16 @@ std::vector<Geometry> polygonize(const Dem& dem, const std::vector<std::uint32_t
     return out;
 }
 
-// Every ring to lon/lat (when `frame`), exterior rings counter-clockwise and holes clockwise
-// (RFC 7946).
-void prepare_rings(OGRGeometry& g, const LonLatFrame* frame) {
+// Every ring to lon/lat (when `frame`; through `global` for a global grid), exterior rings
+// counter-clockwise and holes clockwise (RFC 7946).
+void prepare_rings(OGRGeometry& g, const LonLatFrame* frame, const GlobalOutline* global) {
     auto polygon_rings = [&](OGRPolygon& polygon) {
         for (int k = 0; k < polygon.getNumInteriorRings() + 1; ++k) {
             OGRLinearRing* ring =
                 k == 0 ? polygon.getExteriorRing() : polygon.getInteriorRing(k - 1);
-            if (frame) {
+            if (frame && global) {
+                global->to_lonlat(*ring);
+            } else if (frame) {
                 const int n = ring->getNumPoints();
                 std::vector<double> x(static_cast<std::size_t>(n)), y(x.size());
                 ring->getPoints(x.data(), sizeof(double), y.data(), sizeof(double));
@@ -309,8 +312,10 @@ void write_polygons(const Dem& dem, std::vector<Geometry> polygons,
     const bool geojson = driver == nullptr;
     std::optional<LonLatFrame> frame;
     if (!dem.crs_wkt.empty() && (geojson || options.lonlat)) frame.emplace(dem, "write");
+    std::optional<GlobalOutline> global;
+    if (frame && GlobalOutline::applies(dem)) global.emplace(dem, *frame);
     for (auto& g : polygons)
-        if (g) prepare_rings(*g, frame ? &*frame : nullptr);
+        if (g) prepare_rings(*g, frame ? &*frame : nullptr, global ? &*global : nullptr);
 
     if (geojson) {
         // Lon/lat to 1e-9 degree (0.1 mm on Earth); metres to 1e-6.
