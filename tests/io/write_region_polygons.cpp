@@ -509,6 +509,30 @@ TEST_CASE("regions.geojson of a global grid: split at the seam, poles closed, ar
             CHECK(e.MaxX == c.west + 360);
             CHECK(e.MaxY == 90);
             CHECK(e.MinY == Approx(80).margin(1e-6));
+
+            // A GeoPackage in the DEM's own CRS: lon/lat for a lon/lat grid, else taken to
+            // lon/lat by a client that keeps the grid's longitude range (PROJ's +lon_wrap)
+            // and puts a vertex every pixel along the edges first: the same checks pass.
+            io::RegionPolygonOptions gpkg;
+            gpkg.driver = "GPKG";
+            const auto gpkg_path = (dir / "regions.gpkg").string();
+            io::write_region_polygons(t.dem, t.pixels, t.graph, gpkg_path, true, gpkg);
+            auto map = read_features(gpkg_path);
+            if (!map.layer->GetSpatialRef()->IsGeographic()) {
+                OGRSpatialReference lonlat;
+                lonlat.SetFromUserInput(("+proj=longlat +R=" + std::to_string(R) + " +lon_wrap=" +
+                                         std::to_string(c.west + 180) + " +no_defs +type=crs")
+                                            .c_str());
+                lonlat.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+                std::unique_ptr<OGRCoordinateTransformation> ct(
+                    OGRCreateCoordinateTransformation(map.layer->GetSpatialRef(), &lonlat));
+                REQUIRE(ct);
+                for (auto& f : map.features) {
+                    f->GetGeometryRef()->segmentize(step);
+                    REQUIRE(f->GetGeometryRef()->transform(ct.get()) == 0);
+                }
+            }
+            check_global(map, t, c.west);
         }
     }
 }

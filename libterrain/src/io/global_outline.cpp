@@ -32,20 +32,29 @@ GlobalOutline::GlobalOutline(const Dem& dem, const LonLatFrame& frame) : dem_(de
     auto [x, y] = dem.map_xy(dem.width / 2.0, dem.height / 2.0);
     if (!frame.transform(1, &x, &y)) throw Error("write", "the DEM's centre has no longitude");
     west_ = x - 180.0;
+    map_srs_ = std::make_unique<OGRSpatialReference>();
+    if (map_srs_->SetFromUserInput(dem.crs_wkt.c_str()) != OGRERR_NONE)
+        throw Error("write", "cannot read the DEM's CRS");
+    map_srs_->SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+    geographic_ = map_srs_->IsGeographic();
+    if (!geographic_) {
+        to_map_.reset(OGRCreateCoordinateTransformation(&frame.srs(), map_srs_.get()));
+        if (!to_map_) throw Error("write", "cannot transform lon/lat to the DEM's CRS");
+    }
 }
 
-void GlobalOutline::to_lonlat(OGRLinearRing& ring) const {
+GlobalOutline::Corners GlobalOutline::corners(const OGRLinearRing& ring, bool densify) const {
     const int n = ring.getNumPoints();
-    if (n == 0) return;
+    Corners out;
+    auto& [col, row, lon, lat] = out;
     // Pixel coordinates, with every pixel corner along a row between two vertices on it.
-    std::vector<double> col, row;
     col.reserve(static_cast<std::size_t>(n));
     row.reserve(static_cast<std::size_t>(n));
     for (int i = 0; i < n; ++i) {
         const double x = ring.getX(i), y = ring.getY(i);
         const double c = corner(inverse_[0] + x * inverse_[1] + y * inverse_[2]);
         const double r = corner(inverse_[3] + x * inverse_[4] + y * inverse_[5]);
-        if (i > 0 && r == row.back() && r == std::round(r)) {
+        if (densify && i > 0 && r == row.back() && r == std::round(r)) {
             const double c0 = col.back();
             const int steps = static_cast<int>(std::abs(c - c0));
             const double step = c > c0 ? 1.0 : -1.0;
@@ -58,7 +67,8 @@ void GlobalOutline::to_lonlat(OGRLinearRing& ring) const {
         row.push_back(r);
     }
     const std::size_t m = col.size();
-    std::vector<double> lon(m), lat(m);
+    lon.resize(m);
+    lat.resize(m);
     for (std::size_t i = 0; i < m; ++i) {
         const auto xy = dem_.map_xy(col[i], row[i]);
         lon[i] = xy[0];
@@ -82,7 +92,46 @@ void GlobalOutline::to_lonlat(OGRLinearRing& ring) const {
             lat[i] = std::copysign(90.0, lat[i]);
         lat[i] = std::clamp(lat[i], -90.0, 90.0);
     }
-    ring.setPoints(static_cast<int>(m), lon.data(), lat.data());
+    return out;
+}
+
+void GlobalOutline::to_lonlat(OGRLinearRing& ring) const {
+    if (ring.getNumPoints() == 0) return;
+    auto c = corners(ring, true);
+    ring.setPoints(static_cast<int>(c.lon.size()), c.lon.data(), c.lat.data());
+}
+
+void GlobalOutline::to_map(OGRLinearRing& ring) const {
+    if (ring.getNumPoints() == 0) return;
+    // In a geographic CRS the map coordinates are lon/lat: the rows densified as there.
+    const auto c = corners(ring, geographic_);
+    const std::size_t m = c.col.size();
+    std::vector<double> x(m), y(m);
+    const double W = dem_.width, H = dem_.height;
+    for (std::size_t k = 0; k < m; ++k) {
+        const auto xy = dem_.map_xy(c.col[k], c.row[k]);
+        x[k] = xy[0];
+        y[k] = xy[1];
+        const bool seam = c.col[k] == 0 || c.col[k] == W;
+        const bool pole = (c.row[k] == 0 || c.row[k] == H) && std::abs(c.lat[k]) == 90.0;
+        if (!seam && !pole) continue;
+        if (geographic_) {
+            // The seam 360 degrees apart.
+            const double west = dem_.transform[0];
+            if (seam) x[k] = c.col[k] == 0 ? west : west + 360.0;
+            if (pole) y[k] = c.lat[k];
+            continue;
+        }
+        const double inside = 1e-9;
+        double lon = seam ? (c.col[k] == 0 ? west_ + inside : west_ + 360.0 - inside) : c.lon[k];
+        double lat = c.lat[k];
+        int ok = 0;
+        if (!to_map_->Transform(1, &lon, &lat, nullptr, &ok) || !ok)
+            throw Error("write", "the seam or a pole of the DEM has no map coordinates");
+        if (seam) x[k] = lon;
+        if (pole) y[k] = lat;
+    }
+    ring.setPoints(static_cast<int>(m), x.data(), y.data());
 }
 
 }  // namespace terrain::io

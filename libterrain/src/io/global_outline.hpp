@@ -6,6 +6,10 @@
 // beyond a pole. See docs/outputs.md, "Global grids".
 
 #include <ogr_geometry.h>
+#include <ogr_spatialref.h>
+
+#include <memory>
+#include <vector>
 
 #include "lonlat_frame.hpp"
 #include "terrain/core/dem.hpp"
@@ -30,11 +34,27 @@ class GlobalOutline {
     // within +-90 and a pole row's outer edge at the pole.
     void to_lonlat(OGRLinearRing& ring) const;
 
+    // The same ring kept in the DEM's map coordinates: the seam columns and the pole rows
+    // move onto the seam (a nanodegree inside it in a projected CRS, whose inverse would put
+    // the seam itself at either end) and onto the pole; in a geographic CRS, whose map
+    // coordinates are lon/lat, the rows get a vertex at every pixel corner as there.
+    void to_map(OGRLinearRing& ring) const;
+
   private:
+    struct Corners {
+        std::vector<double> col, row, lon, lat;
+    };
+    // The ring's vertices as pixel corners (with every corner along a row when `densify`),
+    // their lon/lat on the seam and within +-90.
+    Corners corners(const OGRLinearRing& ring, bool densify) const;
+
     const Dem& dem_;
     const LonLatFrame& frame_;
     double inverse_[6] = {};
     double west_ = 0;
+    bool geographic_ = false;
+    std::unique_ptr<OGRSpatialReference> map_srs_;
+    std::unique_ptr<OGRCoordinateTransformation> to_map_;  // lon/lat -> a projected CRS
 };
 
 }  // namespace terrain::io

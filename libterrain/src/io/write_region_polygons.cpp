@@ -74,15 +74,19 @@ std::vector<Geometry> polygonize(const Dem& dem, const std::vector<std::uint32_t
     return out;
 }
 
-// Every ring to lon/lat (when `frame`; through `global` for a global grid), exterior rings
-// counter-clockwise and holes clockwise (RFC 7946).
+// Every ring to lon/lat (when `frame`), through `global` for a global grid (its seam and
+// poles also in map coordinates), exterior rings counter-clockwise and holes clockwise
+// (RFC 7946).
 void prepare_rings(OGRGeometry& g, const LonLatFrame* frame, const GlobalOutline* global) {
     auto polygon_rings = [&](OGRPolygon& polygon) {
         for (int k = 0; k < polygon.getNumInteriorRings() + 1; ++k) {
             OGRLinearRing* ring =
                 k == 0 ? polygon.getExteriorRing() : polygon.getInteriorRing(k - 1);
-            if (frame && global) {
-                global->to_lonlat(*ring);
+            if (global) {
+                if (frame)
+                    global->to_lonlat(*ring);
+                else
+                    global->to_map(*ring);
             } else if (frame) {
                 const int n = ring->getNumPoints();
                 std::vector<double> x(static_cast<std::size_t>(n)), y(x.size());
@@ -312,8 +316,13 @@ void write_polygons(const Dem& dem, std::vector<Geometry> polygons,
     const bool geojson = driver == nullptr;
     std::optional<LonLatFrame> frame;
     if (!dem.crs_wkt.empty() && (geojson || options.lonlat)) frame.emplace(dem, "write");
+    // A global grid's seam and poles, in lon/lat or in the DEM's map coordinates.
+    std::optional<LonLatFrame> global_frame;
     std::optional<GlobalOutline> global;
-    if (frame && GlobalOutline::applies(dem)) global.emplace(dem, *frame);
+    if (GlobalOutline::applies(dem)) {
+        if (!frame) global_frame.emplace(dem, "write");
+        global.emplace(dem, frame ? *frame : *global_frame);
+    }
     for (auto& g : polygons)
         if (g) prepare_rings(*g, frame ? &*frame : nullptr, global ? &*global : nullptr);
 
