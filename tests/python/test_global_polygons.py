@@ -193,3 +193,38 @@ def test_ldem4_polygons_valid_within_range_and_give_their_pixels_back(ldem4_out)
         assert area == pytest.approx(want, rel=1e-3), f["id"]
         total += area
     assert total == pytest.approx(body, rel=5e-3)
+
+
+def test_ldem4_gpkg_to_lonlat_as_documented(cli, ldem4_out, monkeypatch):
+    """regions.gpkg stays in LDEM_4's CRS; docs/outputs.md's to_crs with +lon_wrap takes it
+    to 0..360 lon/lat whole: valid, and rasterised it gives labels.tif back."""
+    import re
+
+    import numpy as np
+    import rasterio
+    from rasterio.features import rasterize
+    from rasterio.transform import from_origin
+
+    from conftest import SOURCE_DIR
+
+    work = ldem4_out.parent / "gpkg"
+    work.mkdir()
+    ldem = SOURCE_DIR.parent / "shared" / "data" / "moon_lola_ldem4" / "LDEM_4.LBL"
+    done = cli("segment", ldem, "-o", work / "out", "-q", "--format", "GPKG")
+    assert done.returncode == 0, done.stderr
+    text = (SOURCE_DIR / "docs" / "outputs.md").read_text()
+    blocks = [b for b in re.findall(r"```python\n(.*?)```", text, re.S) if "lon_wrap" in b]
+    assert len(blocks) == 1
+    lines = blocks[0].splitlines()
+    indent = min(len(l) - len(l.lstrip()) for l in lines if l.strip())
+    monkeypatch.chdir(work)
+    scope = {}
+    exec("\n".join(l[indent:] for l in lines), scope)
+    lonlat = scope["lonlat"]
+    assert lonlat.geometry.is_valid.all()
+    minx, miny, maxx, maxy = lonlat.total_bounds
+    assert 0 <= minx < 1e-6 and 360 - 1e-6 < maxx <= 360 and (miny, maxy) == (-90, 90)
+    labels = rasterio.open(work / "out" / "labels.tif").read(1)
+    burnt = rasterize(zip(lonlat.geometry, lonlat["id"]), out_shape=labels.shape,
+                      transform=from_origin(0, 90, 0.25, 0.25), fill=0, dtype="uint32")
+    assert np.array_equal(burnt, labels)
