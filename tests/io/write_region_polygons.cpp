@@ -12,6 +12,7 @@
 #include "support/segment_support.hpp"
 #include "support/test_support.hpp"
 #include "terrain/core/error.hpp"
+#include "terrain/geo/georeference.hpp"
 #include "terrain/io/read_dem.hpp"
 #include "terrain/io/write_region_polygons.hpp"
 
@@ -321,4 +322,230 @@ TEST_CASE("regions.gpkg keeps the DEM's full CRS, the same bytes every run",
     CHECK_THROWS_AS(io::write_region_polygons(t.dem, t.pixels, t.graph, (dir / "x.shp").string(),
                                               false, options),
                     Error);
+}
+
+namespace {
+
+// A 1-degree global Moon grid (360 x 180, smooth relief) in `crs` with the geotransform `t`.
+Dem global_grid(const std::string& crs, const GeoTransform& t) {
+    Dem dem;
+    dem.width = 360;
+    dem.height = 180;
+    dem.crs_wkt = crs;
+    dem.transform = t;
+    dem.has_transform = true;
+    geo::georeference(dem);
+    for (int r = 0; r < dem.height; ++r)
+        for (int c = 0; c < dem.width; ++c)
+            dem.values.push_back(1000 * std::sin(c * 0.05) * std::cos(r * 0.07));
+    return dem;
+}
+
+// Regions that cross the seam (between the last and first column), the middle column, both
+// poles, with pieces touching across the seam at a corner, a hole at the seam, Voronoi
+// cells elsewhere.
+// (Given in 1-degree cells of column and row; a finer grid scales them.)
+std::function<std::uint32_t(int, int)> global_labels(const Dem& dem) {
+    const auto cells = test::voronoi_cells(dem, 6, 3);
+    const int w = dem.width, h = dem.height;
+    return [cells, w, h](int x, int y) -> std::uint32_t {
+        const int col = x * 360 / w, row = y * 180 / h;
+        if (row < 10) return 1;                                 // north cap, all the way round
+        if (row >= 170) return col >= 20 && col < 190 ? 2 : 3;  // south: 3 crosses the seam
+        if (row >= 40 && row < 60 && (col >= 350 || col < 10)) return 4;  // across the seam
+        if (row >= 40 && row < 60 && col >= 170 && col < 190) return 5;   // across column 180
+        if (row >= 100 && row < 130 && (col >= 340 || col < 20))
+            return row >= 110 && row < 120 && (col >= 355 || col < 5) ? 6 : 7;  // 6 in 7
+        if ((col == 359 && row == 80) || (col == 0 && row == 81)) return 8;     // corner pieces
+        return 8 + cells(x, y);
+    };
+}
+
+// Every ring of a lon/lat geometry.
+void for_each_ring(const OGRGeometry& g, const std::function<void(const OGRLinearRing&)>& fn) {
+    auto polygon = [&](const OGRPolygon& p) {
+        fn(*p.getExteriorRing());
+        for (int k = 0; k < p.getNumInteriorRings(); ++k) fn(*p.getInteriorRing(k));
+    };
+    if (wkbFlatten(g.getGeometryType()) == wkbPolygon)
+        polygon(*g.toPolygon());
+    else
+        for (const auto* p : *g.toMultiPolygon()) polygon(*p);
+}
+
+// The geodesic area of a lon/lat geometry from its own vertices (as a client computes it),
+// the sum of its rings' signed areas. Known modulo the body's area only (a region round
+// both poles reads as minus what it leaves out): resolved to the value nearest `expected`.
+double geodesic_area_near(const OGRGeometry& g, const GeographicLib::Geodesic& geodesic,
+                          double expected) {
+    double sum = 0;
+    for_each_ring(g, [&](const OGRLinearRing& ring) {
+        GeographicLib::PolygonArea polygon(geodesic);
+        for (int i = 0; i + 1 < ring.getNumPoints(); ++i)
+            polygon.AddPoint(ring.getY(i), ring.getX(i));
+        double perimeter = 0, area = 0;
+        polygon.Compute(false, true, perimeter, area);
+        sum += area;
+    });
+    const double whole = geodesic.EllipsoidArea();
+    return sum + whole * std::round((expected - sum) / whole);
+}
+
+// The area of each label's pixels on the body, a sphere here: the pixels of a global grid
+// as it means them, rows of 180/height degrees from pole to pole, of 360/width degrees each.
+std::vector<double> pixel_areas_by_label(const test::SegmentedTile& t) {
+    const double R = t.dem.body.semi_major_axis, degree = std::acos(-1.0) / 180;
+    std::vector<double> area(t.region_count + 1, 0.0);
+    for (int row = 0; row < t.dem.height; ++row) {
+        const double north = 90 - row * 180.0 / t.dem.height;
+        const double south = 90 - (row + 1) * 180.0 / t.dem.height;
+        const double pixel = R * R * (360.0 / t.dem.width * degree) *
+                             (std::sin(north * degree) - std::sin(south * degree));
+        for (int col = 0; col < t.dem.width; ++col) area[t.pixels[t.dem.index(col, row)]] += pixel;
+    }
+    return area;
+}
+
+// The checks every global grid's polygons must pass: valid, within the longitude range
+// [west, west + 360] and +-90, no piece wider than 180 degrees but a pole cap, areas on the
+// body those of the pixels (together the body's), and each pixel centre in its region.
+void check_global(const Read& r, const test::SegmentedTile& t, double west, int stride = 1) {
+    REQUIRE(r.features.size() == t.region_count);
+    const GeographicLib::Geodesic geodesic(t.dem.body.semi_major_axis, 0);
+    const auto expected = pixel_areas_by_label(t);
+    double sum = 0;
+    int invalid = 0, out_of_range = 0, wide = 0, area_off = 0;
+    for (std::size_t i = 0; i < r.features.size(); ++i) {
+        const OGRGeometry* g = r.features[i]->GetGeometryRef();
+        REQUIRE(g);
+        if (!g->IsValid()) ++invalid;
+        const auto* multi =
+            wkbFlatten(g->getGeometryType()) == wkbMultiPolygon ? g->toMultiPolygon() : nullptr;
+        const int parts = multi ? multi->getNumGeometries() : 1;
+        for (int k = 0; k < parts; ++k) {
+            const OGRGeometry* part = multi ? multi->getGeometryRef(k) : g;
+            OGREnvelope e;
+            part->getEnvelope(&e);
+            if (e.MinX < west || e.MaxX > west + 360 || e.MinY < -90 || e.MaxY > 90) ++out_of_range;
+            const bool pole = e.MaxY == 90 || e.MinY == -90;
+            if (e.MaxX - e.MinX > 180 && !pole) ++wide;
+        }
+        const auto id = static_cast<std::uint32_t>(t.graph.regions[i].id);
+        const double pixels = expected[id];
+        const double area = geodesic_area_near(*g, geodesic, pixels);
+        if (std::abs(area - pixels) > 1e-3 * pixels) {
+            ++area_off;
+            UNSCOPED_INFO("region " << id << ": " << area << " m2 on the body, pixels " << pixels);
+        }
+        sum += area;
+    }
+    CHECK(invalid == 0);
+    CHECK(out_of_range == 0);
+    CHECK(wide == 0);
+    CHECK(area_off == 0);
+    const double body = geodesic.EllipsoidArea();
+    CHECK(std::abs(sum - body) < 0.005 * body);
+    // Every pixel centre (every `stride`th) lies in its own region, at its longitude in the
+    // output range.
+    std::vector<std::unique_ptr<OGRPreparedGeometry, void (*)(OGRPreparedGeometry*)>> prepared;
+    for (const auto& f : r.features)
+        prepared.emplace_back(OGRCreatePreparedGeometry(f->GetGeometryRef()),
+                              OGRDestroyPreparedGeometry);
+    int misplaced = 0;
+    for (int row = 0; row < t.dem.height; row += stride)
+        for (int col = 0; col < t.dem.width; col += stride) {
+            const auto label = t.pixels[t.dem.index(col, row)];
+            OGRPoint centre(west + (col + 0.5) * 360.0 / t.dem.width,
+                            90 - (row + 0.5) * 180.0 / t.dem.height);
+            if (label == 0 || !OGRPreparedGeometryContains(prepared[label - 1].get(),
+                                                           OGRGeometry::ToHandle(&centre)))
+                ++misplaced;
+        }
+    CHECK(misplaced == 0);
+}
+
+}  // namespace
+
+TEST_CASE("regions.geojson of a global grid: split at the seam, poles closed, areas add up",
+          "[write_region_polygons][global]") {
+    const double R = 1737400;
+    // A lon/lat grid 0..360 and one -180..180; an equirectangular grid centred on 180 E whose
+    // rounded map scale (as in LDEM_4's label) overshoots 360 x 180 degrees a little.
+    const double overshoot = 1 + 3e-7, step = 2 * std::acos(-1.0) * R / 360 * overshoot;
+    const std::string moon_eqc =
+        "+proj=eqc +lon_0=180 +R=" + std::to_string(R) + " +units=m +no_defs +type=crs";
+    struct Case {
+        std::string name, crs;
+        GeoTransform t;
+        double west;
+    };
+    const Case cases[] = {
+        {"lonlat_0_360", "IAU_2015:30100", {0, 1, 0, 90, 0, -1}, 0},
+        {"lonlat_180", "IAU_2015:30100", {-180, 1, 0, 90, 0, -1}, -180},
+        {"eqc_180", moon_eqc, {-180 * step, step, 0, 90 * step, 0, -step}, 0},
+    };
+    for (const auto& c : cases) {
+        SECTION(c.name) {
+            const Dem dem = global_grid(c.crs, c.t);
+            REQUIRE(dem.georef.global_longitude);
+            const auto t = test::segment_tile(dem, global_labels(dem));
+            REQUIRE(t.region_count > 12);
+            const auto dir = test::scratch_dir("write_region_polygons_global_" + c.name);
+            const auto path = (dir / "regions.geojson").string();
+            io::write_region_polygons(t.dem, t.pixels, t.graph, path, true);
+            const auto r = read_features(path);
+            check_global(r, t, c.west);
+            // Region 4 crosses the seam: two pieces, one at each end of the range.
+            const OGRGeometry* across = r.features[3]->GetGeometryRef();
+            REQUIRE(wkbFlatten(across->getGeometryType()) == wkbMultiPolygon);
+            CHECK(across->toMultiPolygon()->getNumGeometries() == 2);
+            OGREnvelope e;
+            across->getEnvelope(&e);
+            CHECK(e.MinX == c.west);
+            CHECK(e.MaxX == c.west + 360);
+            // The north cap goes all the way round, up to the pole.
+            r.features[0]->GetGeometryRef()->getEnvelope(&e);
+            CHECK(e.MinX == c.west);
+            CHECK(e.MaxX == c.west + 360);
+            CHECK(e.MaxY == 90);
+            CHECK(e.MinY == Approx(80).margin(1e-6));
+
+            // A GeoPackage in the DEM's own CRS: lon/lat for a lon/lat grid, else taken to
+            // lon/lat by a client that keeps the grid's longitude range (PROJ's +lon_wrap)
+            // and puts a vertex every pixel along the edges first: the same checks pass.
+            io::RegionPolygonOptions gpkg;
+            gpkg.driver = "GPKG";
+            const auto gpkg_path = (dir / "regions.gpkg").string();
+            io::write_region_polygons(t.dem, t.pixels, t.graph, gpkg_path, true, gpkg);
+            auto map = read_features(gpkg_path);
+            if (!map.layer->GetSpatialRef()->IsGeographic()) {
+                OGRSpatialReference lonlat;
+                lonlat.SetFromUserInput(("+proj=longlat +R=" + std::to_string(R) + " +lon_wrap=" +
+                                         std::to_string(c.west + 180) + " +no_defs +type=crs")
+                                            .c_str());
+                lonlat.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+                std::unique_ptr<OGRCoordinateTransformation> ct(
+                    OGRCreateCoordinateTransformation(map.layer->GetSpatialRef(), &lonlat));
+                REQUIRE(ct);
+                for (auto& f : map.features) {
+                    f->GetGeometryRef()->segmentize(step);
+                    REQUIRE(f->GetGeometryRef()->transform(ct.get()) == 0);
+                }
+            }
+            check_global(map, t, c.west);
+        }
+    }
+}
+
+TEST_CASE("regions.geojson of LDEM_4 (0..360): valid, within range, areas add up",
+          "[write_region_polygons][global][shared]") {
+    const auto source = test::shared_data("moon_lola_ldem4/LDEM_4.LBL");
+    REQUIRE(source.has_value());
+    const Dem ldem = io::read_dem(*source);
+    REQUIRE(ldem.georef.global_longitude);
+    const auto t = test::segment_tile(ldem, global_labels(ldem));
+    const auto dir = test::scratch_dir("write_region_polygons_ldem4");
+    const auto path = (dir / "regions.geojson").string();
+    io::write_region_polygons(t.dem, t.pixels, t.graph, path, true);
+    check_global(read_features(path), t, 0, 3);
 }

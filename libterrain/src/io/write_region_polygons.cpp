@@ -12,6 +12,7 @@
 #include "dataset_files.hpp"
 #include "gdal_support.hpp"
 #include "geojson_file.hpp"
+#include "global_outline.hpp"
 #include "lonlat_frame.hpp"
 #include "region_attributes.hpp"
 #include "terrain/core/error.hpp"
@@ -73,14 +74,20 @@ std::vector<Geometry> polygonize(const Dem& dem, const std::vector<std::uint32_t
     return out;
 }
 
-// Every ring to lon/lat (when `frame`), exterior rings counter-clockwise and holes clockwise
+// Every ring to lon/lat (when `frame`), through `global` for a global grid (its seam and
+// poles also in map coordinates), exterior rings counter-clockwise and holes clockwise
 // (RFC 7946).
-void prepare_rings(OGRGeometry& g, const LonLatFrame* frame) {
+void prepare_rings(OGRGeometry& g, const LonLatFrame* frame, const GlobalOutline* global) {
     auto polygon_rings = [&](OGRPolygon& polygon) {
         for (int k = 0; k < polygon.getNumInteriorRings() + 1; ++k) {
             OGRLinearRing* ring =
                 k == 0 ? polygon.getExteriorRing() : polygon.getInteriorRing(k - 1);
-            if (frame) {
+            if (global) {
+                if (frame)
+                    global->to_lonlat(*ring);
+                else
+                    global->to_map(*ring);
+            } else if (frame) {
                 const int n = ring->getNumPoints();
                 std::vector<double> x(static_cast<std::size_t>(n)), y(x.size());
                 ring->getPoints(x.data(), sizeof(double), y.data(), sizeof(double));
@@ -309,8 +316,15 @@ void write_polygons(const Dem& dem, std::vector<Geometry> polygons,
     const bool geojson = driver == nullptr;
     std::optional<LonLatFrame> frame;
     if (!dem.crs_wkt.empty() && (geojson || options.lonlat)) frame.emplace(dem, "write");
+    // A global grid's seam and poles, in lon/lat or in the DEM's map coordinates.
+    std::optional<LonLatFrame> global_frame;
+    std::optional<GlobalOutline> global;
+    if (GlobalOutline::applies(dem)) {
+        if (!frame) global_frame.emplace(dem, "write");
+        global.emplace(dem, frame ? *frame : *global_frame);
+    }
     for (auto& g : polygons)
-        if (g) prepare_rings(*g, frame ? &*frame : nullptr);
+        if (g) prepare_rings(*g, frame ? &*frame : nullptr, global ? &*global : nullptr);
 
     if (geojson) {
         // Lon/lat to 1e-9 degree (0.1 mm on Earth); metres to 1e-6.
