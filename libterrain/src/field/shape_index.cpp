@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <functional>
 #include <limits>
 #include <numbers>
@@ -222,7 +223,7 @@ bool mesh_fit(const TriangleMesh& mesh, std::int32_t v, const Vec3& normal,
 // fixed combination of the moments sum d^a of the 3-D offsets d = p_w - p_v over the 35
 // monomials of degree <= 4 in (x, y, z). Those moments are taken about a reference point per
 // tile of pixels from per-row prefix sums, so that a window row costs two look-ups whatever
-// its length, then moved to the vertex (binomial expansion) and turned into its tangent frame.
+// its length, then moved to the vertex (a Taylor shift) and turned into its tangent frame.
 // The window is the same ball as the mesh path's, found row by row: each row's span of pixels
 // within the radius is the previous pixel's span with its ends moved, so finding it costs
 // O(1) per row on average.
@@ -234,59 +235,77 @@ struct Exponents {
     int x = 0, y = 0, z = 0;
 };
 
-struct MomentTables {
-    std::array<Exponents, kMoments> exponents{};
-    int index[5][5][5] = {};  // exponents -> moment index (degree <= 4)
-    // Moving moments by a translation t: M'[to] += coefficient * (-t)^shift * M[from].
-    struct Term {
-        int to, from;
-        double coefficient;
-        int sx, sy, sz;
-    };
-    std::vector<Term> translation;
+// The monomials by degree, then by decreasing x, then decreasing y.
+constexpr std::array<Exponents, kMoments> kExponents = [] {
+    std::array<Exponents, kMoments> e{};
+    int k = 0;
+    for (int degree = 0; degree <= 4; ++degree)
+        for (int x = degree; x >= 0; --x)
+            for (int y = degree - x; y >= 0; --y) e[std::size_t(k++)] = {x, y, degree - x - y};
+    return e;
+}();
 
-    MomentTables() {
-        int k = 0;
-        for (int degree = 0; degree <= 4; ++degree)
-            for (int x = degree; x >= 0; --x)
-                for (int y = degree - x; y >= 0; --y) {
-                    const int z = degree - x - y;
-                    exponents[k] = {x, y, z};
-                    index[x][y][z] = k++;
-                }
-        const auto binomial = [](int n, int r) {
-            double b = 1;
-            for (int i = 1; i <= r; ++i) b = b * (n - r + i) / i;
-            return b;
-        };
-        for (int to = 0; to < kMoments; ++to) {
-            const auto a = exponents[to];
-            for (int bx = 0; bx <= a.x; ++bx)
-                for (int by = 0; by <= a.y; ++by)
-                    for (int bz = 0; bz <= a.z; ++bz)
-                        translation.push_back(
-                            {to, index[bx][by][bz],
-                             binomial(a.x, bx) * binomial(a.y, by) * binomial(a.z, bz), a.x - bx,
-                             a.y - by, a.z - bz});
-        }
-    }
-};
-
-const MomentTables& moment_tables() {
-    static const MomentTables tables;
-    return tables;
+constexpr int moment_index(int x, int y, int z) {
+    for (int k = 0; k < kMoments; ++k)
+        if (kExponents[std::size_t(k)].x == x && kExponents[std::size_t(k)].y == y &&
+            kExponents[std::size_t(k)].z == z)
+            return k;
+    return -1;
 }
+
+// Moving moments by a translation s along one axis is a Taylor shift of each chain of
+// moments that differ only in that axis's exponent: M[e] += s M[e - 1] for j = 1..n, e = n
+// down to j. The steps (axis, target, source) in order, 3 x 35 of them.
+struct ShiftStep {
+    std::uint8_t axis, target, source;
+};
+constexpr int kShiftSteps = 105;
+constexpr std::array<ShiftStep, kShiftSteps> kShift = [] {
+    std::array<ShiftStep, kShiftSteps> steps{};
+    int k = 0;
+    for (int axis = 0; axis < 3; ++axis)
+        for (int o1 = 0; o1 <= 4; ++o1)
+            for (int o2 = 0; o1 + o2 <= 4; ++o2) {
+                const int n = 4 - o1 - o2;
+                const auto at = [&](int e) {
+                    return axis == 0   ? moment_index(e, o1, o2)
+                           : axis == 1 ? moment_index(o1, e, o2)
+                                       : moment_index(o1, o2, e);
+                };
+                for (int j = 1; j <= n; ++j)
+                    for (int e = n; e >= j; --e)
+                        steps[std::size_t(k++)] = {std::uint8_t(axis), std::uint8_t(at(e)),
+                                                   std::uint8_t(at(e - 1))};
+            }
+    return steps;
+}();
+
+// Products of homogeneous polynomials of degrees P and Q: for each pair of their local
+// indices (row-major), the local index of the product's monomial in degree P + Q.
+template <int P, int Q>
+constexpr auto kProduct = [] {
+    constexpr int np = kDegreeStart[P + 1] - kDegreeStart[P];
+    constexpr int nq = kDegreeStart[Q + 1] - kDegreeStart[Q];
+    std::array<std::uint8_t, std::size_t(np * nq)> t{};
+    for (int i = 0; i < np; ++i)
+        for (int j = 0; j < nq; ++j) {
+            const auto a = kExponents[std::size_t(kDegreeStart[P] + i)];
+            const auto b = kExponents[std::size_t(kDegreeStart[Q] + j)];
+            t[std::size_t(i * nq + j)] =
+                std::uint8_t(moment_index(a.x + b.x, a.y + b.y, a.z + b.z) - kDegreeStart[P + Q]);
+        }
+    return t;
+}();
 
 // The 35 monomials of e.
 void monomials(const Vec3& e, double* out) {
-    const auto& t = moment_tables();
     double px[5] = {1, e[0], e[0] * e[0], 0, 0}, py[5] = {1, e[1], e[1] * e[1], 0, 0},
            pz[5] = {1, e[2], e[2] * e[2], 0, 0};
     px[3] = px[2] * e[0], px[4] = px[2] * px[2];
     py[3] = py[2] * e[1], py[4] = py[2] * py[2];
     pz[3] = pz[2] * e[2], pz[4] = pz[2] * pz[2];
     for (int k = 0; k < kMoments; ++k) {
-        const auto a = t.exponents[k];
+        const auto a = kExponents[std::size_t(k)];
         out[k] = px[a.x] * py[a.y] * pz[a.z];
     }
 }
@@ -299,16 +318,11 @@ struct Poly {
 
 template <int P, int Q>
 Poly<P + Q> multiply(const Poly<P>& p, const Poly<Q>& q) {
-    const auto& t = moment_tables();
+    constexpr auto& target = kProduct<P, Q>;
     Poly<P + Q> r;
-    for (std::size_t i = 0; i < p.c.size(); ++i) {
-        const auto a = t.exponents[kDegreeStart[P] + int(i)];
-        for (std::size_t j = 0; j < q.c.size(); ++j) {
-            const auto b = t.exponents[kDegreeStart[Q] + int(j)];
-            r.c[std::size_t(t.index[a.x + b.x][a.y + b.y][a.z + b.z] - kDegreeStart[P + Q])] +=
-                p.c[i] * q.c[j];
-        }
-    }
+    std::size_t k = 0;
+    for (std::size_t i = 0; i < p.c.size(); ++i)
+        for (std::size_t j = 0; j < q.c.size(); ++j) r.c[target[k++]] += p.c[i] * q.c[j];
     return r;
 }
 
@@ -477,7 +491,6 @@ void grid_tile(const TriangleMesh& mesh, const GridLayout& g, const std::vector<
     const int offsets = 2 * my + 1;
     s.lo.assign(std::size_t(offsets), 0);
     s.hi.assign(std::size_t(offsets), -1);
-    const auto& tables = moment_tables();
     for (int row = r0; row < r1; ++row) {
         bool warm = false;  // the spans hold the previous pixel's window
         const int lr = row - rr0;
@@ -543,7 +556,13 @@ void grid_tile(const TriangleMesh& mesh, const GridLayout& g, const std::vector<
                             }
                         }
                     }
-                    if (lo > hi) continue;
+                    if (lo > hi) {  // the ball ends here: the rows beyond are empty too
+                        for (int j = k + 1; j <= my; ++j) {
+                            s.lo[std::size_t(dir * j + my)] = 0;
+                            s.hi[std::size_t(dir * j + my)] = -1;
+                        }
+                        break;
+                    }
                     guess = (lo + hi) / 2;
                     // At the region's margin the ball may go on beyond it.
                     const bool edge_left = lc - lo >= mx && (g.seam || cc0 + lo > 0);
@@ -562,7 +581,7 @@ void grid_tile(const TriangleMesh& mesh, const GridLayout& g, const std::vector<
             }
             warm = true;
             // The moments about the reference, then about the vertex.
-            double about_ref[kMoments] = {};
+            double moments[kMoments] = {};  // about the reference, then about the vertex
             for (int dy = -my; dy <= my; ++dy) {
                 const int lo = s.lo[std::size_t(dy + my)], hi = s.hi[std::size_t(dy + my)];
                 if (lo > hi) continue;
@@ -570,20 +589,14 @@ void grid_tile(const TriangleMesh& mesh, const GridLayout& g, const std::vector<
                     &s.prefix[std::size_t(lr + dy) * std::size_t(cols + 1) * kMoments];
                 const double* a = row_sums + std::size_t(lo) * kMoments;
                 const double* b = row_sums + std::size_t(hi + 1) * kMoments;
-                for (int k = 0; k < kMoments; ++k) about_ref[k] += b[k] - a[k];
+                for (int k = 0; k < kMoments; ++k) moments[k] += b[k] - a[k];
             }
             const Vec3 t{centre[0] - ref[0], centre[1] - ref[1], centre[2] - ref[2]};
-            double power[3][5];
-            for (int i = 0; i < 3; ++i) {
-                power[i][0] = 1;
-                for (int p = 1; p < 5; ++p) power[i][p] = power[i][p - 1] * -t[std::size_t(i)];
-            }
-            double about_vertex[kMoments] = {};
-            for (const auto& term : tables.translation)
-                about_vertex[term.to] += term.coefficient * power[0][term.sx] * power[1][term.sy] *
-                                         power[2][term.sz] * about_ref[term.from];
+            // sum (e - t)^a from sum e^a, axis by axis.
+            for (const auto& step : kShift)
+                moments[step.target] -= t[step.axis] * moments[step.source];
             PrincipalCurvatures k;
-            const auto equations = equations_from_moments(about_vertex, normals[std::size_t(v)]);
+            const auto equations = equations_from_moments(moments, normals[std::size_t(v)]);
             const bool fitted = solve_curvatures(equations, k);
             body(v, fitted, k, equations.scale);
         }
