@@ -304,6 +304,7 @@ void monomials(const Vec3& e, double* out) {
     px[3] = px[2] * e[0], px[4] = px[2] * px[2];
     py[3] = py[2] * e[1], py[4] = py[2] * py[2];
     pz[3] = pz[2] * e[2], pz[4] = pz[2] * pz[2];
+#pragma GCC unroll 35
     for (int k = 0; k < kMoments; ++k) {
         const auto a = kExponents[std::size_t(k)];
         out[k] = px[a.x] * py[a.y] * pz[a.z];
@@ -321,14 +322,18 @@ Poly<P + Q> multiply(const Poly<P>& p, const Poly<Q>& q) {
     constexpr auto& target = kProduct<P, Q>;
     Poly<P + Q> r;
     std::size_t k = 0;
-    for (std::size_t i = 0; i < p.c.size(); ++i)
+#pragma GCC unroll 6
+    for (std::size_t i = 0; i < p.c.size(); ++i) {
+#pragma GCC unroll 15
         for (std::size_t j = 0; j < q.c.size(); ++j) r.c[target[k++]] += p.c[i] * q.c[j];
+    }
     return r;
 }
 
 template <int D>
 double contract(const Poly<D>& p, const double* moments) {
     double s = 0;
+#pragma GCC unroll 15
     for (std::size_t i = 0; i < p.c.size(); ++i) s += p.c[i] * moments[kDegreeStart[D] + int(i)];
     return s;
 }
@@ -593,6 +598,7 @@ void grid_tile(const TriangleMesh& mesh, const GridLayout& g, const std::vector<
             }
             const Vec3 t{centre[0] - ref[0], centre[1] - ref[1], centre[2] - ref[2]};
             // sum (e - t)^a from sum e^a, axis by axis.
+#pragma GCC unroll 105
             for (const auto& step : kShift)
                 moments[step.target] -= t[step.axis] * moments[step.source];
             PrincipalCurvatures k;
