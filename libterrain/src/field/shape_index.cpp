@@ -508,19 +508,19 @@ void grid_tile(const TriangleMesh& mesh, const GridLayout& g, const std::vector<
             const int lc = col - cc0;
             const Vec3 centre = s.position[std::size_t(lr) * std::size_t(cols) + std::size_t(lc)];
             // Within the ball, as the mesh path tests it.
+            // (A pixel without a vertex has a NaN position: never inside.)
             const auto inside = [&](int r, int c) {
                 const Vec3& p = s.position[std::size_t(r) * std::size_t(cols) + std::size_t(c)];
-                if (std::isnan(p[0])) return false;
                 const Vec3 d{p[0] - centre[0], p[1] - centre[1], p[2] - centre[2]};
-                return !(dot(d, d) > r2);
+                return dot(d, d) <= r2;
             };
             // The next pixel of the row within the ball beyond `from` in direction `step`,
             // stepping over pixels without a vertex, at most mx columns from the centre; -1.
             const auto next_inside = [&](int r, int from, int step) {
                 for (int c = from + step; c >= 0 && c < cols && std::abs(c - lc) <= mx; c += step) {
+                    if (inside(r, c)) return c;
                     const Vec3& p = s.position[std::size_t(r) * std::size_t(cols) + std::size_t(c)];
-                    if (std::isnan(p[0])) continue;
-                    return inside(r, c) ? c : -1;
+                    if (!std::isnan(p[0])) return -1;
                 }
                 return -1;
             };
