@@ -6,8 +6,16 @@
 #include <functional>
 #include <limits>
 
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "support/test_support.hpp"
+#include "terrain/core/error.hpp"
 #include "terrain/field/shape_index.hpp"
 #include "terrain/geo/body.hpp"
+#include "terrain/geo/georeference.hpp"
+#include "terrain/io/read_dem.hpp"
 #include "terrain/mesh/dem_to_mesh.hpp"
 
 using namespace terrain;
@@ -202,4 +210,229 @@ TEST_CASE("shape index is the same whatever the thread count", "[shape_index]") 
         two = field::shape_index_field(mesh);
     }
     CHECK(one == two);
+}
+
+// ---- The grid method (DEM meshes with a radius) against the mesh method ----
+
+namespace {
+
+field::ShapeIndexOptions with_method(double radius, field::ShapeIndexMethod method) {
+    field::ShapeIndexOptions options;
+    options.radius = radius;
+    options.method = method;
+    return options;
+}
+
+struct Agreement {
+    std::size_t vertices = 0, above_half = 0, above_hundredth = 0;
+    double worst = 0;
+};
+
+// The grid method's values against the mesh method's on every vertex (or those `keep` takes).
+Agreement grid_against_mesh(const TriangleMesh& mesh, double radius,
+                            const std::function<bool(std::size_t)>& keep = {}) {
+    const auto grid =
+        field::shape_index_field(mesh, with_method(radius, field::ShapeIndexMethod::grid));
+    const auto exact =
+        field::shape_index_field(mesh, with_method(radius, field::ShapeIndexMethod::mesh));
+    REQUIRE(grid.size() == exact.size());
+    Agreement a;
+    for (std::size_t v = 0; v < grid.size(); ++v) {
+        if (keep && !keep(v)) continue;
+        ++a.vertices;
+        const double d = std::abs(double(grid[v]) - double(exact[v]));
+        a.worst = std::max(a.worst, d);
+        a.above_half += d > 0.5;
+        a.above_hundredth += d > 0.01;
+    }
+    return a;
+}
+
+// A crop [c0, c0 + w) x [r0, r0 + h) of a DEM read from a file, georeferenced again.
+Dem crop(const Dem& dem, int c0, int r0, int w, int h) {
+    Dem out = dem;
+    out.width = w, out.height = h;
+    out.values.clear();
+    for (int r = r0; r < r0 + h; ++r)
+        for (int c = c0; c < c0 + w; ++c) out.values.push_back(dem.at(c, r));
+    const auto xy = dem.map_xy(c0, r0);
+    out.transform[0] = xy[0], out.transform[3] = xy[1];
+    geo::georeference(out);
+    return out;
+}
+
+}  // namespace
+
+TEST_CASE("shape index by the grid method: known answers on analytic DEMs", "[shape_index]") {
+    const double k = 1 / R;
+    using F = std::function<double(double, double)>;
+    using D = std::function<Derivatives(double, double)>;
+    const std::vector<std::pair<F, D>> surfaces{
+        {[&](double x, double y) { return -(x * x + y * y) * k / 2; },
+         [&](double x, double y) {
+             return Derivatives{-x * k, -y * k, -k, 0, -k};
+         }},
+        {[&](double x, double y) { return (x * x + y * y) * k / 2; },
+         [&](double x, double y) {
+             return Derivatives{x * k, y * k, k, 0, k};
+         }},
+        {[&](double x, double) { return -x * x * k / 2; },
+         [&](double x, double) {
+             return Derivatives{-x * k, 0, -k, 0, 0};
+         }},
+        {[&](double x, double) { return x * x * k / 2; },
+         [&](double x, double) {
+             return Derivatives{x * k, 0, k, 0, 0};
+         }},
+        {[&](double x, double y) { return (x * x - y * y) * k / 2; },
+         [&](double x, double y) {
+             return Derivatives{x * k, -y * k, k, 0, -k};
+         }},
+        {[&](double x, double y) { return (x * x - 0.5 * y * y) * k / 2; },
+         [&](double x, double y) {
+             return Derivatives{x * k, -0.5 * y * k, k, 0, -0.5 * k};
+         }},
+        {[](double x, double y) { return 0.3 * x - 0.2 * y + 5; },
+         [](double, double) {
+             return Derivatives{0.3, -0.2, 0, 0, 0};
+         }},
+        {[](double x, double y) { return std::sqrt(60.0 * 60.0 - x * x - y * y); },
+         [](double, double) {
+             return Derivatives{0, 0, -1, 0, -1};
+         }},
+    };
+    for (const auto& [f, d] : surfaces) {
+        const auto dem = analytic(41, 1.0, f);
+        const auto mesh = mesh::dem_to_mesh(dem);
+        for (double radius : {2.9, 5.5}) {
+            const auto options = with_method(radius, field::ShapeIndexMethod::grid);
+            REQUIRE(std::string(field::shape_index_method(mesh, options)) == "grid");
+            check_known_answer(dem, d, options, int(std::ceil(radius)) + 1);
+            // And the same values as the mesh method, border vertices included.
+            const auto a = grid_against_mesh(mesh, radius);
+            CHECK(a.worst < 1e-3);
+        }
+    }
+}
+
+TEST_CASE("shape index methods: which applies", "[shape_index]") {
+    const auto mesh = mesh::dem_to_mesh(analytic(8, 1.0, [](double x, double) { return x; }));
+    field::ShapeIndexOptions options;
+    CHECK(std::string(field::shape_index_method(mesh, options)) == "mesh");  // rings
+    options.radius = 2;
+    CHECK(std::string(field::shape_index_method(mesh, options)) == "grid");
+    options.method = field::ShapeIndexMethod::mesh;
+    CHECK(std::string(field::shape_index_method(mesh, options)) == "mesh");
+    TriangleMesh file_mesh = mesh;  // as if read from a file: no pixels
+    file_mesh.vertex_pixel.clear();
+    file_mesh.grid_width = file_mesh.grid_height = 0;
+    options.method = field::ShapeIndexMethod::automatic;
+    CHECK(std::string(field::shape_index_method(file_mesh, options)) == "mesh");
+    options.method = field::ShapeIndexMethod::grid;
+    CHECK_THROWS_AS(field::shape_index_method(file_mesh, options), Error);
+}
+
+TEST_CASE("shape index by the grid method next to NoData and borders", "[shape_index]") {
+    // A rough surface with a NoData hole, a NoData row cutting part of the tile, a lone
+    // corner pixel and a ragged edge.
+    Dem dem = analytic(60, 1.0, [](double x, double y) {
+        return 3 * std::sin(x * 0.31) * std::cos(y * 0.23) + 0.4 * std::sin(x * 1.7 + y * 2.3);
+    });
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    for (int r = 20; r < 27; ++r)
+        for (int c = 25; c < 33; ++c) dem.values[dem.index(c, r)] = nan;
+    for (int c = 0; c < 40; ++c) dem.values[dem.index(c, 45)] = nan;
+    for (int r = 0; r < 60; r += 3) dem.values[dem.index(59, r)] = nan;
+    dem.values[dem.index(0, 59)] = nan;
+    const auto mesh = mesh::dem_to_mesh(dem);
+    for (double radius : {2.5, 4.5, 8.0}) {
+        // Vertices with no NoData pixel within radius + 1 pixels: their windows are whole
+        // (the tile's border clips both methods' balls alike) and must agree.
+        const int reach = int(std::ceil(radius)) + 1;
+        const auto whole = [&](std::size_t v) {
+            const int c = mesh.vertex_pixel[v] % dem.width, r = mesh.vertex_pixel[v] / dem.width;
+            for (int dr = -reach; dr <= reach; ++dr)
+                for (int dc = -reach; dc <= reach; ++dc) {
+                    const int cc = c + dc, rr = r + dr;
+                    if (cc >= 0 && rr >= 0 && cc < dem.width && rr < dem.height &&
+                        !dem.valid(cc, rr))
+                        return false;
+                }
+            return true;
+        };
+        const auto a = grid_against_mesh(mesh, radius, whole);
+        const auto near = grid_against_mesh(mesh, radius, [&](std::size_t v) { return !whole(v); });
+        INFO("radius " << radius << ": whole windows " << a.above_half << " above 0.5, worst "
+                       << a.worst << " over " << a.vertices << "; next to NoData "
+                       << near.above_half << " of " << near.vertices << " above 0.5, worst "
+                       << near.worst);
+        REQUIRE(a.vertices > 1000);
+        // This surface is rough at the pixel (slopes up to 1.1 from a 0.4 m ripple of 2.2 m
+        // wavelength): a ball's pixels in one row are then not always one run, nor all
+        // reached through the ball on the mesh, which the grid method assumes.
+        CHECK(a.above_half * 50 <= a.vertices);
+        // Next to NoData the grid method's rows step over NoData in their own row but stop at
+        // a row with no pixel near the window's middle, where the mesh method's search goes
+        // round: a minority differ.
+        CHECK(near.above_half * 4 <= near.vertices);
+        const auto field =
+            field::shape_index_field(mesh, with_method(radius, field::ShapeIndexMethod::grid));
+        std::size_t bad = 0;
+        for (float v : field) bad += !(std::isfinite(v) && v >= 0 && v <= 100);
+        CHECK(bad == 0);
+    }
+}
+
+TEST_CASE("shape index by the grid method is the same whatever the thread count", "[shape_index]") {
+    const auto mesh = mesh::dem_to_mesh(analytic(
+        150, 2.0, [](double x, double y) { return std::sin(x * 0.1) * std::cos(y * 0.13) * 10; }));
+    const auto options = with_method(13.0, field::ShapeIndexMethod::grid);
+    const auto one = test::with_threads(1, [&] { return field::shape_index_field(mesh, options); });
+    const auto two = test::with_threads(2, [&] { return field::shape_index_field(mesh, options); });
+    CHECK(one == two);
+}
+
+TEST_CASE("shape index by the grid method agrees with the mesh method on real DEMs",
+          "[shape_index][shared]") {
+    // Every vertex of each crop (its border and NoData neighbours included) is compared.
+    struct Case {
+        std::string name;
+        Dem dem;
+        std::vector<double> radii;
+    };
+    std::vector<Case> cases;
+    const auto srtm = test::shared_data("earth/bigtujunga_srtm30m_utm11.tif");
+    REQUIRE(srtm.has_value());
+    cases.push_back({"SRTM crop", crop(io::read_dem(*srtm), 400, 200, 240, 200), {60, 150, 300}});
+    // The Vesta sample (a HAMO tile far from its projection's centre, meshed in the body
+    // frame): its 256 x 256 pixels farthest from the centre.
+    cases.push_back({"Vesta sample",
+                     crop(io::read_dem(test::sample("vesta_hamo_tile.lbl")), 256, 256, 256, 256),
+                     {350, 700}});
+    // A geographic (lon/lat) Moon crop at 55-80 N from LOLA LDEM_4: pixels 2-6 times narrower
+    // than tall.
+    const auto ldem = test::shared_data("moon_lola_ldem4/LDEM_4.LBL");
+    REQUIRE(ldem.has_value());
+    {
+        const Dem full = io::read_dem(*ldem);
+        Dem moon = crop(full, 600, 40, 160, 100);
+        moon.crs_wkt = "IAU_2015:30100";
+        moon.transform = {150, 0.25, 0, 80, 0, -0.25};
+        geo::georeference(moon);
+        cases.push_back({"geographic Moon crop", std::move(moon), {25000, 60000}});
+    }
+    // The whole Moon at one pixel per degree: seam and poles.
+    cases.push_back(
+        {"global Moon", io::read_dem(test::sample("moon_ldem1_global.tif")), {100000, 200000}});
+    for (const auto& c : cases) {
+        const auto mesh = mesh::dem_to_mesh(c.dem);
+        for (double radius : c.radii) {
+            const auto a = grid_against_mesh(mesh, radius);
+            INFO(c.name << " radius " << radius << ": worst " << a.worst << ", " << a.above_half
+                        << " above 0.5 and " << a.above_hundredth << " above 0.01 of "
+                        << a.vertices);
+            CHECK(a.above_half * 2000 <= a.vertices);      // at least 99.95 % within 0.5
+            CHECK(a.above_hundredth * 200 <= a.vertices);  // 99.5 % within 0.01
+        }
+    }
 }

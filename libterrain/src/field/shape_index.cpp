@@ -7,6 +7,9 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
+#include <functional>
+#include <limits>
 #include <numbers>
 #include <span>
 
@@ -115,34 +118,24 @@ bool solve_spd(std::array<std::array<double, N>, N>& a, std::array<double, N>& b
     return true;
 }
 
-// Fits h = a u^2 + b uv + c v^2 (+ d u + e v) to the neighbourhood in the tangent frame of
-// `normal`, coordinates divided by their mean distance so the fit is scale-free. Returns
-// false when the neighbourhood is too small. Curvatures come back in units of 1/scale.
-bool fit_curvatures(const TriangleMesh& mesh, std::int32_t v, const Vec3& normal,
-                    const std::int32_t* neighbour_ids, std::size_t m, PrincipalCurvatures& out,
-                    double& scale) {
-    const std::span<const std::int32_t> neighbours(neighbour_ids, m);
-    if (m < 3) return false;
-    const Vec3 axis = std::abs(normal[0]) < 0.6 ? Vec3{1, 0, 0} : Vec3{0, 1, 0};
-    const Vec3 t1 = normalized(cross(normal, axis));
-    const Vec3 t2 = cross(normal, t1);
-    // One pass: the normal equations of the raw tangent coordinates and their mean
-    // distance; dividing coordinates by that distance then only rescales the equations.
-    const auto& centre = mesh.positions[v];
+// The normal equations of the fit h = a u^2 + b uv + c v^2 (+ d u + e v) in raw tangent
+// coordinates (lower triangles of ata), the neighbour count m and their mean distance.
+struct NormalEquations {
     std::array<std::array<double, 5>, 5> ata{};
     std::array<double, 5> atb{};
-    scale = 0;
-    for (auto w : neighbours) {
-        const Vec3 d = sub(mesh.positions[w], centre);
-        const double u = dot(d, t1), s = dot(d, t2), h = dot(d, normal);
-        scale += std::sqrt(u * u + s * s + h * h);
-        const double row[5] = {u * u, u * s, s * s, u, s};
-        for (int i = 0; i < 5; ++i) {
-            for (int j = 0; j <= i; ++j) ata[i][j] += row[i] * row[j];
-            atb[i] += row[i] * h;
-        }
-    }
-    scale /= double(m);
+    std::size_t m = 0;
+    double scale = 0;
+};
+
+// Solves the fit with coordinates divided by `scale` (so that it is scale-free; dividing only
+// rescales the equations) and returns the principal curvatures in units of 1/scale; false
+// when the neighbourhood is too small.
+bool solve_curvatures(NormalEquations e, PrincipalCurvatures& out) {
+    auto& ata = e.ata;
+    auto& atb = e.atb;
+    const std::size_t m = e.m;
+    if (m < 3) return false;
+    const double scale = e.scale;
     if (!(scale > 0)) return false;
     const double inv = 1.0 / scale;
     const double unit[5] = {inv * inv, inv * inv, inv * inv, inv, inv};
@@ -182,6 +175,483 @@ bool fit_curvatures(const TriangleMesh& mesh, std::int32_t v, const Vec3& normal
     return true;
 }
 
+// The tangent frame (t1, t2) of a vertex normal.
+std::array<Vec3, 2> tangent_frame(const Vec3& normal) {
+    const Vec3 axis = std::abs(normal[0]) < 0.6 ? Vec3{1, 0, 0} : Vec3{0, 1, 0};
+    const Vec3 t1 = normalized(cross(normal, axis));
+    return {t1, cross(normal, t1)};
+}
+
+// Fits h = a u^2 + b uv + c v^2 (+ d u + e v) to the neighbourhood in the tangent frame of
+// `normal`, coordinates divided by their mean distance so the fit is scale-free. Returns
+// false when the neighbourhood is too small. Curvatures come back in units of 1/scale.
+bool fit_curvatures(const TriangleMesh& mesh, std::int32_t v, const Vec3& normal,
+                    const std::int32_t* neighbour_ids, std::size_t m, PrincipalCurvatures& out,
+                    double& scale) {
+    const std::span<const std::int32_t> neighbours(neighbour_ids, m);
+    if (m < 3) return false;
+    const auto [t1, t2] = tangent_frame(normal);
+    // One pass: the normal equations of the raw tangent coordinates and their mean distance.
+    const auto& centre = mesh.positions[v];
+    NormalEquations e;
+    e.m = m;
+    for (auto w : neighbours) {
+        const Vec3 d = sub(mesh.positions[w], centre);
+        const double u = dot(d, t1), s = dot(d, t2), h = dot(d, normal);
+        e.scale += std::sqrt(u * u + s * s + h * h);
+        const double row[5] = {u * u, u * s, s * s, u, s};
+        for (int i = 0; i < 5; ++i) {
+            for (int j = 0; j <= i; ++j) e.ata[i][j] += row[i] * row[j];
+            e.atb[i] += row[i] * h;
+        }
+    }
+    e.scale /= double(m);
+    scale = e.scale;
+    return solve_curvatures(e, out);
+}
+
+// The mesh path for one vertex: gather its neighbourhood on the mesh and fit.
+bool mesh_fit(const TriangleMesh& mesh, std::int32_t v, const Vec3& normal,
+              const ShapeIndexOptions& options, Scratch& s, PrincipalCurvatures& k, double& scale) {
+    gather(mesh, v, options, s);
+    return fit_curvatures(mesh, v, normal, s.gathered.data() + 1, s.gathered.size() - 1, k, scale);
+}
+
+// ---------------------------------------------------------------------------------------------
+// The grid path (DEM meshes with a metric radius). The fit above needs, per vertex, sums over
+// its neighbours of products of their tangent coordinates u, s, h up to degree 4; each is a
+// fixed combination of the moments sum d^a of the 3-D offsets d = p_w - p_v over the 35
+// monomials of degree <= 4 in (x, y, z). Those moments are taken about a reference point per
+// tile of pixels from per-row prefix sums, so that a window row costs two look-ups whatever
+// its length, then moved to the vertex (a Taylor shift) and turned into its tangent frame.
+// The window is the same ball as the mesh path's, found row by row: each row's span of pixels
+// within the radius is the previous pixel's span with its ends moved, so finding it costs
+// O(1) per row on average.
+
+constexpr int kMoments = 35;
+constexpr int kDegreeStart[6] = {0, 1, 4, 10, 20, 35};
+
+struct Exponents {
+    int x = 0, y = 0, z = 0;
+};
+
+// The monomials by degree, then by decreasing x, then decreasing y.
+constexpr std::array<Exponents, kMoments> kExponents = [] {
+    std::array<Exponents, kMoments> e{};
+    int k = 0;
+    for (int degree = 0; degree <= 4; ++degree)
+        for (int x = degree; x >= 0; --x)
+            for (int y = degree - x; y >= 0; --y) e[std::size_t(k++)] = {x, y, degree - x - y};
+    return e;
+}();
+
+constexpr int moment_index(int x, int y, int z) {
+    for (int k = 0; k < kMoments; ++k)
+        if (kExponents[std::size_t(k)].x == x && kExponents[std::size_t(k)].y == y &&
+            kExponents[std::size_t(k)].z == z)
+            return k;
+    return -1;
+}
+
+// Moving moments by a translation s along one axis is a Taylor shift of each chain of
+// moments that differ only in that axis's exponent: M[e] += s M[e - 1] for j = 1..n, e = n
+// down to j. The steps (axis, target, source) in order, 3 x 35 of them.
+struct ShiftStep {
+    std::uint8_t axis, target, source;
+};
+constexpr int kShiftSteps = 105;
+constexpr std::array<ShiftStep, kShiftSteps> kShift = [] {
+    std::array<ShiftStep, kShiftSteps> steps{};
+    int k = 0;
+    for (int axis = 0; axis < 3; ++axis)
+        for (int o1 = 0; o1 <= 4; ++o1)
+            for (int o2 = 0; o1 + o2 <= 4; ++o2) {
+                const int n = 4 - o1 - o2;
+                const auto at = [&](int e) {
+                    return axis == 0   ? moment_index(e, o1, o2)
+                           : axis == 1 ? moment_index(o1, e, o2)
+                                       : moment_index(o1, o2, e);
+                };
+                for (int j = 1; j <= n; ++j)
+                    for (int e = n; e >= j; --e)
+                        steps[std::size_t(k++)] = {std::uint8_t(axis), std::uint8_t(at(e)),
+                                                   std::uint8_t(at(e - 1))};
+            }
+    return steps;
+}();
+
+// Products of homogeneous polynomials of degrees P and Q: for each pair of their local
+// indices (row-major), the local index of the product's monomial in degree P + Q.
+template <int P, int Q>
+constexpr auto kProduct = [] {
+    constexpr int np = kDegreeStart[P + 1] - kDegreeStart[P];
+    constexpr int nq = kDegreeStart[Q + 1] - kDegreeStart[Q];
+    std::array<std::uint8_t, std::size_t(np * nq)> t{};
+    for (int i = 0; i < np; ++i)
+        for (int j = 0; j < nq; ++j) {
+            const auto a = kExponents[std::size_t(kDegreeStart[P] + i)];
+            const auto b = kExponents[std::size_t(kDegreeStart[Q] + j)];
+            t[std::size_t(i * nq + j)] =
+                std::uint8_t(moment_index(a.x + b.x, a.y + b.y, a.z + b.z) - kDegreeStart[P + Q]);
+        }
+    return t;
+}();
+
+// The 35 monomials of e.
+void monomials(const Vec3& e, double* out) {
+    double px[5] = {1, e[0], e[0] * e[0], 0, 0}, py[5] = {1, e[1], e[1] * e[1], 0, 0},
+           pz[5] = {1, e[2], e[2] * e[2], 0, 0};
+    px[3] = px[2] * e[0], px[4] = px[2] * px[2];
+    py[3] = py[2] * e[1], py[4] = py[2] * py[2];
+    pz[3] = pz[2] * e[2], pz[4] = pz[2] * pz[2];
+#pragma GCC unroll 35
+    for (int k = 0; k < kMoments; ++k) {
+        const auto a = kExponents[std::size_t(k)];
+        out[k] = px[a.x] * py[a.y] * pz[a.z];
+    }
+}
+
+// A homogeneous polynomial of degree D in (x, y, z), coefficients in moment order.
+template <int D>
+struct Poly {
+    std::array<double, kDegreeStart[D + 1] - kDegreeStart[D]> c{};
+};
+
+template <int P, int Q>
+Poly<P + Q> multiply(const Poly<P>& p, const Poly<Q>& q) {
+    constexpr auto& target = kProduct<P, Q>;
+    Poly<P + Q> r;
+    std::size_t k = 0;
+#pragma GCC unroll 6
+    for (std::size_t i = 0; i < p.c.size(); ++i) {
+#pragma GCC unroll 15
+        for (std::size_t j = 0; j < q.c.size(); ++j) r.c[target[k++]] += p.c[i] * q.c[j];
+    }
+    return r;
+}
+
+template <int D>
+double contract(const Poly<D>& p, const double* moments) {
+    double s = 0;
+#pragma GCC unroll 15
+    for (std::size_t i = 0; i < p.c.size(); ++i) s += p.c[i] * moments[kDegreeStart[D] + int(i)];
+    return s;
+}
+
+// The normal equations of the fit from the moments of the offsets (about the vertex) in the
+// tangent frame (t1, t2, n).
+NormalEquations equations_from_moments(const double* m, const Vec3& normal) {
+    const auto [t1, t2] = tangent_frame(normal);
+    const Poly<1> U{{t1[0], t1[1], t1[2]}}, S{{t2[0], t2[1], t2[2]}},
+        N{{normal[0], normal[1], normal[2]}};
+    const auto UU = multiply(U, U), US = multiply(U, S), SS = multiply(S, S), UN = multiply(U, N),
+               SN = multiply(S, N);
+    const double u2 = contract(UU, m), us = contract(US, m), s2 = contract(SS, m);
+    const double u3 = contract(multiply(UU, U), m), u2s = contract(multiply(UU, S), m),
+                 us2 = contract(multiply(SS, U), m), s3 = contract(multiply(SS, S), m);
+    const double u4 = contract(multiply(UU, UU), m), u3s = contract(multiply(UU, US), m),
+                 u2s2 = contract(multiply(UU, SS), m), us3 = contract(multiply(US, SS), m),
+                 s4 = contract(multiply(SS, SS), m);
+    NormalEquations e;
+    auto& a = e.ata;
+    a[0][0] = u4;
+    a[1][0] = u3s, a[1][1] = u2s2;
+    a[2][0] = u2s2, a[2][1] = us3, a[2][2] = s4;
+    a[3][0] = u3, a[3][1] = u2s, a[3][2] = us2, a[3][3] = u2;
+    a[4][0] = u2s, a[4][1] = us2, a[4][2] = s3, a[4][3] = us, a[4][4] = s2;
+    e.atb = {contract(multiply(UU, N), m), contract(multiply(US, N), m),
+             contract(multiply(SS, N), m), contract(UN, m), contract(SN, m)};
+    const double count = m[0] - 1;  // the vertex itself is in its window, at d = 0
+    e.m = count > 0 ? std::size_t(std::llround(count)) : 0;
+    // The mean neighbour distance, which the fit only uses to make itself scale-free and to
+    // measure curvedness: the root mean square distance times 2 sqrt(2) / 3, their ratio on a
+    // uniformly filled disk.
+    const double sum2 = m[4] + m[7] + m[9];  // x^2 + y^2 + z^2
+    e.scale =
+        count > 0 ? std::sqrt(std::max(0.0, sum2) / count) * (2 * std::numbers::sqrt2 / 3) : 0.0;
+    return e;
+}
+
+constexpr int kTile = 64;       // output pixels per tile side
+constexpr int kMaxReach = 128;  // a window reaching further (pixels) takes the mesh path
+
+struct GridLayout {
+    int width = 0, height = 0;
+    bool seam = false;
+    std::vector<std::int32_t> pixel_vertex;  // the vertex a pixel owns, or -1
+};
+
+struct GridScratch {
+    std::vector<Vec3> position;   // region pixels; x NaN where no vertex
+    std::vector<double> prefix;   // per region row, (cols + 1) x kMoments running sums
+    std::vector<int> lo, hi;      // the current window's span in each row offset
+    std::vector<double> spacing;  // adjacent-pixel distances, to size the region
+    Scratch mesh;
+};
+
+GridLayout grid_layout(const TriangleMesh& mesh) {
+    GridLayout g;
+    g.width = mesh.grid_width, g.height = mesh.grid_height;
+    g.seam = mesh.seam_closed;
+    g.pixel_vertex.assign(std::size_t(g.width) * std::size_t(g.height), -1);
+    for (std::size_t v = mesh.vertex_pixel.size(); v-- > 0;)
+        g.pixel_vertex[std::size_t(mesh.vertex_pixel[v])] = std::int32_t(v);
+    // A collapsed pole row is one vertex: it takes the mesh path.
+    for (int row : mesh.pole_rows)
+        if (row >= 0)
+            std::fill_n(g.pixel_vertex.begin() + std::ptrdiff_t(row) * g.width, g.width, -1);
+    return g;
+}
+
+using VertexFn = std::function<void(std::int32_t, bool, const PrincipalCurvatures&, double)>;
+
+// The vertices of one tile of output pixels [c0, c0 + kTile) x [r0, r0 + kTile).
+void grid_tile(const TriangleMesh& mesh, const GridLayout& g, const std::vector<Vec3>& normals,
+               const ShapeIndexOptions& options, int r0, int c0, GridScratch& s,
+               std::size_t& mesh_fallbacks, const VertexFn& body) {
+    const int W = g.width, H = g.height;
+    const int r1 = std::min(H, r0 + kTile), c1 = std::min(W, c0 + kTile);
+    const auto vertex_at = [&](int col, int row) {
+        return g.pixel_vertex[std::size_t(row) * std::size_t(W) + std::size_t(col)];
+    };
+    const auto fallback = [&](std::int32_t v) {
+        PrincipalCurvatures k;
+        double scale = 0;
+        const bool ok = mesh_fit(mesh, v, normals[std::size_t(v)], options, s.mesh, k, scale);
+        body(v, ok, k, scale);
+        ++mesh_fallbacks;
+    };
+    const auto fallback_tile = [&] {
+        for (int row = r0; row < r1; ++row)
+            for (int col = c0; col < c1; ++col)
+                if (const auto v = vertex_at(col, row); v >= 0) fallback(v);
+    };
+    // How far (in pixels) the ball can reach: from the short end of the tile's distances
+    // between neighbouring pixels, with a margin; a window reaching the margin takes the
+    // mesh path.
+    const auto reach = [&](int dc, int dr) {
+        s.spacing.clear();
+        for (int row = r0; row + dr < r1; ++row)
+            for (int col = c0; col + dc < c1; ++col) {
+                const auto a = vertex_at(col, row), b = vertex_at(col + dc, row + dr);
+                if (a < 0 || b < 0) continue;
+                const Vec3 d = sub(mesh.positions[std::size_t(a)], mesh.positions[std::size_t(b)]);
+                s.spacing.push_back(std::sqrt(dot(d, d)));
+            }
+        if (s.spacing.empty()) return kMaxReach + 1;
+        const auto tenth = s.spacing.begin() + std::ptrdiff_t(s.spacing.size() / 10);
+        std::nth_element(s.spacing.begin(), tenth, s.spacing.end());
+        if (!(*tenth > 0)) return kMaxReach + 1;
+        const double r = 1.25 * options.radius / *tenth + 2;
+        return r > kMaxReach ? kMaxReach + 1 : int(std::ceil(r));
+    };
+    const int mx = reach(1, 0), my = reach(0, 1);
+    if (mx > kMaxReach || my > kMaxReach) return fallback_tile();
+    // The region: the tile and its margins (rows clipped to the grid; columns clipped, or
+    // wrapped across the seam of a global grid).
+    const int rr0 = std::max(0, r0 - my), rr1 = std::min(H, r1 + my);
+    for (int row : mesh.pole_rows)
+        if (row >= rr0 && row < rr1) return fallback_tile();
+    int cc0 = c0 - mx, cc1 = c1 + mx;
+    if (g.seam) {
+        if (cc1 - cc0 > W) return fallback_tile();
+    } else {
+        cc0 = std::max(0, cc0), cc1 = std::min(W, cc1);
+    }
+    const int rows = rr1 - rr0, cols = cc1 - cc0;
+    const auto region_col = [&](int col) { return ((col % W) + W) % W; };
+    // The tile's reference point: its first vertex.
+    Vec3 ref{0, 0, 0};
+    bool any = false;
+    for (int row = r0; row < r1 && !any; ++row)
+        for (int col = c0; col < c1 && !any; ++col)
+            if (const auto v = vertex_at(col, row); v >= 0) {
+                const auto& p = mesh.positions[std::size_t(v)];
+                ref = {p[0], p[1], p[2]}, any = true;
+            }
+    if (!any) return;
+    s.position.resize(std::size_t(rows) * std::size_t(cols));
+    s.prefix.resize(std::size_t(rows) * std::size_t(cols + 1) * kMoments);
+    for (int lr = 0; lr < rows; ++lr) {
+        double* running = &s.prefix[std::size_t(lr) * std::size_t(cols + 1) * kMoments];
+        std::fill_n(running, kMoments, 0.0);
+        for (int lc = 0; lc < cols; ++lc) {
+            const auto v = vertex_at(region_col(cc0 + lc), rr0 + lr);
+            Vec3& p = s.position[std::size_t(lr) * std::size_t(cols) + std::size_t(lc)];
+            double* next = running + kMoments;
+            if (v < 0) {
+                p = {std::numeric_limits<double>::quiet_NaN(), 0, 0};
+                std::copy_n(running, kMoments, next);
+            } else {
+                const auto& q = mesh.positions[std::size_t(v)];
+                p = {q[0], q[1], q[2]};
+                double mono[kMoments];
+                monomials({p[0] - ref[0], p[1] - ref[1], p[2] - ref[2]}, mono);
+                for (int k = 0; k < kMoments; ++k) next[k] = running[k] + mono[k];
+            }
+            running = next;
+        }
+    }
+    const double r2 = options.radius * options.radius;
+    const int offsets = 2 * my + 1;
+    s.lo.assign(std::size_t(offsets), 0);
+    s.hi.assign(std::size_t(offsets), -1);
+    for (int row = r0; row < r1; ++row) {
+        bool warm = false;  // the spans hold the previous pixel's window
+        const int lr = row - rr0;
+        for (int col = c0; col < c1; ++col) {
+            const auto v = vertex_at(col, row);
+            if (v < 0) {
+                warm = false;
+                continue;
+            }
+            const int lc = col - cc0;
+            const Vec3 centre = s.position[std::size_t(lr) * std::size_t(cols) + std::size_t(lc)];
+            // Within the ball, as the mesh path tests it.
+            // (A pixel without a vertex has a NaN position: never inside.)
+            const auto inside = [&](int r, int c) {
+                const Vec3& p = s.position[std::size_t(r) * std::size_t(cols) + std::size_t(c)];
+                const Vec3 d{p[0] - centre[0], p[1] - centre[1], p[2] - centre[2]};
+                return dot(d, d) <= r2;
+            };
+            // The next pixel of the row within the ball beyond `from` in direction `step`,
+            // stepping over pixels without a vertex, at most mx columns from the centre; -1.
+            const auto next_inside = [&](int r, int from, int step) {
+                for (int c = from + step; c >= 0 && c < cols && std::abs(c - lc) <= mx; c += step) {
+                    if (inside(r, c)) return c;
+                    const Vec3& p = s.position[std::size_t(r) * std::size_t(cols) + std::size_t(c)];
+                    if (!std::isnan(p[0])) return -1;
+                }
+                return -1;
+            };
+            bool ok = true;
+            for (int dir = 1; dir >= -1 && ok; dir -= 2) {
+                int guess = lc;
+                for (int k = dir > 0 ? 0 : 1; k <= my; ++k) {
+                    const int dy = dir * k, r = lr + dy;
+                    int& lo = s.lo[std::size_t(dy + my)];
+                    int& hi = s.hi[std::size_t(dy + my)];
+                    if (r < 0 || r >= rows) {
+                        lo = 0, hi = -1;
+                        continue;
+                    }
+                    if (warm && lo <= hi) {
+                        if (inside(r, hi))
+                            for (int c; (c = next_inside(r, hi, 1)) >= 0;) hi = c;
+                        else
+                            while (hi >= lo && !inside(r, hi)) --hi;
+                        if (hi >= lo) {
+                            if (inside(r, lo))
+                                for (int c; (c = next_inside(r, lo, -1)) >= 0;) lo = c;
+                            else
+                                while (lo <= hi && !inside(r, lo)) ++lo;
+                        }
+                    } else {
+                        lo = 0, hi = -1;
+                    }
+                    if (lo > hi) {
+                        // Search next to where the row nearer the centre had its middle.
+                        for (int t : {0, -1, 1, -2, 2}) {
+                            const int c = guess + t;
+                            if (c >= 0 && c < cols && inside(r, c)) {
+                                lo = hi = c;
+                                for (int n; (n = next_inside(r, hi, 1)) >= 0;) hi = n;
+                                for (int n; (n = next_inside(r, lo, -1)) >= 0;) lo = n;
+                                break;
+                            }
+                        }
+                    }
+                    if (lo > hi) {  // the ball ends here: the rows beyond are empty too
+                        for (int j = k + 1; j <= my; ++j) {
+                            s.lo[std::size_t(dir * j + my)] = 0;
+                            s.hi[std::size_t(dir * j + my)] = -1;
+                        }
+                        break;
+                    }
+                    guess = (lo + hi) / 2;
+                    // At the region's margin the ball may go on beyond it.
+                    const bool edge_left = lc - lo >= mx && (g.seam || cc0 + lo > 0);
+                    const bool edge_right = hi - lc >= mx && (g.seam || cc0 + hi < W - 1);
+                    const bool edge_row = k == my && (dir > 0 ? rr0 + r < H - 1 : rr0 + r > 0);
+                    if (edge_left || edge_right || edge_row) {
+                        ok = false;
+                        break;
+                    }
+                }
+            }
+            if (!ok) {
+                fallback(v);
+                warm = false;
+                continue;
+            }
+            warm = true;
+            // The moments about the reference, then about the vertex.
+            double moments[kMoments] = {};  // about the reference, then about the vertex
+            for (int dy = -my; dy <= my; ++dy) {
+                const int lo = s.lo[std::size_t(dy + my)], hi = s.hi[std::size_t(dy + my)];
+                if (lo > hi) continue;
+                const double* row_sums =
+                    &s.prefix[std::size_t(lr + dy) * std::size_t(cols + 1) * kMoments];
+                const double* a = row_sums + std::size_t(lo) * kMoments;
+                const double* b = row_sums + std::size_t(hi + 1) * kMoments;
+                for (int k = 0; k < kMoments; ++k) moments[k] += b[k] - a[k];
+            }
+            const Vec3 t{centre[0] - ref[0], centre[1] - ref[1], centre[2] - ref[2]};
+            // sum (e - t)^a from sum e^a, axis by axis.
+#pragma GCC unroll 105
+            for (const auto& step : kShift)
+                moments[step.target] -= t[step.axis] * moments[step.source];
+            PrincipalCurvatures k;
+            const auto equations = equations_from_moments(moments, normals[std::size_t(v)]);
+            const bool fitted = solve_curvatures(equations, k);
+            body(v, fitted, k, equations.scale);
+        }
+    }
+}
+
+bool grid_applies(const TriangleMesh& mesh, const ShapeIndexOptions& options) {
+    if (options.method == ShapeIndexMethod::mesh || !(options.radius > 0)) return false;
+    const bool grid = mesh.grid_width > 0 && mesh.grid_height > 0 &&
+                      mesh.vertex_pixel.size() == mesh.vertex_count();
+    if (options.method == ShapeIndexMethod::grid && !grid)
+        throw Error("field", "the grid method needs a mesh made from a DEM");
+    return grid;
+}
+
+// Every vertex once through `body`, by tiles of pixels; vertices no pixel owns (pinched
+// copies, collapsed poles) and windows the tiles cannot hold take the mesh path.
+std::size_t grid_for_each_vertex(const TriangleMesh& mesh, const ShapeIndexOptions& options,
+                                 const std::vector<Vec3>& normals, const ProgressFn& progress,
+                                 const VertexFn& body) {
+    const auto g = grid_layout(mesh);
+    tbb::enumerable_thread_specific<GridScratch> scratch;
+    tbb::enumerable_thread_specific<std::size_t> fallbacks(0);
+    const int tile_rows = (g.height + kTile - 1) / kTile, tile_cols = (g.width + kTile - 1) / kTile;
+    for (int tr = 0; tr < tile_rows; ++tr) {
+        tbb::parallel_for(tbb::blocked_range<int>(0, tile_cols, 1), [&](const auto& r) {
+            for (int tc = r.begin(); tc < r.end(); ++tc)
+                grid_tile(mesh, g, normals, options, tr * kTile, tc * kTile, scratch.local(),
+                          fallbacks.local(), body);
+        });
+        report_progress(progress, double(tr + 1) / tile_rows, "shape index");
+    }
+    std::vector<std::int32_t> unowned;
+    for (std::size_t v = 0; v < mesh.vertex_count(); ++v)
+        if (g.pixel_vertex[std::size_t(mesh.vertex_pixel[v])] != std::int32_t(v))
+            unowned.push_back(std::int32_t(v));
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, unowned.size(), 64), [&](const auto& r) {
+        auto& s = scratch.local();
+        for (std::size_t i = r.begin(); i < r.end(); ++i) {
+            const auto v = unowned[i];
+            PrincipalCurvatures k;
+            double scale = 0;
+            const bool ok = mesh_fit(mesh, v, normals[std::size_t(v)], options, s.mesh, k, scale);
+            body(v, ok, k, scale);
+        }
+    });
+    return fallbacks.combine(std::plus<>()) + unowned.size();
+}
+
 template <class Body>
 void for_each_vertex(const TriangleMesh& mesh, const ShapeIndexOptions& options,
                      const ProgressFn& progress, Body body) {
@@ -190,6 +660,10 @@ void for_each_vertex(const TriangleMesh& mesh, const ShapeIndexOptions& options,
     if (options.radius < 0 || !std::isfinite(options.radius))
         throw Error("field", "--radius must be a positive number of metres");
     const auto normals = vertex_normals(mesh);
+    if (grid_applies(mesh, options)) {
+        grid_for_each_vertex(mesh, options, normals, progress, body);
+        return;
+    }
     const auto n = static_cast<std::int32_t>(mesh.vertex_count());
     tbb::enumerable_thread_specific<Scratch> scratch;
     const std::int32_t chunk = 1 << 16;
@@ -198,11 +672,9 @@ void for_each_vertex(const TriangleMesh& mesh, const ShapeIndexOptions& options,
         tbb::parallel_for(tbb::blocked_range<std::int32_t>(start, stop, 512), [&](const auto& r) {
             Scratch& s = scratch.local();
             for (std::int32_t v = r.begin(); v < r.end(); ++v) {
-                gather(mesh, v, options, s);
                 PrincipalCurvatures k;
                 double scale = 0;
-                const bool ok = fit_curvatures(mesh, v, normals[v], s.gathered.data() + 1,
-                                               s.gathered.size() - 1, k, scale);
+                const bool ok = mesh_fit(mesh, v, normals[v], options, s, k, scale);
                 body(v, ok, k, scale);
             }
         });
@@ -216,6 +688,10 @@ double shape_index(double k1, double k2) {
     if (k1 < k2) std::swap(k1, k2);
     if (k1 == 0 && k2 == 0) return 0.0;
     return 2.0 / std::numbers::pi * std::atan2(k1 + k2, k1 - k2);
+}
+
+const char* shape_index_method(const TriangleMesh& mesh, const ShapeIndexOptions& options) {
+    return grid_applies(mesh, options) ? "grid" : "mesh";
 }
 
 std::vector<PrincipalCurvatures> principal_curvatures(const TriangleMesh& mesh,

@@ -331,6 +331,9 @@ void write_run_json(const SegmentResult& result, const std::string& input_path,
         .field("saddle_penalty", options.saddle_penalty)
         .field("format", options.format)
         .field("frame", to_string(result.input.mesh.frame));
+    if (options.field == "shape-index")
+        j.field("shape_index_method",
+                field::shape_index_method(result.input.mesh, options.shape_index));
     if (options.field == "sdf")
         j.field("rays", options.rays)
             .field("cone_angle_degrees", options.cone_angle_degrees)

@@ -12,12 +12,23 @@
 
 namespace terrain::field {
 
+// How the neighbourhood sums are made. mesh: per vertex over its gathered neighbours (cost
+// grows with their number). grid (meshes made from a DEM, with a radius): from per-row prefix
+// sums of the pixels' moments, a window row costing the same whatever its length
+// (docs/field.md, "The grid method"). automatic: grid when it applies, else mesh.
+enum class ShapeIndexMethod { automatic, mesh, grid };
+
 struct ShapeIndexOptions {
     int rings = 2;      // neighbourhood: vertices within this many mesh edges
     double radius = 0;  // > 0: vertices within this distance in metres instead of rings
     // Curvedness times the mean neighbour distance below this is a planar point (SI 0).
     double planar_curvedness = 1e-4;
+    ShapeIndexMethod method = ShapeIndexMethod::automatic;
 };
+
+// The method shape_index_field takes for this mesh and these options: "grid" or "mesh".
+// Throws terrain::Error when `grid` is asked for a mesh not made from a DEM.
+const char* shape_index_method(const TriangleMesh& mesh, const ShapeIndexOptions& options);
 
 struct PrincipalCurvatures {
     double k1 = 0, k2 = 0;  // k1 >= k2, positive where the surface is convex (a cap)
