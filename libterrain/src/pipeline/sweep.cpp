@@ -156,7 +156,7 @@ SweepResult run_sweep(Input input, const std::vector<ScaleSpec>& specs,
         SegmentOptions scale_options = options;
         scale_options.simplify.area_ratio = specs[i].ratio;
         scale_options.min_area.clear();
-        auto result = segment_scale(base.input, graph, scale_options);
+        auto result = segment_scale(base.input, base.field, graph, scale_options);
         scales[i].ratio = specs[i].ratio;
         scales[i].name = specs[i].name;
         scales[i].min_area_m2 = specs[i].min_area_m2;
