@@ -160,9 +160,13 @@ TEST_CASE("pipeline::sweep over areas: each scale is a segment at that --min-are
     CHECK(sweep.scales[0].name == "100km2");
     CHECK(sweep.scales[0].min_area_m2 == 1e8);
     CHECK(sweep.scales[0].ratio < sweep.scales[1].ratio);
-    options.min_area = "400km2";
+    // The finest scale is a segment at its area; the coarser one continues from it.
+    options.min_area = "100km2";
     const auto one = pipeline::segment(pipeline::load_input(path), options);
-    CHECK(sweep.scales[1].ratio == one.area_ratio_percent);
-    CHECK(sweep.scales[1].segmentation.labels == one.segmentation.labels);
+    CHECK(sweep.scales[0].ratio == one.area_ratio_percent);
+    CHECK(sweep.scales[0].segmentation.labels == one.segmentation.labels);
+    options.min_area = "400km2";
+    const auto coarse = pipeline::segment(pipeline::load_input(path), options);
+    CHECK(sweep.scales[1].ratio == coarse.area_ratio_percent);
     CHECK(sweep.scales[0].segmentation.region_count >= sweep.scales[1].segmentation.region_count);
 }

@@ -209,7 +209,8 @@ namespace {
 // Regions grown on a simplified graph.
 ScaleResult grow_scale(const Input& input, const std::vector<float>& field,
                        const SegmentOptions& options, const reeb::SimplifyResult& simplified,
-                       double simplify_seconds, const ProgressFn& progress) {
+                       double simplify_seconds, const ProgressFn& progress,
+                       const std::vector<std::uint32_t>* finer = nullptr) {
     ScaleResult out;
     out.after = reeb::summarize(simplified.graph);
     out.simplify_seconds = simplify_seconds;
@@ -220,12 +221,18 @@ ScaleResult grow_scale(const Input& input, const std::vector<float>& field,
     out.segmentation = segment::grow_regions(input.mesh, simplified.graph, grow, progress);
     if (parse_absorbed(options.absorbed) == Absorbed::divide)
         out.divided = segment::divide_absorbed(input.mesh, simplified.graph, field,
-                                               simplified.absorbed, out.segmentation);
+                                               simplified.absorbed, out.segmentation, finer);
     out.grow_seconds = since(t0);
     return out;
 }
 
 }  // namespace
+
+ScaleResult grow_simplified(const Input& input, const std::vector<float>& field,
+                            const SegmentOptions& options, const reeb::SimplifyResult& simplified,
+                            const std::vector<std::uint32_t>* finer, const ProgressFn& progress) {
+    return grow_scale(input, field, options, simplified, 0, progress, finer);
+}
 
 ScaleResult segment_scale(const Input& input, const std::vector<float>& field,
                           const reeb::ReebGraph& graph, const SegmentOptions& options,

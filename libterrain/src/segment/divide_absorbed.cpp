@@ -17,6 +17,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <queue>
 #include <string>
 
@@ -46,17 +47,36 @@ struct Step {
 constexpr float kStepShare = 0.01f;
 
 // The field's range over the vertices that keep their region (1 when flat).
-float field_spread(const std::vector<float>& field, const std::vector<std::uint8_t>& absorbed) {
-    float lo = 0, hi = 0;
-    bool any = false;
-    for (std::size_t v = 0; v < field.size(); ++v) {
-        (void)absorbed;
-        if (!any) lo = hi = field[v];
-        any = true;
-        lo = std::min(lo, field[v]);
-        hi = std::max(hi, field[v]);
+float field_spread(const std::vector<float>& field) {
+    if (field.empty()) return 1.0f;
+    const auto [lo, hi] = std::minmax_element(field.begin(), field.end());
+    return *hi > *lo ? *hi - *lo : 1.0f;
+}
+
+// Each finer region's region here: the one most of its vertices that kept a region are in
+// (ties to the lower id; 0 when none kept one).
+std::vector<std::uint32_t> finer_to_here(const std::vector<std::uint32_t>& finer,
+                                         const std::vector<std::uint32_t>& labels) {
+    std::uint32_t top = 0;
+    for (const auto f : finer) top = std::max(top, f);
+    std::vector<std::uint64_t> pairs;  // (finer region, region here), for kept vertices
+    for (std::size_t v = 0; v < labels.size(); ++v)
+        if (labels[v] != 0 && finer[v] != 0)
+            pairs.push_back(std::uint64_t{finer[v]} << 32 | labels[v]);
+    std::sort(pairs.begin(), pairs.end());
+    std::vector<std::uint32_t> out(std::size_t{top} + 1, 0);
+    std::vector<std::size_t> best(out.size(), 0);
+    for (std::size_t i = 0; i < pairs.size();) {
+        std::size_t j = i;
+        while (j < pairs.size() && pairs[j] == pairs[i]) ++j;
+        const auto f = static_cast<std::uint32_t>(pairs[i] >> 32);
+        if (j - i > best[f]) {
+            best[f] = j - i;
+            out[f] = static_cast<std::uint32_t>(pairs[i]);
+        }
+        i = j;
     }
-    return hi > lo ? hi - lo : 1.0f;
+    return out;
 }
 
 double mean_edge_length(const TriangleMesh& mesh) {
@@ -78,9 +98,11 @@ double mean_edge_length(const TriangleMesh& mesh) {
 
 DivideCounts divide_absorbed(const TriangleMesh& mesh, const reeb::ReebGraph& graph,
                              const std::vector<float>& field,
-                             const std::vector<std::uint8_t>& absorbed,
-                             Segmentation& segmentation) {
+                             const std::vector<std::uint8_t>& absorbed, Segmentation& segmentation,
+                             const std::vector<std::uint32_t>* finer) {
     const std::size_t n = mesh.vertex_count();
+    if (finer && finer->size() != n)
+        throw Error("segment", "divide_absorbed: the finer labels do not match the mesh");
     auto& labels = segmentation.labels;
     if (field.size() != n || absorbed.size() != n || labels.size() != n ||
         graph.vertex_nodes.size() != n)
@@ -93,6 +115,12 @@ DivideCounts divide_absorbed(const TriangleMesh& mesh, const reeb::ReebGraph& gr
             ++counts.absorbed;
         }
     if (counts.absorbed == 0) return counts;
+    // 1b. With a finer scale's labels: absorbed vertices first go with their finer region.
+    if (finer) {
+        const auto here = finer_to_here(*finer, labels);
+        for (std::size_t v = 0; v < n; ++v)
+            if (absorbed[v]) labels[v] = here[(*finer)[v]];
+    }
     const auto neighbours = [&](std::size_t v, auto&& f) {
         for (i32 k = mesh.neighbor_offsets[v]; k < mesh.neighbor_offsets[v + 1]; ++k)
             f(idx(mesh.neighbors[idx(k)]));
@@ -127,9 +155,15 @@ DivideCounts divide_absorbed(const TriangleMesh& mesh, const reeb::ReebGraph& gr
         }
     // 3. Flooding from the regions' edges: the shortest paths in the metric where a step
     // into u for region r costs |field(u) - mean(r)| plus a constant per mean edge length.
-    const float step = kStepShare * field_spread(field, absorbed);
+    const float step = kStepShare * field_spread(field);
     const double mean_edge = mean_edge_length(mesh);
+    // cost: a labelled vertex's path cost; for the others, the best offer so far (from
+    // `offer`), so that only better offers are queued (the same result as queuing every
+    // one: costs grow along a path, so a vertex's first offer taken is its cheapest).
     std::vector<float> cost(n, 0.0f);
+    std::vector<std::uint32_t> offer(n, 0);
+    for (std::size_t v = 0; v < n; ++v)
+        if (labels[v] == 0) cost[v] = std::numeric_limits<float>::infinity();
     // Each region's mean of the field over the vertices it kept (area-weighted), fixed for
     // the flooding.
     std::vector<double> sum(segmentation.seeds.size() + 1, 0.0),
@@ -154,6 +188,9 @@ DivideCounts divide_absorbed(const TriangleMesh& mesh, const reeb::ReebGraph& gr
                                          double(p[2] - q[2]) * (p[2] - q[2]));
             const float c = cost[w] + std::fabs(field[u] - mean[labels[w]]) +
                             step * static_cast<float>(len / mean_edge);
+            if (c > cost[u] || (c == cost[u] && labels[w] >= offer[u])) return;
+            cost[u] = c;
+            offer[u] = labels[w];
             heap.push({c, static_cast<i32>(u), labels[w]});
         });
     };
@@ -167,7 +204,7 @@ DivideCounts divide_absorbed(const TriangleMesh& mesh, const reeb::ReebGraph& gr
         const Step s = heap.top();
         heap.pop();
         const std::size_t u = idx(s.vertex);
-        if (labels[u] != 0) continue;
+        if (labels[u] != 0 || s.cost != cost[u] || s.label != offer[u]) continue;
         labels[u] = s.label;
         cost[u] = s.cost;
         push_around(u);

@@ -152,6 +152,13 @@ struct ScaleResult {
     double simplify_seconds = 0, grow_seconds = 0;
 };
 // Reads its arguments only, so scales can run side by side.
+// The regions grown on a graph already simplified (a sweep's scale, continuing from the
+// finer one's graph); `field` is the field before any simplification; `finer`, if given,
+// the finer scale's vertex labels (segment::divide_absorbed).
+ScaleResult grow_simplified(const Input& input, const std::vector<float>& field,
+                            const SegmentOptions& options, const reeb::SimplifyResult& simplified,
+                            const std::vector<std::uint32_t>* finer = nullptr,
+                            const ProgressFn& progress = {});
 // `field` is the field the graph was built on (before any simplification).
 ScaleResult segment_scale(const Input& input, const std::vector<float>& field,
                           const reeb::ReebGraph& graph, const SegmentOptions& options,

@@ -32,8 +32,13 @@ struct DivideCounts {
 // then region). The region count and seeds are unchanged; every region
 // stays connected on the mesh (each vertex joins next to a vertex of its region); every vertex
 // keeps a region. Deterministic, O(n log n). Throws terrain::Error when the sizes disagree.
+// `finer`: the labels of a finer scale of a sweep whose graph this one's continues. Before the
+// flooding, the absorbed vertices of each finer region go to the region most of that finer
+// region's other vertices are in here (then the connectivity rule above applies), so that
+// regions nest in those of coarser scales where the graph allows it.
 DivideCounts divide_absorbed(const TriangleMesh& mesh, const reeb::ReebGraph& graph,
                              const std::vector<float>& field,
-                             const std::vector<std::uint8_t>& absorbed, Segmentation& segmentation);
+                             const std::vector<std::uint8_t>& absorbed, Segmentation& segmentation,
+                             const std::vector<std::uint32_t>* finer = nullptr);
 
 }  // namespace terrain::segment
