@@ -1,6 +1,7 @@
 // terrain segment INPUT -o OUTDIR [field options] [--persistence 10]
 //                  [--area-ratio 0.5 | --min-area AREA] [--cost graph|standard]
-//                  [--saddle-penalty 20] [--format GeoJSON] [--timings]
+//                  [--saddle-penalty 20] [--absorbed divide|whole] [--format GeoJSON]
+//                  [--timings]
 // The main job: field, Reeb graph, simplification, region growing, and every output file
 // (terrain/pipeline/segment.hpp does the work). The outputs are written into a temporary
 // sibling directory that replaces OUTDIR at the end, so OUTDIR appears complete or not at all.
@@ -26,7 +27,7 @@ int run_segment(int argc, char** argv) {
         if (!parse_command(argc, argv,
                            "terrain segment INPUT -o OUTDIR [--persistence 10] [--area-ratio 0.5 | "
                            "--min-area AREA] [--cost graph|standard] [--saddle-penalty 20] "
-                           "[--format GeoJSON|GPKG|...] [--timings]",
+                           "[--absorbed divide|whole] [--format GeoJSON|GPKG|...] [--timings]",
                            options, vm))
             return 0;
         to_field_options(field_values, vm);  // refuses contradictions (exit status 2)

@@ -17,6 +17,9 @@ void add_segment_options(po::options_description& options, SegmentOptionValues& 
         "graph (Reeb-graph constrained), standard, or auto: graph for DEMs, standard for meshes")(
         "saddle-penalty", po::value(&values.grow.saddle_penalty)->default_value(20.0),
         "graph cost: penalty for joining a saddle with several unassigned branches")(
+        "absorbed", po::value(&values.absorbed)->default_value("divide"),
+        "divide: the vertices cancellations absorbed go back to the regions around them by "
+        "their own values; whole: each surviving node grows as one unit (the paper)")(
         "format", po::value(&values.format)->default_value("GeoJSON"),
         "OGR driver of the region polygons (GeoJSON, GPKG, ...)")(
         "timings", po::bool_switch(&values.timings), "print the time of each stage");
@@ -40,6 +43,7 @@ pipeline::SegmentOptions to_pipeline_options(const FieldOptionValues& field,
     out.min_area = values.min_area;
     out.cost = values.cost;
     out.saddle_penalty = values.grow.saddle_penalty;
+    out.absorbed = values.absorbed;
     out.format = values.format;
     pipeline::check_options(out);
     return out;

@@ -17,11 +17,13 @@ struct SegmentOptionValues {
     std::string min_area;  // --min-area as given, or empty
     segment::GrowOptions grow;
     std::string cost = "auto";
+    std::string absorbed = "divide";
     std::string format = "GeoJSON";
     bool timings = false;
 };
 
-// --persistence, --area-ratio, --min-area, --cost, --saddle-penalty, --format, --timings.
+// --persistence, --area-ratio, --min-area, --cost, --saddle-penalty, --absorbed, --format,
+// --timings.
 void add_segment_options(po::options_description& options, SegmentOptionValues& values);
 
 // Throws UsageError (exit status 2) when both --area-ratio and `area_option` are given.

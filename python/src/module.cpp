@@ -398,6 +398,7 @@ PYBIND11_MODULE(_terrain, m) {
             })
         .def_readwrite("cost", &pipeline::SegmentOptions::cost)
         .def_readwrite("saddle_penalty", &pipeline::SegmentOptions::saddle_penalty)
+        .def_readwrite("absorbed", &pipeline::SegmentOptions::absorbed)
         .def_readwrite("format", &pipeline::SegmentOptions::format)
         .def("check", &pipeline::check_options);
 

@@ -40,7 +40,8 @@ __all__ = [
 # The options of `terrain segment` (docs/cli.md), as keyword arguments.
 _SEGMENT_OPTIONS = (
     "field", "rings", "radius", "rays", "cone_angle", "postprocess", "allow_open",
-    "persistence", "area_ratio", "min_area", "cost", "saddle_penalty", "format",
+    "persistence", "area_ratio", "min_area", "cost", "saddle_penalty", "absorbed",
+    "format",
 )
 # How the input is read and meshed.
 _INPUT_OPTIONS = ("band", "elevation", "nan_nodata", "pixel_size", "frame", "repair")
@@ -215,7 +216,8 @@ def segment(dem, geotransform=None, crs=None, *, progress=None, **options):
         allow_open=False, persistence=10, area_ratio=0.5 (percent) or min_area (an area on
         the body: m^2 as a number, or "5km2", "2000m2", "3ha"; an arc is cancelled when its
         area is below it, whatever the tile's extent), cost="auto" ("graph",
-        "standard"), saddle_penalty=20, format="GeoJSON"; reading: band=1,
+        "standard"), saddle_penalty=20, absorbed="divide" (or "whole", the paper's
+        growing), format="GeoJSON"; reading: band=1,
         elevation="auto", nan_nodata=False, pixel_size=None, frame="auto", repair=False.
     progress: optional callable progress(fraction, message); return False to cancel.
     Returns a SegmentResult (.labels, .regions, .graph, .to_geodataframe(), .write()).

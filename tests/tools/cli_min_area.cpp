@@ -106,9 +106,20 @@ TEST_CASE("terrain segment and sweep --min-area(s): run.json, bands, same labels
     std::vector<std::uint32_t> p(static_cast<std::size_t>(w) * h), q(p.size());
     REQUIRE(one->GetRasterBand(1)->RasterIO(GF_Read, 0, 0, w, h, p.data(), w, h, GDT_UInt32, 0,
                                             0) == CE_None);
-    REQUIRE(bands->GetRasterBand(2)->RasterIO(GF_Read, 0, 0, w, h, q.data(), w, h, GDT_UInt32, 0,
+    // The finest scale (50 km^2) is a plain segment at that area; the coarser one continues
+    // from its graph, so it is not the plain segment at 200 km^2 (= 20000 ha).
+    const auto fine = dir / "seg50";
+    REQUIRE(
+        run_cli({"segment", dem, "-o", fine.string(), "-q", "--overwrite", "--min-area", "50km2"})
+            .status == 0);
+    std::unique_ptr<GDALDataset> one50(
+        GDALDataset::FromHandle(GDALOpen((fine / "labels.tif").string().c_str(), GA_ReadOnly)));
+    REQUIRE(one50);
+    REQUIRE(one50->GetRasterBand(1)->RasterIO(GF_Read, 0, 0, w, h, p.data(), w, h, GDT_UInt32, 0,
                                               0) == CE_None);
-    CHECK(p == q);  // 200 km^2 = 20000 ha
+    REQUIRE(bands->GetRasterBand(1)->RasterIO(GF_Read, 0, 0, w, h, q.data(), w, h, GDT_UInt32, 0,
+                                              0) == CE_None);
+    CHECK(p == q);
     const auto run = load_json(sweep / "run.json");
     CHECK(run.GetArray("scales")[0].GetDouble("min_area_m2") == 5e7);
     CHECK(run.GetArray("scales")[1].GetDouble("area_ratio_percent") == ratio);

@@ -56,10 +56,11 @@ TEST_CASE("terrain sweep: scales agree with segment, counts fall, lineage adds u
         CHECK(count <= last);
         last = count;
     }
-    // The 0.5 % scale is byte for byte the labels of a plain segment run at 0.5 %.
+    // The finest scale (0.1 %) is byte for byte the labels of a plain segment run at 0.1 %
+    // (the coarser ones continue from it).
     const auto seg = dir / "seg";
-    REQUIRE(run_cli({"segment", dem, "-o", seg.string(), "-q", "--area-ratio", "0.5"}).status == 0);
-    CHECK(read_band(out / "labels.tif", 3) == read_band(seg / "labels.tif", 1));
+    REQUIRE(run_cli({"segment", dem, "-o", seg.string(), "-q", "--area-ratio", "0.1"}).status == 0);
+    CHECK(read_band(out / "labels.tif", 1) == read_band(seg / "labels.tif", 1));
     // Lineage: every region overlaps the next scale, and its overlaps add up to its area.
     CPLJSONDocument lineage;
     REQUIRE(lineage.Load((out / "lineage.json").string()));
@@ -68,6 +69,7 @@ TEST_CASE("terrain sweep: scales agree with segment, counts fall, lineage adds u
     for (int i = 0; i < links.Size(); ++i) {
         const auto regions = links[i].GetArray("regions");
         CHECK(regions.Size() > 0);
+        CHECK(links[i].GetDouble("mean_parent_share") > 0.85);  // 0.87-1.0 on this tile
         for (int k = 0; k < regions.Size(); ++k) {
             const auto overlaps = regions[k].GetArray("overlaps");
             REQUIRE(overlaps.Size() >= 1);
@@ -78,6 +80,16 @@ TEST_CASE("terrain sweep: scales agree with segment, counts fall, lineage adds u
             }
             CHECK(area == Approx(regions[k].GetDouble("area_m2")).epsilon(1e-9));
             CHECK(fraction == Approx(1.0).epsilon(1e-9));
+            // Its parent is its largest overlap, with that share.
+            double largest = 0;
+            int parent = 0;
+            for (int o = 0; o < overlaps.Size(); ++o)
+                if (overlaps[o].GetDouble("fraction") > largest) {
+                    largest = overlaps[o].GetDouble("fraction");
+                    parent = overlaps[o].GetInteger("region");
+                }
+            CHECK(regions[k].GetInteger("parent") == parent);
+            CHECK(regions[k].GetDouble("parent_share") == largest);
         }
     }
     // The GeoPackage has one layer per scale, and layer_styles with a style for each.

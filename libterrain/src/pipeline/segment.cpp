@@ -87,6 +87,13 @@ void check_options(const SegmentOptions& o) {
         throw Error("segment", "--saddle-penalty must be a number >= 0");
     if (o.cost != "auto") segment::parse_grow_cost(o.cost);
     if (!o.min_area.empty()) parse_area(o.min_area);
+    parse_absorbed(o.absorbed);
+}
+
+Absorbed parse_absorbed(const std::string& name) {
+    if (name == "divide") return Absorbed::divide;
+    if (name == "whole") return Absorbed::whole;
+    throw Error("segment", "--absorbed is divide or whole; '" + name + "' is neither");
 }
 
 double parse_area(const std::string& text, const std::string& option) {
@@ -200,9 +207,10 @@ reeb::ReebGraph compute_reeb(SegmentResult& result, const ProgressFn& progress) 
 namespace {
 
 // Regions grown on a simplified graph.
-ScaleResult grow_scale(const Input& input, const SegmentOptions& options,
-                       const reeb::SimplifyResult& simplified, double simplify_seconds,
-                       const ProgressFn& progress) {
+ScaleResult grow_scale(const Input& input, const std::vector<float>& field,
+                       const SegmentOptions& options, const reeb::SimplifyResult& simplified,
+                       double simplify_seconds, const ProgressFn& progress,
+                       const std::vector<std::uint32_t>* finer = nullptr) {
     ScaleResult out;
     out.after = reeb::summarize(simplified.graph);
     out.simplify_seconds = simplify_seconds;
@@ -211,18 +219,29 @@ ScaleResult grow_scale(const Input& input, const SegmentOptions& options,
     grow.saddle_penalty = options.saddle_penalty;
     grow.cost = grow_cost(options, input.dem.has_value());
     out.segmentation = segment::grow_regions(input.mesh, simplified.graph, grow, progress);
+    if (parse_absorbed(options.absorbed) == Absorbed::divide)
+        out.divided = segment::divide_absorbed(input.mesh, simplified.graph, field,
+                                               simplified.absorbed, out.segmentation, finer);
     out.grow_seconds = since(t0);
     return out;
 }
 
 }  // namespace
 
-ScaleResult segment_scale(const Input& input, const reeb::ReebGraph& graph,
-                          const SegmentOptions& options, const ProgressFn& progress) {
+ScaleResult grow_simplified(const Input& input, const std::vector<float>& field,
+                            const SegmentOptions& options, const reeb::SimplifyResult& simplified,
+                            const std::vector<std::uint32_t>* finer, const ProgressFn& progress) {
+    return grow_scale(input, field, options, simplified, 0, progress, finer);
+}
+
+ScaleResult segment_scale(const Input& input, const std::vector<float>& field,
+                          const reeb::ReebGraph& graph, const SegmentOptions& options,
+                          const ProgressFn& progress) {
     const auto t0 = clock::now();
     const auto simplified = reeb::simplify(input.mesh, graph, simplify_options(options, input.mesh),
                                            scaled_progress(progress, 0, 0.3));
-    return grow_scale(input, options, simplified, since(t0), scaled_progress(progress, 0.3, 1));
+    return grow_scale(input, field, options, simplified, since(t0),
+                      scaled_progress(progress, 0.3, 1));
 }
 
 SegmentResult segment(Input input, const SegmentOptions& options, const ProgressFn& progress) {
@@ -244,10 +263,11 @@ SegmentResult segment(Input input, const SegmentOptions& options, const Progress
     const auto simplified = reeb::simplify(result.input.mesh, std::move(graph), thresholds,
                                            scaled_progress(progress, 45.0 / 55, 48.0 / 55));
     const double seconds = since(t0);
-    auto scale = grow_scale(result.input, options, simplified, seconds,
+    auto scale = grow_scale(result.input, result.field, options, simplified, seconds,
                             scaled_progress(progress, 48.0 / 55, 1));
     result.segmentation = std::move(scale.segmentation);
     result.after = scale.after;
+    result.divided = scale.divided;
     result.add_time("simplify", scale.simplify_seconds);
     const auto t1 = clock::now();
     result.regions =
@@ -329,6 +349,7 @@ void write_run_json(const SegmentResult& result, const std::string& input_path,
         j.field("min_area", options.min_area).field("min_area_m2", parse_area(options.min_area));
     j.field("cost", options.cost == "auto" ? (dem ? "graph" : "standard") : options.cost.c_str())
         .field("saddle_penalty", options.saddle_penalty)
+        .field("absorbed", options.absorbed)
         .field("format", options.format)
         .field("frame", to_string(result.input.mesh.frame));
     if (options.field == "shape-index")
@@ -351,6 +372,8 @@ void write_run_json(const SegmentResult& result, const std::string& input_path,
         .field("loops", after.loops)
         .field("regions", static_cast<std::size_t>(result.segmentation.region_count))
         .field("relaxed_nodes", result.segmentation.relaxed_nodes)
+        .field("absorbed_vertices", result.divided.absorbed)
+        .field("absorbed_relabelled", result.divided.relabelled)
         .end_object();
     j.key("timings_seconds").begin_object();
     double total = 0;

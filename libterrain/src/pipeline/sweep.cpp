@@ -2,6 +2,7 @@
 
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
+#include <tbb/task_group.h>
 
 #include <algorithm>
 #include <chrono>
@@ -92,6 +93,12 @@ std::vector<AreaThreshold> parse_min_areas(const std::string& text) {
 
 namespace {
 
+// What a continued scale no longer needs from the finer one (its graph's arcs and vertex
+// lists stay until the coarser scale is simplified from them: this is called after).
+void release(reeb::SimplifyResult& r) {
+    r = reeb::SimplifyResult{};
+}
+
 // One scale to run: its area ratio, name and area threshold (0 for a sweep over ratios).
 struct ScaleSpec {
     double ratio = 0;
@@ -147,29 +154,59 @@ SweepResult run_sweep(Input input, const std::vector<ScaleSpec>& specs,
     compute_field(base, options, scaled_progress(progress, 0, 0.25 / 0.6));
     const auto graph = compute_reeb(base, scaled_progress(progress, 0.25 / 0.6, 0.35 / 0.6));
 
-    // Every scale from the same unsimplified graph, as `segment` would do it.
+    // Scale by scale, finest first, each simplification continuing from the previous scale's
+    // graph: a coarser scale is a simplification of the finer one, so its extrema (and so its
+    // regions' seeds) are among the finer one's. The first is `segment`'s at that threshold.
+    // The absorbed vertices of a coarser scale go first with their finer region
+    // (segment::divide_absorbed). Region tables are made while the next scale is simplified.
     auto& scales = out.scales;
     scales.resize(specs.size());
     const auto t0 = clock::now();
-    tbb::parallel_for(std::size_t{0}, scales.size(), [&](std::size_t i) {
-        const auto s0 = clock::now();
-        SegmentOptions scale_options = options;
-        scale_options.simplify.area_ratio = specs[i].ratio;
-        scale_options.min_area.clear();
-        auto result = segment_scale(base.input, graph, scale_options);
-        scales[i].ratio = specs[i].ratio;
-        scales[i].name = specs[i].name;
-        scales[i].min_area_m2 = specs[i].min_area_m2;
-        scales[i].after = result.after;
-        scales[i].segmentation = std::move(result.segmentation);
-        scales[i].regions =
-            segment::region_graph(base.input.mesh, base.field, scales[i].segmentation.labels,
-                                  scales[i].segmentation.region_count, base.dem());
-        // On a DEM, with the regions of valid pixels in no triangle (segment::label_pixels).
-        scales[i].segmentation.region_count =
-            static_cast<std::uint32_t>(scales[i].regions.regions.size());
-        scales[i].seconds = since(s0);
-    });
+    std::vector<reeb::SimplifyResult> simplified(specs.size());
+    tbb::task_group growing;
+    try {
+        for (std::size_t i = 0; i < specs.size(); ++i) {
+            const auto s0 = clock::now();
+            SegmentOptions scale_options = options;
+            scale_options.simplify.area_ratio = specs[i].ratio;
+            scale_options.min_area.clear();
+            simplified[i] = reeb::simplify(
+                base.input.mesh, i == 0 ? graph : simplified[i - 1].graph, scale_options.simplify);
+            // Absorbed at this scale or a finer one.
+            if (i > 0) {
+                for (std::size_t v = 0; v < simplified[i].absorbed.size(); ++v)
+                    simplified[i].absorbed[v] |= simplified[i - 1].absorbed[v];
+                release(simplified[i - 1]);
+            }
+            auto result = grow_simplified(base.input, base.field, scale_options, simplified[i],
+                                          i == 0 ? nullptr : &scales[i - 1].segmentation.labels);
+            auto& scale = scales[i];
+            scale.ratio = specs[i].ratio;
+            scale.name = specs[i].name;
+            scale.min_area_m2 = specs[i].min_area_m2;
+            scale.after = result.after;
+            scale.segmentation = std::move(result.segmentation);
+            const double seconds = since(s0);
+            report_progress(progress, (0.35 + 0.25 * double(i + 1) / double(specs.size())) / 0.6,
+                            "sweep");
+            growing.run([&, i, seconds] {
+                const auto g0 = clock::now();
+                auto& done = scales[i];
+                done.regions =
+                    segment::region_graph(base.input.mesh, base.field, done.segmentation.labels,
+                                          done.segmentation.region_count, base.dem());
+                done.seconds = seconds + since(g0);
+            });
+        }
+    } catch (...) {
+        growing.wait();
+        throw;
+    }
+    growing.wait();
+    simplified.clear();
+    // On a DEM, with the regions of valid pixels in no triangle (segment::label_pixels).
+    for (auto& scale : scales)
+        scale.segmentation.region_count = static_cast<std::uint32_t>(scale.regions.regions.size());
     // lineage: scale i -> scale i+1.
     out.lineage.resize(scales.empty() ? 0 : scales.size() - 1);
     tbb::parallel_for(std::size_t{0}, out.lineage.size(), [&](std::size_t i) {
@@ -263,12 +300,17 @@ std::vector<std::string> write_sweep_directory(SweepResult& result, const Segmen
         for (std::size_t i = 0; i < result.lineage.size(); ++i) {
             const auto& a = scales[i];
             const auto& b = scales[i + 1];
-            j.begin_object().field("from_area_ratio", a.ratio).field("to_area_ratio", b.ratio);
+            j.begin_object()
+                .field("from_area_ratio", a.ratio)
+                .field("to_area_ratio", b.ratio)
+                .field("mean_parent_share", segment::mean_parent_share(result.lineage[i]));
             j.key("regions").begin_array();
             for (const auto& r : result.lineage[i]) {
                 j.begin_object()
                     .field("region", static_cast<std::int64_t>(r.region))
-                    .field("area_m2", r.area_m2);
+                    .field("area_m2", r.area_m2)
+                    .field("parent", static_cast<std::int64_t>(r.parent))
+                    .field("parent_share", r.parent_share);
                 j.key("overlaps").begin_array();
                 for (const auto& o : r.overlaps)
                     j.begin_object()

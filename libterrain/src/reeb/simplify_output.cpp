@@ -32,12 +32,14 @@ void WorkingGraph::write_result(SimplifyResult& result) {
     }
     // The remaining nodes are numbered in the order of the old ones; node_map_ takes each old
     // node's new node (first -2 - the node that took it, for the absorbed ones).
-    std::vector<std::array<i32, 2>> kept;  // {old node, internal index} by new id
+    std::vector<std::array<i32, 2>> kept;   // {old node, internal index} by new id
+    std::vector<std::uint8_t> gone(nn, 0);  // old nodes absorbed by another
     for (std::size_t n = 0; n < nn; ++n) {
         if (n + kAhead < nn) __builtin_prefetch(&code[idx(node_map_[n + kAhead])]);
         i32& c = code[idx(node_map_[n])];
         if (c != kNone) {
             node_map_[n] = -2 - c;
+            gone[n] = 1;
             continue;
         }
         c = -2 - static_cast<i32>(kept.size());
@@ -75,6 +77,7 @@ void WorkingGraph::write_result(SimplifyResult& result) {
     out.node_vertex_offsets = size;
     out.node_vertices.resize(g_.node_vertices.size());
     out.vertex_nodes.resize(g_.vertex_nodes.size());
+    result.absorbed.assign(g_.vertex_nodes.size(), 0);
     for (std::size_t n = 0; n < nn; ++n) {
         if (n + kAhead < nn) {
             const i32 i = g_.node_vertex_offsets[n + kAhead];
@@ -86,6 +89,7 @@ void WorkingGraph::write_result(SimplifyResult& result) {
             const i32 v = g_.node_vertices[idx(i)];
             out.node_vertices[idx(size[idx(nid)]++)] = v;
             out.vertex_nodes[idx(v)] = nid;
+            result.absorbed[idx(v)] = gone[n];
         }
     }
     result.field.resize(g_.vertex_nodes.size());

@@ -51,10 +51,26 @@ std::vector<RegionLineage> region_lineage(const TriangleMesh& mesh, const Dem* d
         entry.area_m2 += area;
         entry.overlaps.push_back({key.second, area, 0});
     }
-    for (auto& entry : out)
-        for (auto& o : entry.overlaps)
+    for (auto& entry : out) {
+        for (auto& o : entry.overlaps) {
             o.fraction = entry.area_m2 > 0 ? o.area_m2 / entry.area_m2 : 0;
+            if (o.area_m2 > entry.parent_area_m2) {  // ties: the lower id, listed first
+                entry.parent = o.region;
+                entry.parent_area_m2 = o.area_m2;
+                entry.parent_share = o.fraction;
+            }
+        }
+    }
     return out;
+}
+
+double mean_parent_share(const std::vector<RegionLineage>& lineage) {
+    double inside = 0, total = 0;
+    for (const auto& r : lineage) {
+        inside += r.parent_area_m2;
+        total += r.area_m2;
+    }
+    return total > 0 ? inside / total : 1.0;
 }
 
 }  // namespace terrain::segment

@@ -25,6 +25,7 @@
 #include "terrain/mesh/triangle_mesh.hpp"
 #include "terrain/reeb/reeb_graph.hpp"
 #include "terrain/reeb/simplify.hpp"
+#include "terrain/segment/divide_absorbed.hpp"
 #include "terrain/segment/grow_regions.hpp"
 #include "terrain/segment/regions.hpp"
 
@@ -71,7 +72,15 @@ struct SegmentOptions {
     std::string cost = "auto";  // graph, standard, or auto: graph for DEMs, standard for meshes
     double saddle_penalty = 20;
     std::string format = "GeoJSON";  // OGR driver of the region polygons
+    // What the growing does with the vertices the simplification absorbed into surviving
+    // nodes: "divide" (default) gives them back to the regions around by their own values
+    // (segment::divide_absorbed); "whole" keeps each node one unit, as the paper does.
+    std::string absorbed = "divide";
 };
+
+enum class Absorbed { divide, whole };
+// "divide" or "whole"; throws terrain::Error otherwise.
+Absorbed parse_absorbed(const std::string& name);
 
 // Thresholds and names, checked before any long work; throws terrain::Error.
 void check_options(const SegmentOptions& options);
@@ -117,6 +126,7 @@ struct SegmentResult {
     // Its region_count counts every region of the table: on a DEM, after the vertices'
     // regions, those of valid pixels in no triangle (segment::label_pixels).
     segment::Segmentation segmentation;
+    segment::DivideCounts divided;  // with absorbed = divide
     segment::RegionGraph regions;
     std::vector<StageTime> timings;         // read, mesh, field, reeb, simplify, grow, write
     std::optional<MeshCounts> mesh_counts;  // kept by release_large_data for run.json
@@ -137,12 +147,22 @@ reeb::ReebGraph compute_reeb(SegmentResult& result, const ProgressFn& progress =
 // One scale: the graph simplified with options.simplify and the regions grown on it.
 struct ScaleResult {
     segment::Segmentation segmentation;
-    reeb::ReebSummary after;  // of the simplified graph
+    segment::DivideCounts divided;  // with absorbed = divide
+    reeb::ReebSummary after;        // of the simplified graph
     double simplify_seconds = 0, grow_seconds = 0;
 };
 // Reads its arguments only, so scales can run side by side.
-ScaleResult segment_scale(const Input& input, const reeb::ReebGraph& graph,
-                          const SegmentOptions& options, const ProgressFn& progress = {});
+// The regions grown on a graph already simplified (a sweep's scale, continuing from the
+// finer one's graph); `field` is the field before any simplification; `finer`, if given,
+// the finer scale's vertex labels (segment::divide_absorbed).
+ScaleResult grow_simplified(const Input& input, const std::vector<float>& field,
+                            const SegmentOptions& options, const reeb::SimplifyResult& simplified,
+                            const std::vector<std::uint32_t>* finer = nullptr,
+                            const ProgressFn& progress = {});
+// `field` is the field the graph was built on (before any simplification).
+ScaleResult segment_scale(const Input& input, const std::vector<float>& field,
+                          const reeb::ReebGraph& graph, const SegmentOptions& options,
+                          const ProgressFn& progress = {});
 
 // The whole segmentation: field, Reeb graph, simplification, growing, region table.
 // Throws terrain::Error (with the failing stage) on bad options or input, "cancelled" when

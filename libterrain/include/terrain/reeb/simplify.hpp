@@ -8,6 +8,7 @@
 // rewritten so that the field and the simplified graph agree.
 
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #include "terrain/core/progress.hpp"
@@ -24,6 +25,12 @@ struct SimplifyOptions {
 struct SimplifyResult {
     ReebGraph graph;           // the simplified graph, nodes renumbered
     std::vector<float> field;  // the rewritten field: each vertex takes its node's value
+    // Per vertex, 1 when a cancellation handed its original node to another node (an extremum
+    // absorbed into a saddle, regular nodes left outside their arc's new range, ...): these
+    // vertices sit in a node that is not their own, at a value that is not theirs. The
+    // growing can give them back to the regions around by their original values
+    // (segment::divide_absorbed).
+    std::vector<std::uint8_t> absorbed;
     std::size_t saddle_extremum = 0, extremum_extremum = 0;  // cancellations done
     // What the cancellations did besides. Each node made regular merges its two arcs into one,
     // so the graph loses (cancellations + made_regular) critical nodes and as many arcs.

@@ -19,6 +19,11 @@ struct RegionLineage {
     std::uint32_t region = 0;
     double area_m2 = 0;
     std::vector<Overlap> overlaps;  // by region id
+    // Its parent: the region of the other segmentation it shares the most area with (ties
+    // to the lower id; 0 for a region with no area), that area, and its share of the region.
+    std::uint32_t parent = 0;
+    double parent_area_m2 = 0;
+    double parent_share = 0;
 };
 
 // For each region of `from` (ids 1..from_count), the regions of `to` it overlaps. Areas are
@@ -31,5 +36,9 @@ std::vector<RegionLineage> region_lineage(const TriangleMesh& mesh, const Dem* d
                                           std::uint32_t from_count,
                                           const std::vector<std::uint32_t>& to,
                                           std::uint32_t to_count);
+
+// The share of the regions' area inside their parents (each region weighted by its area):
+// 1 when every region lies in one region of the other segmentation.
+double mean_parent_share(const std::vector<RegionLineage>& lineage);
 
 }  // namespace terrain::segment
