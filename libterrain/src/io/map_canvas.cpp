@@ -150,11 +150,11 @@ void Canvas::image(const std::uint8_t* rgba, int w, int h, int x, int y) {
 // Debian 12's OpenImageIO (2.4.7) decodes UTF-8 wrongly in render_text: a character of two or
 // more bytes comes out as the code of its last byte's low six bits ("°" as "0"). The text is
 // therefore cut into ASCII runs, rendered by OpenImageIO, and the few other characters the
-// figures use, drawn as shapes: the degree sign (a ring), the middle dot (a disc); "×" is
-// written "x", any other character "?". Spaces at the ends of a run are added as DejaVu Sans's
-// advance, 0.318 of the size, since the rendered mask ends at the last ink.
+// figures use, drawn as shapes: the degree sign (a ring), the middle dot (a disc), "²" (a small
+// raised 2); "×" is written "x", any other character "?". Spaces at the ends of a run are added as
+// DejaVu Sans's advance, 0.318 of the size, since the rendered mask ends at the last ink.
 struct Canvas::Run {
-    enum Kind { ascii, degree, dot, space } kind = ascii;
+    enum Kind { ascii, degree, dot, space, squared } kind = ascii;
     TextMask mask;
     double advance = 0;
 };
@@ -188,7 +188,14 @@ std::vector<Canvas::Run> Canvas::layout(const std::string& text, int size) {
         while (i + n < text.size() && (static_cast<unsigned char>(text[i + n]) & 0xC0) == 0x80) ++n;
         const std::string character = text.substr(i, n);
         i += n;
-        if (character == "\u00d7") {
+        if (character == "\u00b2") {  // a raised "2" at 60 % of the size
+            flush();
+            Run run;
+            run.kind = Run::squared;
+            run.mask = render_text_mask(font_, std::max(6, size * 3 / 5), "2");
+            run.advance = run.mask.x + run.mask.width + 0.05 * size;
+            runs.push_back(std::move(run));
+        } else if (character == "\u00d7") {
             ascii += 'x';
         } else if (character == "\u00b0" || character == "\u00b7") {
             flush();
@@ -240,12 +247,14 @@ int Canvas::text(int x, int y, const std::string& text, int size, Rgba colour, A
     if (align_y == AlignY::bottom) baseline = y - static_cast<int>(std::lround(0.24 * size));
     for (const auto& run : runs) {
         const int left = static_cast<int>(std::lround(pen));
-        if (run.kind == Run::ascii) {
+        if (run.kind == Run::ascii || run.kind == Run::squared) {
             const auto& mask = run.mask;
+            const int base =
+                baseline - (run.kind == Run::squared ? static_cast<int>(0.38 * size) : 0);
             for (int r = 0; r < mask.height; ++r)
                 for (int c = 0; c < mask.width; ++c) {
                     const auto a = mask.alpha[static_cast<std::size_t>(r) * mask.width + c];
-                    if (a) blend(left + mask.x + c, baseline + mask.y + r, colour, a / 255.0);
+                    if (a) blend(left + mask.x + c, base + mask.y + r, colour, a / 255.0);
                 }
         } else if (run.kind == Run::degree) {
             disc(pen + 0.2 * size, baseline - 0.6 * size, 0.13 * size, colour,
