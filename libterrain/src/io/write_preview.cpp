@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <numbers>
+#include <string>
 
 #include "image_module.hpp"
 #include "map_canvas.hpp"
@@ -267,6 +268,11 @@ MapFrame map_frame(const Dem& dem, int width, int height, double scale,
         frame.caption.push_back("shown at 1/" + std::to_string(reduce));
     if (!lonlat && !local) frame.caption.push_back("no longitude/latitude for this CRS");
     if (lonlat && !frame.has_north) frame.caption.push_back("north: undefined at the centre");
+    for (auto& item : frame.caption) {  // names may end in spaces ("EQUIRECTANGULAR VESTA ")
+        const auto first = item.find_first_not_of(' '), last = item.find_last_not_of(' ');
+        item = first == std::string::npos ? std::string() : item.substr(first, last - first + 1);
+    }
+    std::erase(frame.caption, std::string());
     return frame;
 }
 
