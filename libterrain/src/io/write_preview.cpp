@@ -136,7 +136,10 @@ std::string length_text(double metres) {
 
 std::string metres_text(double metres) {
     char text[32];
-    std::snprintf(text, sizeof text, metres >= 100 ? "%.0f m" : "%.3g m", metres);
+    if (metres >= 1000)
+        std::snprintf(text, sizeof text, "%.3g km", metres / 1000);
+    else
+        std::snprintf(text, sizeof text, metres >= 100 ? "%.0f m" : "%.3g m", metres);
     return text;
 }
 

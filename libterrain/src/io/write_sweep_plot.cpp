@@ -27,6 +27,16 @@ std::string short_number(double v) {
     return buf;
 }
 
+// The smallest 4 * (1, 2, 2.5 or 5 times a power of ten) at least `v`: an axis's top whose
+// quarters are round numbers.
+double axis_top(double v) {
+    const double quarter = v / 4;
+    const double magnitude = std::pow(10.0, std::floor(std::log10(quarter)));
+    for (const double m : {1.0, 2.0, 2.5, 5.0, 10.0})
+        if (m * magnitude >= quarter * (1 - 1e-12)) return 4 * m * magnitude;
+    return 40 * magnitude;
+}
+
 }  // namespace
 
 void write_sweep_plot(const std::vector<double>& ratios, const std::vector<double>& counts,
@@ -45,12 +55,12 @@ void write_sweep_plot(const std::vector<double>& ratios, const std::vector<doubl
         red{210, 50, 40, 255};
     const auto [rmin, rmax] = std::minmax_element(ratios.begin(), ratios.end());
     const double l0 = std::log10(*rmin), l1 = std::max(std::log10(*rmax), l0 + 1e-9);
-    const double cmax = std::max(1.0, *std::max_element(counts.begin(), counts.end()));
+    const double cmax = axis_top(std::max(1.0, *std::max_element(counts.begin(), counts.end())));
     // Areas in km² from 1 km² up, in m² below.
     const double amax_m2 = std::max(1e-300, *std::max_element(areas.begin(), areas.end()));
     const bool km2 = amax_m2 >= 1e6;
     const double unit = km2 ? 1e6 : 1.0;
-    const double amax = amax_m2 / unit;
+    const double amax = axis_top(amax_m2 / unit);
     auto X = [&](double r) {
         return left + static_cast<int>((std::log10(r) - l0) / (l1 - l0) * (right - left));
     };
