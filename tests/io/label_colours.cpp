@@ -143,6 +143,20 @@ TEST_CASE(
         REQUIRE(rat);
         CHECK(rat->GetRowCount() == static_cast<int>((k == 1 ? a : b).graph.regions.size()));
     }
+    // rasterio finds band 1's colour map, with each region's colour.
+    const auto c = io::region_colour(a.graph.regions.back().id);
+    CHECK(python("import rasterio\n"
+                 "with rasterio.open('" +
+                 coloured +
+                 "') as r:\n"
+                 "    m = r.colormap(1)\n"
+                 "    assert len(m) == " +
+                 std::to_string(a.graph.regions.size() + 1) +
+                 ", len(m)\n"
+                 "    assert m[" +
+                 std::to_string(a.graph.regions.back().id) + "] == (" + std::to_string(c[0]) +
+                 ", " + std::to_string(c[1]) + ", " + std::to_string(c[2]) + ", " +
+                 std::to_string(c[3]) + "), m\n") == 0);
     const auto style = text_of(dir / "labels.qml");
     CHECK(style.find("type=\"paletted\" band=\"1\"") != std::string::npos);
     CHECK(count_of(style, "<paletteEntry ") == a.graph.regions.size());
