@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <map>
 #include <sstream>
 
 #include "support/segment_support.hpp"
@@ -275,4 +276,37 @@ TEST_CASE("sweep.png: axis titles and legend text", "[write_sweep_plot]") {
     const auto bare = read_png((dir / "bare.png").string());
     CHECK(dark_pixels(bare, 300, 520, 600, 550) == 0);
     CHECK(dark_pixels(bare, 150, 10, 400, 35) == 0);
+}
+
+TEST_CASE("preview.png on a UTM tile: north leans by the grid convergence, ticks follow it",
+          "[write_preview][shared]") {
+    const auto path = test::shared_data("earth/bigtujunga_srtm30m_utm11.tif");
+    REQUIRE(path.has_value());  // CI always has ../shared beside the project
+    const Dem dem = io::read_dem(*path);
+    const std::vector<float> field(dem.size(), 50.f);
+    const std::vector<std::uint32_t> pixels(dem.size(), 1);
+    const auto image = io::render_preview(dem, field, pixels);
+    const auto& frame = image.frame;
+    // West of zone 11's central meridian (117°W) at 34.3°N the meridians lean east going north
+    // by (118.15 - 117) * sin(34.3°) = 0.65 degrees.
+    REQUIRE(frame.has_north);
+    CHECK(frame.north_degrees == Approx(0.65).margin(0.05));
+    CHECK(frame.scale_note.find("34.3°N") != std::string::npos);
+    CHECK(frame.metres_per_pixel == Approx(dem.georef.pixel_width_m));
+    // Latitude ticks are lower on the right edge than on the left, by the map's width times
+    // tan(0.65°) (about 14 map pixels over 1197); longitudes are west and grow eastwards.
+    std::map<std::string, double> left, right;
+    std::vector<double> bottom_lons;
+    for (const auto& t : frame.ticks) {
+        if (t.edge == 3) left[t.label] = t.position;
+        if (t.edge == 1) right[t.label] = t.position;
+        if (t.edge % 2 == 0) CHECK(t.label.back() == 'W');
+        if (t.edge == 2) bottom_lons.push_back(t.position);
+    }
+    REQUIRE(left.count("34.30°N") == 1);
+    REQUIRE(right.count("34.30°N") == 1);
+    CHECK(right["34.30°N"] - left["34.30°N"] ==
+          Approx(image.width * std::tan(0.65 * 3.14159265358979 / 180)).margin(2));
+    CHECK(bottom_lons.size() >= 3);
+    CHECK(std::is_sorted(bottom_lons.begin(), bottom_lons.end()));
 }
