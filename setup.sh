@@ -30,6 +30,7 @@ packages=(
   libeigen3-dev libtbb-dev
   catch2
   time
+  fonts-dejavu-core
   # The Python module and its tests (docs/python.md).
   pybind11-dev python3-pybind11 python3-dev python3-numpy python3-pytest
   python3-gdal python3-geopandas python3-rasterio python3-networkx

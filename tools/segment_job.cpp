@@ -2,6 +2,8 @@
 
 #include <cstdio>
 
+#include "terrain/io/write_preview.hpp"
+
 namespace terrain::cli {
 
 void add_segment_options(po::options_description& options, SegmentOptionValues& values) {
@@ -52,6 +54,8 @@ pipeline::SegmentOptions to_pipeline_options(const FieldOptionValues& field,
 void print_input_warnings(const char* command, const Input& input) {
     if (!input.dem) return;
     for (const auto& w : pipeline::georeference_warnings(*input.dem))
+        std::fprintf(stderr, "terrain %s: warning: %s\n", command, w.c_str());
+    if (const auto w = io::map_text_warning(); !w.empty())
         std::fprintf(stderr, "terrain %s: warning: %s\n", command, w.c_str());
 }
 

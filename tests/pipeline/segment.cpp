@@ -53,6 +53,7 @@ TEST_CASE("pipeline::segment gives labels, regions and the files of terrain segm
     const auto dir = test::scratch_dir("pipeline_segment");
     const auto files = pipeline::write_segment_directory(result, options, path, dir.string());
     CHECK(files.front() == "labels.tif");
+    CHECK(files[1] == "labels.qml");
     CHECK(files.back() == "run.json");
     for (const auto& f : files) CHECK(fs::exists(dir / f));
     const auto written = test::read_raster_values((dir / "labels.tif").string());

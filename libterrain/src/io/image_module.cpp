@@ -15,11 +15,13 @@ namespace {
 
 using WriteFn = int (*)(const char*, int, int, int, const unsigned char*, int, char*, int);
 using InterfaceFn = int (*)();
+using TextFn = int (*)(const char*, int, const char*, int*, unsigned char*, int, char*, int);
 
 constexpr const char* kModule = "libterrain_oiio.so";
 
 struct Module {
     WriteFn write = nullptr;
+    TextFn text = nullptr;
     std::string path;
     std::string error;  // why it could not be loaded
 };
@@ -63,8 +65,10 @@ const Module& module() {
             const auto version =
                 reinterpret_cast<InterfaceFn>(dlsym(handle, "terrain_oiio_interface"));
             r.write = reinterpret_cast<WriteFn>(dlsym(handle, "terrain_oiio_write"));
-            if (!version || version() != 1 || !r.write) {
+            r.text = reinterpret_cast<TextFn>(dlsym(handle, "terrain_oiio_text"));
+            if (!version || version() != 2 || !r.write || !r.text) {
                 r.write = nullptr;
+                r.text = nullptr;
                 r.error = path + " is not this version's OpenImageIO module";
                 return r;
             }
@@ -88,6 +92,27 @@ void write_image(const std::string& path, const std::string& shown_path, int wid
     if (!m.write(path.c_str(), width, height, channels, pixels, png_compression, error,
                  static_cast<int>(sizeof error)))
         throw Error("write", "writing '" + shown_path + "' failed: " + error);
+}
+
+TextMask render_text_mask(const std::string& font, int size, const std::string& text) {
+    const Module& m = module();
+    if (!m.text) throw Error("write", m.error);
+    TextMask out;
+    int box[4] = {0, 0, 0, 0};
+    char error[512] = {0};
+    if (!m.text(font.c_str(), size, text.c_str(), box, nullptr, 0, error,
+                static_cast<int>(sizeof error)))
+        throw Error("write", error);
+    out.x = box[0];
+    out.y = box[1];
+    out.width = std::max(0, box[2]);
+    out.height = std::max(0, box[3]);
+    out.alpha.assign(static_cast<std::size_t>(out.width) * out.height, 0);
+    if (out.alpha.empty()) return out;
+    if (!m.text(font.c_str(), size, text.c_str(), box, out.alpha.data(),
+                static_cast<int>(out.alpha.size()), error, static_cast<int>(sizeof error)))
+        throw Error("write", error);
+    return out;
 }
 
 std::string image_module_path() {

@@ -12,6 +12,7 @@
 
 #include "dataset_files.hpp"
 #include "gdal_support.hpp"
+#include "label_style.hpp"
 #include "region_attributes.hpp"
 #include "terrain/core/error.hpp"
 #include "terrain/io/output_file.hpp"
@@ -64,10 +65,7 @@ GDALDefaultRasterAttributeTable region_attribute_table(const segment::RegionGrap
     return rat;
 }
 
-namespace {
-
-// The colour table of a UInt16 band: entry i is the colour of region i (0 transparent).
-GDALColorTable colour_table(std::size_t region_count) {
+GDALColorTable region_colour_table(std::size_t region_count) {
     GDALColorTable table(GPI_RGB);
     for (std::size_t id = 0; id <= region_count; ++id) {
         const auto c = region_colour(static_cast<std::uint32_t>(id));
@@ -76,6 +74,8 @@ GDALColorTable colour_table(std::size_t region_count) {
     }
     return table;
 }
+
+namespace {
 
 // Overview factors 2, 4, 8, ... while the reduced grid keeps 64 pixels on its long side.
 std::vector<int> overview_factors(const Dem& dem) {
@@ -114,13 +114,15 @@ std::string xml_escape(const std::string& s) {
     return out;
 }
 
-// A QGIS layer style: the paletted renderer, one entry per region in its colour, labelled
-// "<id> <landform>"; QGIS loads <name>.qml with <name>.tif.
-void write_style(std::ostream& out, const segment::RegionGraph& graph) {
+}  // namespace
+
+void write_label_style(std::ostream& out, const segment::RegionGraph& graph, int band) {
     out << "<!DOCTYPE qgis PUBLIC 'http://mrcc.com/qgis.dtd' 'SYSTEM'>\n"
            "<qgis version=\"3.22.0\" styleCategories=\"Symbology\">\n"
            " <pipe>\n"
-           "  <rasterrenderer type=\"paletted\" band=\"1\" opacity=\"1\" "
+           "  <rasterrenderer type=\"paletted\" band=\""
+        << band
+        << "\" opacity=\"1\" "
            "alphaBand=\"-1\" nodataColor=\"\">\n"
            "   <rasterTransparency/>\n"
            "   <colorPalette>\n";
@@ -136,8 +138,6 @@ void write_style(std::ostream& out, const segment::RegionGraph& graph) {
            " </pipe>\n"
            "</qgis>\n";
 }
-
-}  // namespace
 
 std::string label_style_path(const std::string& path) {
     return std::filesystem::path(path).replace_extension(".qml").string();
@@ -166,7 +166,7 @@ void write_label_raster(const Dem& dem, const std::vector<std::uint32_t>& pixels
         band->SetNoDataValue(0);
         band->SetDescription("region id");
         if (sixteen) {
-            const auto table = colour_table(graph.regions.size());
+            const auto table = region_colour_table(graph.regions.size());
             band->SetColorInterpretation(GCI_PaletteIndex);
             if (band->SetColorTable(const_cast<GDALColorTable*>(&table)) != CE_None)
                 throw Error("write",
@@ -195,7 +195,7 @@ void write_label_raster(const Dem& dem, const std::vector<std::uint32_t>& pixels
     commit_dataset(output, files, overwrite);
     temporary.release();
     write_file_atomically(label_style_path(path), overwrite,
-                          [&](std::ostream& out) { write_style(out, graph); });
+                          [&](std::ostream& out) { write_label_style(out, graph); });
 }
 
 }  // namespace terrain::io

@@ -1,10 +1,13 @@
+#include <gdal_pam.h>
 #include <gdal_priv.h>
 
 #include <memory>
 
 #include "dataset_files.hpp"
 #include "gdal_support.hpp"
+#include "label_style.hpp"
 #include "terrain/core/error.hpp"
+#include "terrain/io/write_label_raster.hpp"
 #include "terrain/io/write_label_stack.hpp"
 
 namespace terrain::io {
@@ -28,7 +31,10 @@ void write_label_stack(const Dem& dem, const std::vector<std::vector<std::uint32
         throw Error("write", "label stack: one region graph per band is needed");
     ensure_gdal_registered();
     const GdalErrorCapture errors;
-    if (!graphs.empty()) check_output_path(path + ".aux.xml", overwrite);
+    if (!graphs.empty()) {
+        check_output_path(path + ".aux.xml", overwrite);
+        check_output_path(label_style_path(path), overwrite);
+    }
     AtomicOutput output(path, overwrite);
     TemporaryFiles temporary(output);
     GDALDriver* gtiff = GetGDALDriverManager()->GetDriverByName("GTiff");
@@ -53,6 +59,20 @@ void write_label_stack(const Dem& dem, const std::vector<std::vector<std::uint32
                 throw Error("write", "cannot store the attribute table of band " +
                                          std::to_string(i + 1) + " of '" + path + "'" +
                                          errors.suffix());
+            // Band 1's colour table, when its ids fit in 16 bits. GeoTIFF stores one only for
+            // 8 and 16-bit single-sample images, and GDAL reads one from the .aux.xml (its
+            // persistent auxiliary metadata, beside the attribute tables) for band 1 only; so
+            // it goes there and the GeoTIFF itself stays as it was.
+            auto* pam = dynamic_cast<GDALPamRasterBand*>(band);
+            if (pam && i == 0 && graphs[i]->regions.size() < 65536) {
+                const auto table = region_colour_table(graphs[i]->regions.size());
+                if (pam->GDALPamRasterBand::SetColorInterpretation(GCI_PaletteIndex) != CE_None ||
+                    pam->GDALPamRasterBand::SetColorTable(const_cast<GDALColorTable*>(&table)) !=
+                        CE_None)
+                    throw Error("write", "cannot store the colour table of band " +
+                                             std::to_string(i + 1) + " of '" + path + "'" +
+                                             errors.suffix());
+            }
         }
     }
     ds->FlushCache();
@@ -64,6 +84,11 @@ void write_label_stack(const Dem& dem, const std::vector<std::vector<std::uint32
     if (!graphs.empty()) files.push_back(output.temp_path() + ".aux.xml");
     commit_dataset(output, files, overwrite);
     temporary.release();
+    // QGIS's style: band 1 (the first scale) in its regions' colours.
+    if (!graphs.empty())
+        write_file_atomically(label_style_path(path), overwrite, [&](std::ostream& out) {
+            write_label_style(out, *graphs.front(), 1);
+        });
 }
 
 }  // namespace terrain::io

@@ -80,8 +80,10 @@ std::vector<std::string> write_segment_outputs(const std::string& dir, const Tri
                 step();
             },
             [&] {
-                auto image =
-                    render_preview(*dem, field::field_to_pixels(mesh, *dem, field), pixels);
+                auto caption = options.preview_caption;
+                if (caption.regions == 0) caption.regions = graph.regions.size();
+                auto image = render_preview(*dem, field::field_to_pixels(mesh, *dem, field), pixels,
+                                            caption);
                 if (options.deferred_preview)
                     *options.deferred_preview = std::move(image);
                 else

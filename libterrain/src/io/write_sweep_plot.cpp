@@ -1,14 +1,18 @@
-// sweep.png: a small line plot drawn by hand (no plotting library in the stack): region count
-// in blue on the left axis, mean region area in red on the right axis, against the area ratio
-// on a log axis; tick values in a built-in 3x5 digit font.
+// sweep.png: a small line plot drawn on a map_canvas.hpp Canvas (no plotting library in the
+// stack): region count in blue on the left axis, mean region area in red on the right axis,
+// against the area ratio on a log axis; axis titles, tick values and the legend in DejaVu Sans
+// (none without the font).
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "image_module.hpp"
+#include "map_canvas.hpp"
 #include "terrain/core/error.hpp"
 #include "terrain/io/output_file.hpp"
 #include "terrain/io/write_sweep_plot.hpp"
@@ -17,101 +21,46 @@ namespace terrain::io {
 
 namespace {
 
-using Rgb = std::array<std::uint8_t, 3>;
-
-// 3x5 glyphs for digits, '.', 'e', '+', '-': one row per 3 bits, top to bottom.
-std::array<int, 5> glyph(char c) {
-    switch (c) {
-        case '0':
-            return {7, 5, 5, 5, 7};
-        case '1':
-            return {2, 6, 2, 2, 7};
-        case '2':
-            return {7, 1, 7, 4, 7};
-        case '3':
-            return {7, 1, 7, 1, 7};
-        case '4':
-            return {5, 5, 7, 1, 1};
-        case '5':
-            return {7, 4, 7, 1, 7};
-        case '6':
-            return {7, 4, 7, 5, 7};
-        case '7':
-            return {7, 1, 1, 1, 1};
-        case '8':
-            return {7, 5, 7, 5, 7};
-        case '9':
-            return {7, 5, 7, 1, 7};
-        case '.':
-            return {0, 0, 0, 0, 2};
-        case 'e':
-            return {0, 7, 7, 4, 7};
-        case '+':
-            return {0, 2, 7, 2, 0};
-        case '-':
-            return {0, 0, 7, 0, 0};
-        default:
-            return {0, 0, 0, 0, 0};
-    }
-}
-
-class Canvas {
-  public:
-    Canvas(int w, int h) : w_(w), h_(h), px_(static_cast<std::size_t>(w * h) * 3, 255) {}
-    void dot(int x, int y, Rgb c, int r = 0) {
-        for (int dy = -r; dy <= r; ++dy)
-            for (int dx = -r; dx <= r; ++dx) {
-                const int xx = x + dx, yy = y + dy;
-                if (xx < 0 || yy < 0 || xx >= w_ || yy >= h_) continue;
-                const auto i = static_cast<std::size_t>(yy * w_ + xx) * 3;
-                px_[i] = c[0], px_[i + 1] = c[1], px_[i + 2] = c[2];
-            }
-    }
-    void line(int x0, int y0, int x1, int y1, Rgb c, int r = 0) {
-        const int n = std::max(std::abs(x1 - x0), std::abs(y1 - y0));
-        for (int i = 0; i <= n; ++i)
-            dot(x0 + (n ? (x1 - x0) * i / n : 0), y0 + (n ? (y1 - y0) * i / n : 0), c, r);
-    }
-    void text(int x, int y, const std::string& s, Rgb c, int scale = 2) {
-        for (const char ch : s) {
-            const auto g = glyph(ch);
-            for (int row = 0; row < 5; ++row)
-                for (int col = 0; col < 3; ++col)
-                    if (g[static_cast<std::size_t>(row)] & (4 >> col))
-                        for (int a = 0; a < scale; ++a)
-                            for (int b = 0; b < scale; ++b)
-                                dot(x + col * scale + a, y + row * scale + b, c);
-            x += 4 * scale;
-        }
-    }
-    const std::uint8_t* data() const { return px_.data(); }
-
-  private:
-    int w_, h_;
-    std::vector<std::uint8_t> px_;
-};
-
 std::string short_number(double v) {
     char buf[32];
-    std::snprintf(buf, sizeof buf, "%.3g", v);
+    std::snprintf(buf, sizeof buf, "%.4g", v);
     return buf;
+}
+
+// The smallest 4 * (1, 2, 2.5 or 5 times a power of ten) at least `v`: an axis's top whose
+// quarters are round numbers.
+double axis_top(double v) {
+    const double quarter = v / 4;
+    const double magnitude = std::pow(10.0, std::floor(std::log10(quarter)));
+    for (const double m : {1.0, 2.0, 2.5, 5.0, 10.0})
+        if (m * magnitude >= quarter * (1 - 1e-12)) return 4 * m * magnitude;
+    return 40 * magnitude;
 }
 
 }  // namespace
 
 void write_sweep_plot(const std::vector<double>& ratios, const std::vector<double>& counts,
                       const std::vector<double>& areas, const std::string& path, bool overwrite) {
+    using detail::AlignX;
+    using detail::AlignY;
+    using detail::Rgba;
     if (ratios.empty() || ratios.size() != counts.size() || ratios.size() != areas.size())
         throw Error("write", "sweep plot: one count and one area per area ratio are needed");
     for (const double r : ratios)
         if (!(r > 0)) throw Error("write", "sweep plot: area ratios must be positive");
-    const int W = 900, H = 540, left = 90, right = W - 90, top = 40, bottom = H - 70;
-    Canvas c(W, H);
-    const Rgb black{0, 0, 0}, grey{200, 200, 200}, blue{40, 90, 200}, red{210, 50, 40};
+    const int W = 900, H = 560, left = 100, right = W - 100, top = 60, bottom = H - 90;
+    const int f = 14;
+    detail::Canvas c(W, H, {255, 255, 255, 255}, detail::map_font());
+    const Rgba black{0, 0, 0, 255}, grey{200, 200, 200, 255}, blue{40, 90, 200, 255},
+        red{210, 50, 40, 255};
     const auto [rmin, rmax] = std::minmax_element(ratios.begin(), ratios.end());
     const double l0 = std::log10(*rmin), l1 = std::max(std::log10(*rmax), l0 + 1e-9);
-    const double cmax = std::max(1.0, *std::max_element(counts.begin(), counts.end()));
-    const double amax = std::max(1e-300, *std::max_element(areas.begin(), areas.end()));
+    const double cmax = axis_top(std::max(1.0, *std::max_element(counts.begin(), counts.end())));
+    // Areas in km² from 1 km² up, in m² below.
+    const double amax_m2 = std::max(1e-300, *std::max_element(areas.begin(), areas.end()));
+    const bool km2 = amax_m2 >= 1e6;
+    const double unit = km2 ? 1e6 : 1.0;
+    const double amax = axis_top(amax_m2 / unit);
     auto X = [&](double r) {
         return left + static_cast<int>((std::log10(r) - l0) / (l1 - l0) * (right - left));
     };
@@ -120,34 +69,50 @@ void write_sweep_plot(const std::vector<double>& ratios, const std::vector<doubl
     };
     for (int k = 0; k <= 4; ++k) {  // horizontal grid and both axes' tick values
         const int y = bottom - k * (bottom - top) / 4;
-        c.line(left, y, right, y, grey);
-        c.text(8, y - 5, short_number(cmax * k / 4), blue);
-        c.text(right + 8, y - 5, short_number(amax * k / 4), red);
+        c.fill(left, y, right - left, 1, grey);
+        c.text(left - 8, y, short_number(cmax * k / 4), f, blue, AlignX::right, AlignY::middle);
+        c.text(right + 8, y, short_number(amax * k / 4), f, red, AlignX::left, AlignY::middle);
     }
-    c.line(left, top, left, bottom, black, 1);
-    c.line(right, top, right, bottom, black, 1);
-    c.line(left, bottom, right, bottom, black, 1);
+    c.fill(left - 1, top, 2, bottom - top + 1, black);
+    c.fill(right - 1, top, 2, bottom - top + 1, black);
+    c.fill(left - 1, bottom, right - left + 2, 2, black);
     for (const double r : ratios) {
-        c.line(X(r), bottom, X(r), bottom + 6, black);
-        const std::string label = short_number(r);
-        c.text(X(r) - static_cast<int>(label.size()) * 4, bottom + 14, label, black);
+        c.fill(X(r), bottom, 1, 6, black);
+        c.text(X(r), bottom + 10, short_number(r), f, black, AlignX::centre, AlignY::top);
     }
     for (std::size_t i = 0; i < ratios.size(); ++i) {
+        const double a = areas[i] / unit;
         if (i > 0) {
             c.line(X(ratios[i - 1]), Y(counts[i - 1], cmax), X(ratios[i]), Y(counts[i], cmax), blue,
-                   1);
-            c.line(X(ratios[i - 1]), Y(areas[i - 1], amax), X(ratios[i]), Y(areas[i], amax), red,
-                   1);
+                   2.5);
+            c.line(X(ratios[i - 1]), Y(areas[i - 1] / unit, amax), X(ratios[i]), Y(a, amax), red,
+                   2.5);
         }
-        c.dot(X(ratios[i]), Y(counts[i], cmax), blue, 4);
-        c.dot(X(ratios[i]), Y(areas[i], amax), red, 4);
+        c.disc(X(ratios[i]), Y(counts[i], cmax), 4.5, blue);
+        c.disc(X(ratios[i]), Y(a, amax), 4.5, red);
     }
-    // Legend: blue square = region count, red = mean area (m^2); x axis: area ratio, percent.
-    c.dot(left + 20, 18, blue, 6);
-    c.dot(left + 200, 18, red, 6);
+    // Axis titles.
+    const std::string area_title = std::string("mean region area (") + (km2 ? "km²" : "m²") + ")";
+    c.text((left + right) / 2, bottom + 40, "area ratio (% of the surface, log scale)", f + 1,
+           black, AlignX::centre, AlignY::top);
+    c.text(left - 8, top - 14, "regions", f + 1, blue, AlignX::right, AlignY::bottom);
+    c.text(W - 8, top - 14, area_title, f + 1, red, AlignX::right, AlignY::bottom);
+    // Legend: a line with its marker and its name for each series.
+    const int ly = 22;
+    int lx = left + 20;
+    for (const auto& [colour, name] : {std::pair<Rgba, std::string>{blue, "region count"},
+                                       std::pair<Rgba, std::string>{red, area_title}}) {
+        c.line(lx, ly, lx + 30, ly, colour, 2.5);
+        c.disc(lx + 15, ly, 4.5, colour);
+        lx += 40 + c.text(lx + 40, ly, name, f, black, AlignX::left, AlignY::middle) + 40;
+    }
 
+    std::vector<std::uint8_t> rgb(static_cast<std::size_t>(W) * H * 3);  // opaque: no alpha
+    for (std::size_t i = 0, n = rgb.size() / 3; i < n; ++i)
+        std::copy_n(c.rgba().begin() + std::ptrdiff_t(i * 4), 3,
+                    rgb.begin() + std::ptrdiff_t(i * 3));
     AtomicOutput output(path, overwrite);
-    detail::write_image(output.temp_path(), path, W, H, 3, c.data());
+    detail::write_image(output.temp_path(), path, W, H, 3, rgb.data());
     output.commit();
 }
 

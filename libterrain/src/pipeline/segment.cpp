@@ -16,6 +16,7 @@
 #include "terrain/core/version.hpp"
 #include "terrain/io/dependency_versions.hpp"
 #include "terrain/io/mesh_files.hpp"
+#include "terrain/io/write_label_raster.hpp"
 #include "terrain/io/write_preview.hpp"
 #include "terrain/io/write_region_polygons.hpp"
 #include "terrain/io/write_segment_outputs.hpp"
@@ -304,6 +305,16 @@ std::vector<std::string> write_segment_directory(SegmentResult& result,
     const auto t0 = clock::now();
     io::SegmentOutputOptions out;
     out.polygons.driver = options.format;
+    out.preview_caption.input = fs::path(input_path).filename().string();
+    out.preview_caption.field = options.field;
+    out.preview_caption.parameters = {
+        "persistence " + JsonWriter::number(options.simplify.persistence),
+        "area ratio " + JsonWriter::number(result.area_ratio_percent) + " %" +
+            (options.min_area.empty() ? std::string() : " (min area " + options.min_area + ")"),
+        "cost " +
+            std::string(options.cost == "auto" ? (result.input.dem ? "graph" : "standard")
+                                               : options.cost) +
+            ", saddle penalty " + JsonWriter::number(options.saddle_penalty)};
     // The preview is written last, once the large data is freed.
     io::PreviewImage preview;
     const bool deferred = write.release_memory && result.input.dem;
@@ -313,7 +324,12 @@ std::vector<std::string> write_segment_directory(SegmentResult& result,
                                   result.regions, result.dem(), out, progress);
     result.add_time("write", since(t0));
     std::vector<std::string> names;
-    for (const auto& p : paths) names.push_back(fs::path(p).filename().string());
+    for (const auto& p : paths) {
+        names.push_back(fs::path(p).filename().string());
+        // The QGIS style written with the label raster.
+        if (result.dem() && p == paths.front())
+            names.push_back(fs::path(io::label_style_path(p)).filename().string());
+    }
     if (write.release_memory) release_large_data(result);
     if (deferred) {
         const auto t1 = clock::now();

@@ -245,6 +245,7 @@ std::vector<std::string> write_sweep_directory(SweepResult& result, const Segmen
         }
         io::write_label_stack(*dem, bands, descriptions, graphs, d + "labels.tif", false);
         files.push_back("labels.tif");
+        files.push_back("labels.qml");
         report_progress(progress, 0.2);
         // Each scale polygonized once; then the GeoPackage's layers one after the other,
         // the GeoJSON files beside them.

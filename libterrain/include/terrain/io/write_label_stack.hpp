@@ -18,7 +18,9 @@ void write_label_stack(const Dem& dem, const std::vector<std::vector<std::uint32
                        const std::vector<std::string>& descriptions, const std::string& path,
                        bool overwrite);
 // The same with each band's raster attribute table (`graphs[i]` describes band i; as
-// labels.tif's, docs/outputs.md), which GDAL keeps in `path`.aux.xml beside the GeoTIFF.
+// labels.tif's, docs/outputs.md), which GDAL keeps in `path`.aux.xml beside the GeoTIFF, with
+// band 1's colour table (entry i the colour of region i, below 65536 regions) there too; and a
+// QGIS style, label_style_path(path) (labels.qml), that shows band 1 in the regions' colours.
 void write_label_stack(const Dem& dem, const std::vector<std::vector<std::uint32_t>>& bands,
                        const std::vector<std::string>& descriptions,
                        const std::vector<const segment::RegionGraph*>& graphs,

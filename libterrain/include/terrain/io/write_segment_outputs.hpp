@@ -24,6 +24,8 @@ struct SegmentOutputOptions {
     // writes it with write_preview_image (to the path returned for it) once it has freed what
     // it no longer needs.
     PreviewImage* deferred_preview = nullptr;
+    // preview.png's caption (its region count, when 0, is the graph's).
+    PreviewCaption preview_caption;
 };
 
 // Everything for one segmentation into the existing directory `dir`: for a DEM (dem !=
