@@ -308,6 +308,12 @@ def test_planetary_outputs_carry_the_iau_2015_crs(cli, tmp_path, name, geographi
             always_xy=True)
         xmin, xmax, ymin, ymax = layer.GetExtent()
         a = np.array(to_iau.transform_bounds(xmin, ymin, xmax, ymax))
+        # What docs/outputs.md tells geopandas users: set the CRS from the file's code, then
+        # to_crs works (here to the body's equirectangular CRS, clon = 0).
+        fixed = gpd.read_file(out / "regions.geojson").set_crs(
+            crs_member.replace("urn:ogc:def:crs:IAU_2015::", "IAU_2015:"), allow_override=True)
+        eqc = fixed.to_crs(f"IAU_2015:{int(geographic) + 10}")
+        assert eqc.geometry.is_valid.all() and np.isfinite(eqc.total_bounds).all()
     b = gdf.total_bounds
     assert abs(a[[1, 3]] - b[[1, 3]]).max() < 1e-6  # latitudes
     assert all(abs((x - y + 180) % 360 - 180) < 1e-6 for x, y in zip(a[[0, 2]], b[[0, 2]]))
