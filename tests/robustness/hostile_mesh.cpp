@@ -187,7 +187,7 @@ TEST_CASE("OFF colours and vertex lines CGAL's scanner reads unchecked are refus
     // Colours as CGAL reads them (an index, RGB integers, RGBA, fractions) stay readable,
     // as do normals and homogeneous coordinates.
     const std::string valid[] = {
-        "COFF\n3 2 0\n0 0 0 7\n1 0 0 255 0 0\n0 1 0 0.5 0.25 1 1\n1 1 0 0 0 255 255\n"
+        "COFF\n4 2 0\n0 0 0 7\n1 0 0 255 0 0\n0 1 0 0.5 0.25 1 1\n1 1 0 0 0 255 255\n"
         "3 0 1 2 12\n3 1 3 2 0 255 0\n",
         "NOFF\n3 1 0\n0 0 0 0 0 1\n1 0 0 0 0 1\n0 1 0 0 0 1\n3 0 1 2\n",
         "4OFF\n3 1 0\n0 0 0 1\n2 0 0 2\n0 1 0 1\n3 0 1 2\n",
