@@ -172,6 +172,11 @@ TEST_CASE("OFF colours and vertex lines CGAL's scanner reads unchecked are refus
         {"NOFF\n3 1 0\n0 0 0 0 0\n1 0 0 0 0 1\n0 1 0 0 0 1\n3 0 1 2\n", "not a line of 6 numbers"},
         {"STOFF\n3 1 0\n0 0 0 0 0\n" + tail, "texture coordinates"},
         {"XOFF\n3 1 0\n0 0 0\n" + tail, "unknown OFF keyword"},
+        // Found by fuzz_mesh_off: CGAL reads the edge count from the next line when the
+        // header line lacks it; read without it, the data were shifted by one number and a
+        // face's "5 0" taken for a colour (5 x 255 does not fit a byte: undefined behaviour).
+        {"COFF\n# 0\n 0\n1 \n 0\n0 5 0\n20\n2 C4", "OFF face 0 has 2 colour values"},
+        {"OFF\n3 1\n0 0 0\n" + tail, "numbers after its three counts"},
     };
     int i = 0;
     for (const auto& [text, expected] : cases) {

@@ -403,6 +403,11 @@ MeshFileCounts check_off(std::string_view bytes, const std::string& name) {
     const auto nv = next_number();
     const auto nf = next_number();
     if (!nv || !nf) refuse(name, "OFF header has no vertex and face counts");
+    // CGAL reads the edge count too, from the next line if need be: without it, the first
+    // number of the data would be taken for it and the data read shifted.
+    if (!next_number()) refuse(name, "OFF header has no edge count (the third number)");
+    // CGAL reads the first vertex from the rest of that line.
+    if (!numbers.empty()) refuse(name, "OFF header has numbers after its three counts");
     counts.vertices = *nv;
     counts.faces = *nf;
     const std::uint64_t rest = bytes.size() - lines.reader.pos + 1;
