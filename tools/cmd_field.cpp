@@ -69,7 +69,8 @@ int run_field(int argc, char** argv) {
         io::check_output_path(output, overwrite);
 
         const auto progress = terminal_progress(quiet);
-        const Input input = load_input(input_path, input_values, scaled_progress(progress, 0, 0.4));
+        const Input input = load_input(input_path, input_values, field_values.name,
+                                       scaled_progress(progress, 0, 0.4));
         const auto field_progress = scaled_progress(progress, 0.4, 1);
         std::vector<float> values;
         std::optional<field::SdfResult> sdf;

@@ -75,8 +75,8 @@ int run_reeb(int argc, char** argv) {
             throw UsageError("--write-field and -o name the same file '" + common.output + "'");
 
         const auto progress = terminal_progress(common.quiet);
-        const Input input =
-            load_input(common.input, input_values, scaled_progress(progress, 0, 0.3));
+        const Input input = load_input(common.input, input_values, field_values.name,
+                                       scaled_progress(progress, 0, 0.3));
         const Dem* dem = input.dem ? &*input.dem : nullptr;
         if (!min_area.empty())
             simplify_options.area_ratio = reeb::area_ratio_for_area(input.mesh, min_area_m2);

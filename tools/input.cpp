@@ -1,14 +1,10 @@
 #include "input.hpp"
 
 #include "terrain/core/error.hpp"
+#include "terrain/core/memory_budget.hpp"
 #include "terrain/io/mesh_files.hpp"
 
 namespace terrain::cli {
-namespace {
-// Peak bytes per DEM pixel of the mesh and the stages after it (field, Reeb graph,
-// segmentation): about 160 measured for segment on a 1197x643 DEM; the SDF needs more.
-constexpr double kPipelineBytesPerPixel = 200;
-}  // namespace
 
 void add_input_options(po::options_description& options, InputOptionValues& values) {
     add_dem_options(options, values.dem);
@@ -20,11 +16,14 @@ void add_input_options(po::options_description& options, InputOptionValues& valu
         "mesh input: repair degenerate or non-manifold elements instead of refusing");
 }
 
-Input load_input(const std::string& path, const InputOptionValues& values,
+Input load_input(const std::string& path, const InputOptionValues& values, const std::string& field,
                  const ProgressFn& progress) {
     pipeline::InputOptions options;
-    options.dem = to_read_options(values.dem);  // checks the values, sets --max-memory
-    options.dem.planned_bytes_per_pixel = kPipelineBytesPerPixel;
+    options.dem = to_read_options(values.dem);  // checks the values
+    // The pipeline's memory plan for the field computed next, with --max-memory.
+    options.planned_field = field;
+    if (!values.dem.max_memory.empty())
+        options.max_memory = parse_memory_size(values.dem.max_memory);
     options.repair = values.repair;
     if (!io::is_mesh_file(path)) {
         if (values.frame != "body" && values.frame != "map" && values.frame != "auto")

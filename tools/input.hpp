@@ -23,9 +23,9 @@ void add_input_options(po::options_description& options, InputOptionValues& valu
 using Input = pipeline::Input;
 
 // Reads `path` as a mesh file (.off/.ply/.obj) or a DEM and builds the mesh
-// (pipeline::load_input, with the options checked and the DEM's memory planned for the
-// pipeline's stages).
-Input load_input(const std::string& path, const InputOptionValues& values,
+// (pipeline::load_input, with the options checked and the memory planned for computing
+// `field` next: "shape-index", "sdf", "height", or "" for meshing only; --max-memory).
+Input load_input(const std::string& path, const InputOptionValues& values, const std::string& field,
                  const ProgressFn& progress);
 
 }  // namespace terrain::cli

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "terrain/core/error.hpp"
+#include "terrain/core/memory_budget.hpp"
 #include "terrain/core/version.hpp"
 #include "terrain/field/vertex_field.hpp"
 #include "terrain/geo/georeference.hpp"
@@ -278,10 +279,21 @@ pipeline::Input load(const Source& s, const pipeline::InputOptions& options,
     return pipeline::load_input(*s.path, options, progress);
 }
 
+// max_memory: None, a number of bytes, or a size as the command line's --max-memory takes
+// it ("512M", "4G").
+std::uint64_t memory_limit_argument(const py::object& max_memory) {
+    if (max_memory.is_none()) return 0;
+    return parse_memory_size(py::str(max_memory).cast<std::string>());
+}
+
+// The input options, with the memory plan of computing `field` (pipeline::memory_plan).
 pipeline::InputOptions input_options(int band, const std::string& elevation, bool nan_nodata,
                                      std::optional<double> pixel_size, const std::string& frame,
-                                     bool repair) {
+                                     bool repair, const py::object& max_memory,
+                                     const std::string& field) {
     pipeline::InputOptions o;
+    o.planned_field = field;
+    o.max_memory = memory_limit_argument(max_memory);
     o.dem.band = band;
     o.dem.elevation = parse_elevation(elevation);
     o.dem.nan_as_nodata = nan_nodata;
@@ -481,9 +493,11 @@ PYBIND11_MODULE(_terrain, m) {
         "segment",
         [](const py::object& source, const pipeline::SegmentOptions& options, int band,
            const std::string& elevation, bool nan_nodata, std::optional<double> pixel_size,
-           const std::string& frame, bool repair, const py::object& progress) {
+           const std::string& frame, bool repair, const py::object& progress,
+           const py::object& max_memory) {
             pipeline::check_options(options);
-            const auto in = input_options(band, elevation, nan_nodata, pixel_size, frame, repair);
+            const auto in = input_options(band, elevation, nan_nodata, pixel_size, frame, repair,
+                                          max_memory, options.field);
             const Source s = to_source(source);
             return run(progress, [&](const ProgressFn& fn) {
                 auto input = load(s, in, scaled_progress(fn, 0, 0.2));
@@ -492,7 +506,8 @@ PYBIND11_MODULE(_terrain, m) {
         },
         py::arg("source"), py::arg("options"), py::arg("band") = 1, py::arg("elevation") = "auto",
         py::arg("nan_nodata") = false, py::arg("pixel_size") = py::none(),
-        py::arg("frame") = "auto", py::arg("repair") = false, py::arg("progress") = py::none());
+        py::arg("frame") = "auto", py::arg("repair") = false, py::arg("progress") = py::none(),
+        py::arg("max_memory") = py::none());
 
     py::class_<pipeline::SweepResult>(m, "SweepResult")
         .def_property_readonly("ratios",
@@ -578,13 +593,15 @@ PYBIND11_MODULE(_terrain, m) {
         [](const py::object& source, const std::vector<double>& ratios,
            const pipeline::SegmentOptions& options, int band, const std::string& elevation,
            bool nan_nodata, std::optional<double> pixel_size, const std::string& frame, bool repair,
-           const py::object& progress, const std::vector<std::string>& min_areas) {
+           const py::object& progress, const std::vector<std::string>& min_areas,
+           const py::object& max_memory) {
             pipeline::check_options(options);
             // A sweep over areas when min_areas is given (ratios are then ignored).
             std::vector<pipeline::AreaThreshold> areas;
             for (const auto& a : min_areas)
                 areas.push_back({a, pipeline::parse_area(a, "min_areas")});
-            const auto in = input_options(band, elevation, nan_nodata, pixel_size, frame, repair);
+            const auto in = input_options(band, elevation, nan_nodata, pixel_size, frame, repair,
+                                          max_memory, options.field);
             const Source s = to_source(source);
             return run(progress, [&](const ProgressFn& fn) {
                 auto input = load(s, in, scaled_progress(fn, 0, 0.2));
@@ -598,14 +615,17 @@ PYBIND11_MODULE(_terrain, m) {
         py::arg("source"), py::arg("ratios"), py::arg("options"), py::arg("band") = 1,
         py::arg("elevation") = "auto", py::arg("nan_nodata") = false,
         py::arg("pixel_size") = py::none(), py::arg("frame") = "auto", py::arg("repair") = false,
-        py::arg("progress") = py::none(), py::arg("min_areas") = std::vector<std::string>{});
+        py::arg("progress") = py::none(), py::arg("min_areas") = std::vector<std::string>{},
+        py::arg("max_memory") = py::none());
 
     m.def(
         "field",
         [](const py::object& source, const pipeline::SegmentOptions& options, int band,
            const std::string& elevation, bool nan_nodata, std::optional<double> pixel_size,
-           const std::string& frame, bool repair, const py::object& progress) -> py::object {
-            const auto in = input_options(band, elevation, nan_nodata, pixel_size, frame, repair);
+           const std::string& frame, bool repair, const py::object& progress,
+           const py::object& max_memory) -> py::object {
+            const auto in = input_options(band, elevation, nan_nodata, pixel_size, frame, repair,
+                                          max_memory, options.field);
             const Source s = to_source(source);
             pipeline::SegmentResult r;
             run(progress, [&](const ProgressFn& fn) {
@@ -619,14 +639,17 @@ PYBIND11_MODULE(_terrain, m) {
         },
         py::arg("source"), py::arg("options"), py::arg("band") = 1, py::arg("elevation") = "auto",
         py::arg("nan_nodata") = false, py::arg("pixel_size") = py::none(),
-        py::arg("frame") = "auto", py::arg("repair") = false, py::arg("progress") = py::none());
+        py::arg("frame") = "auto", py::arg("repair") = false, py::arg("progress") = py::none(),
+        py::arg("max_memory") = py::none());
 
     m.def(
         "reeb_graph",
         [](const py::object& source, const pipeline::SegmentOptions& options, int band,
            const std::string& elevation, bool nan_nodata, std::optional<double> pixel_size,
-           const std::string& frame, bool repair, const py::object& progress) {
-            const auto in = input_options(band, elevation, nan_nodata, pixel_size, frame, repair);
+           const std::string& frame, bool repair, const py::object& progress,
+           const py::object& max_memory) {
+            const auto in = input_options(band, elevation, nan_nodata, pixel_size, frame, repair,
+                                          max_memory, options.field);
             const Source s = to_source(source);
             pipeline::SegmentResult r;
             reeb::ReebGraph graph;
@@ -689,5 +712,6 @@ PYBIND11_MODULE(_terrain, m) {
         },
         py::arg("source"), py::arg("options"), py::arg("band") = 1, py::arg("elevation") = "auto",
         py::arg("nan_nodata") = false, py::arg("pixel_size") = py::none(),
-        py::arg("frame") = "auto", py::arg("repair") = false, py::arg("progress") = py::none());
+        py::arg("frame") = "auto", py::arg("repair") = false, py::arg("progress") = py::none(),
+        py::arg("max_memory") = py::none());
 }

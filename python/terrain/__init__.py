@@ -44,7 +44,8 @@ _SEGMENT_OPTIONS = (
     "format",
 )
 # How the input is read and meshed.
-_INPUT_OPTIONS = ("band", "elevation", "nan_nodata", "pixel_size", "frame", "repair")
+_INPUT_OPTIONS = ("band", "elevation", "nan_nodata", "pixel_size", "frame", "repair",
+                  "max_memory")
 
 
 def read_dem(path, band=1, *, elevation="auto", nan_nodata=False, pixel_size=None):
@@ -218,7 +219,9 @@ def segment(dem, geotransform=None, crs=None, *, progress=None, **options):
         area is below it, whatever the tile's extent), cost="auto" ("graph",
         "standard"), saddle_penalty=20, absorbed="divide" (or "whole", the paper's
         growing), format="GeoJSON"; reading: band=1,
-        elevation="auto", nan_nodata=False, pixel_size=None, frame="auto", repair=False.
+        elevation="auto", nan_nodata=False, pixel_size=None, frame="auto", repair=False,
+        max_memory=None (bytes, or "512M", "4G" as --max-memory: a file whose estimated
+        peak memory exceeds it, or the memory available, is refused before it is read).
     progress: optional callable progress(fraction, message); return False to cancel.
     Returns a SegmentResult (.labels, .regions, .graph, .to_geodataframe(), .write()).
     Raises terrain.Error on bad input or options, TypeError on an unknown option.

@@ -152,11 +152,45 @@ TEST_CASE("a limit given with --max-memory refuses work over it with one line",
     auto r = run_limited({"mesh", input, "-o", (dir / "m.ply").string(), "--max-memory", "1M"});
     CHECK(r.status == 1);
     CHECK(line_count(r.err) == 1);
-    CHECK_THAT(r.err, Contains("--max-memory"));
+    CHECK_THAT(r.err, Contains("but the memory limit is 1 MB (1048576 bytes)"));
     CHECK_FALSE(std::filesystem::exists(dir / "m.ply"));
     r = run_limited({"mesh", input, "-o", (dir / "m.ply").string(), "--max-memory", "lots"});
     CHECK(r.status == 1);
     r = run_limited({"mesh", input, "-o", (dir / "m.ply").string(), "--max-memory", "1G", "-q"});
     CHECK(r.status == 0);
     CHECK(std::filesystem::exists(dir / "m.ply"));
+}
+
+TEST_CASE("a truncated ASCII grid is refused at once instead of rereading its lines",
+          "[robustness][dem]") {
+    // Found by fuzz_dem: GDAL's AAIGrid driver finds a line by reading every line before it,
+    // again for each one that failed, so asking first for the last row of a grid whose text
+    // ends early took time exponential in the missing lines (40 rows: hours).
+    const auto dir = scratch_dir("hostile_ascii_grid");
+    std::string text = "ncols 16\nnrows 40\nxllcorner 0\nyllcorner 0\ncellsize 10\n";
+    // Three rows of long values: the text could hold the 640 values, the rows after are missing.
+    for (int r = 0; r < 3; ++r) {
+        for (int c = 0; c < 16; ++c) text += std::to_string(100 + c) + ".000000000000000000000000 ";
+        text += "\n";
+    }
+    const auto truncated = write_bytes(dir / "truncated.asc", text);
+    for (const char* command : {"info", "mesh"}) {
+        std::vector<std::string> args = {command, truncated};
+        if (std::string(command) == "mesh")
+            args.insert(args.end(), {"-o", (dir / "m.ply").string(), "-q"});
+        const auto r = run_limited(args, 30);
+        INFO(command);
+        CHECK(r.status == 1);
+        CHECK(line_count(r.err) == 1);
+        CHECK_THAT(r.err, Contains("row 3"));
+    }
+    // A header declaring more values than its text can hold (each takes two characters).
+    const auto huge = write_bytes(dir / "huge.asc",
+                                  "ncols 20000\nnrows 20000\nxllcorner 0\n"
+                                  "yllcorner 0\ncellsize 10\n1 2 3 4\n");
+    const auto r = run_limited({"info", huge}, 30);
+    CHECK(r.status == 1);
+    CHECK(line_count(r.err) == 1);
+    CHECK_THAT(r.err, Contains("text holds at most"));
+    CHECK_FALSE(std::filesystem::exists(dir / "m.ply"));
 }

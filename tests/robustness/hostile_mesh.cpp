@@ -154,3 +154,82 @@ TEST_CASE("mesh coordinates of 1e308 are refused instead of giving NaN areas",
     CHECK_THAT(r.err, Contains("beyond 1e9"));
     CHECK_FALSE(std::filesystem::exists(dir / "seg"));
 }
+
+TEST_CASE("OFF colours and vertex lines CGAL's scanner reads unchecked are refused",
+          "[robustness][mesh]") {
+    const auto dir = scratch_dir("hostile_off_colours");
+    const std::string tail = "1 0 0\n0 1 0\n3 0 1 2\n";
+    const std::pair<std::string, const char*> cases[] = {
+        // Found by fuzz_mesh_off: a COFF vertex line without numbers made CGAL read the
+        // colour of an empty line (undefined behaviour in File_scanner_OFF::scan_color).
+        {"COFF\n# 0 0\n1 0 0\n` 1 0\n0 ~ C0\n*CC4", "OFF vertex 0 is not a line of 3 numbers"},
+        {"COFF\n3 1 0\n0 inf 0 1 2 3\n" + tail, "OFF vertex 0 is not a line"},
+        {"COFF\n3 1 0\n0 0 0 1 2\n" + tail, "vertex 0 has 2 colour values"},
+        {"COFF\n3 1 0\n0 0 0 300 0 0\n" + tail, "vertex 0 has a colour out of range"},
+        {"COFF\n3 1 0\n0 0 0 -5\n" + tail, "vertex 0 has a colour out of range"},
+        {"COFF\n3 1 0\n0 0 0 0.5 2.5 0\n" + tail, "vertex 0 has a colour out of range"},
+        {"COFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2 1 2\n", "face 0 has 2 colour values"},
+        {"NOFF\n3 1 0\n0 0 0 0 0\n1 0 0 0 0 1\n0 1 0 0 0 1\n3 0 1 2\n", "not a line of 6 numbers"},
+        {"STOFF\n3 1 0\n0 0 0 0 0\n" + tail, "texture coordinates"},
+        {"XOFF\n3 1 0\n0 0 0\n" + tail, "unknown OFF keyword"},
+        // Found by fuzz_mesh_off: CGAL reads the edge count from the next line when the
+        // header line lacks it; read without it, the data were shifted by one number and a
+        // face's "5 0" taken for a colour (5 x 255 does not fit a byte: undefined behaviour).
+        {"COFF\n# 0\n 0\n1 \n 0\n0 5 0\n20\n2 C4", "OFF face 0 has 2 colour values"},
+        {"OFF\n3 1\n0 0 0\n" + tail, "numbers after its three counts"},
+    };
+    int i = 0;
+    for (const auto& [text, expected] : cases) {
+        const auto input = write_bytes(dir / ("case" + std::to_string(i++) + ".off"), text);
+        const auto r = run_limited({"mesh", input, "-o", (dir / "m.ply").string(), "-q"}, 30, 512);
+        INFO(text);
+        CHECK(r.status == 1);
+        CHECK(line_count(r.err) == 1);
+        CHECK_THAT(r.err, Contains(expected));
+    }
+    CHECK_FALSE(std::filesystem::exists(dir / "m.ply"));
+
+    // Colours as CGAL reads them (an index, RGB integers, RGBA, fractions) stay readable,
+    // as do normals and homogeneous coordinates.
+    const std::string valid[] = {
+        "COFF\n4 2 0\n0 0 0 7\n1 0 0 255 0 0\n0 1 0 0.5 0.25 1 1\n1 1 0 0 0 255 255\n"
+        "3 0 1 2 12\n3 1 3 2 0 255 0\n",
+        "NOFF\n3 1 0\n0 0 0 0 0 1\n1 0 0 0 0 1\n0 1 0 0 0 1\n3 0 1 2\n",
+        "4OFF\n3 1 0\n0 0 0 1\n2 0 0 2\n0 1 0 1\n3 0 1 2\n",
+    };
+    for (const auto& text : valid) {
+        INFO(text);
+        const auto input = write_bytes(dir / ("valid" + std::to_string(i++) + ".off"), text);
+        const auto mesh = terrain::io::read_mesh(input);
+        CHECK(mesh.triangles.size() >= 1);
+    }
+}
+
+TEST_CASE("a PLY format line other than the second is refused, not read in another format",
+          "[robustness][mesh]") {
+    // Found by fuzz_mesh_ply: CGAL takes the second line as the format and ignores a later
+    // `format` line, which the header check used to follow: the ASCII face "3 0 1 2" read as
+    // binary declares a list of 0x20302033 entries, about 2 GB.
+    const auto dir = scratch_dir("hostile_ply_format");
+    const std::string body =
+        "element vertex 3\nproperty float x\nproperty float y\n"
+        "property float z\nelement face 1\n"
+        "property list uint int vertex_indices\nend_header\n"
+        "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+    const std::pair<std::string, const char*> cases[] = {
+        {"ply\nformat binary_little_endian 1.0\nformat ascii 1.0\n" + body, "second line"},
+        {"ply\ncomment binary_little_endian 1.0\nformat ascii 1.0\n" + body, "second line"},
+    };
+    int i = 0;
+    for (const auto& [text, expected] : cases) {
+        const auto input = write_bytes(dir / ("case" + std::to_string(i++) + ".ply"), text);
+        const auto r = run_limited({"mesh", input, "-o", (dir / "m.ply").string(), "-q"}, 30, 512);
+        INFO(text);
+        CHECK(r.status == 1);
+        CHECK(line_count(r.err) == 1);
+        CHECK_THAT(r.err, Contains(expected));
+    }
+    CHECK_FALSE(std::filesystem::exists(dir / "m.ply"));
+    const auto valid = write_bytes(dir / "valid.ply", "ply\nformat ascii 1.0\n" + body);
+    CHECK(terrain::io::read_mesh(valid).triangles.size() == 1);
+}

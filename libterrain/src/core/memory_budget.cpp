@@ -72,14 +72,22 @@ std::string format_bytes(double bytes) {
     return text;
 }
 
-void check_memory(const std::string& what, double bytes) {
-    const std::uint64_t limit = limit_bytes;
+namespace {
+std::string bytes_text(double bytes) {
+    char exact[32];
+    std::snprintf(exact, sizeof exact, "%.0f", std::ceil(bytes));
+    return format_bytes(bytes) + " (" + exact + " bytes)";
+}
+}  // namespace
+
+void check_memory(const std::string& what, double bytes, std::uint64_t limit) {
+    if (limit == 0) limit = limit_bytes;
     if (limit > 0 && bytes > double(limit))
-        throw Error("memory", what + " needs about " + format_bytes(bytes) + ", over the " +
-                                  format_bytes(double(limit)) + " of --max-memory");
+        throw Error("memory", what + " needs about " + bytes_text(bytes) +
+                                  " but the memory limit is " + bytes_text(double(limit)));
     if (const auto available = available_memory(); available && bytes > double(*available))
-        throw Error("memory", what + " needs about " + format_bytes(bytes) + " but only " +
-                                  format_bytes(double(*available)) +
+        throw Error("memory", what + " needs about " + bytes_text(bytes) + " but only " +
+                                  bytes_text(double(*available)) +
                                   " are available; use a smaller input or free memory");
 }
 

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cctype>
 #include <charconv>
+#include <cmath>
 #include <cstring>
 #include <optional>
 #include <vector>
@@ -128,6 +129,10 @@ MeshFileCounts check_ply(std::string_view bytes, const std::string& name) {
             break;
         }
         if (key == "format") {
+            // CGAL takes the second line as the format whatever it says and ignores other
+            // format lines: the data must be walked in the format CGAL reads.
+            if (line_number != 2 || format >= 0)
+                refuse(name, "PLY format line must be the second line, and the only one" + where);
             if (tokens.size() < 2) refuse(name, "PLY format line without a format" + where);
             if (tokens[1] == "ascii")
                 format = 0;
@@ -173,7 +178,7 @@ MeshFileCounts check_ply(std::string_view bytes, const std::string& name) {
         }
     }
     if (!ended) refuse(name, "PLY header has no end_header line");
-    if (format < 0) refuse(name, "PLY header has no format line");
+    if (format < 0) refuse(name, "PLY header has no format line (the second line)");
 
     MeshFileCounts counts;
     for (const auto& e : elements) {
@@ -271,6 +276,51 @@ struct OffLines {
     }
 };
 
+// The numbers of an OFF data line, each token read whole; nullopt when one is not a finite
+// decimal number. CGAL's scanner stops at the first token its stream cannot read ("inf",
+// hexadecimal) and counts the entries after it from what it read: the line must read the
+// same both ways.
+std::optional<std::vector<double>> off_numbers(const std::vector<std::string_view>& tokens) {
+    std::vector<double> values;
+    for (const auto token : tokens) {
+        const char* end = token.data() + token.size();
+        double v = 0;
+        const auto [ptr, ec] = std::from_chars(token.data(), end, v);
+        if (ec != std::errc() || ptr != end || !std::isfinite(v)) return std::nullopt;
+        values.push_back(v);
+    }
+    return values;
+}
+
+// The colour of a vertex or face of a "C" OFF variant: the `count` values from `first`.
+// CGAL's scanner reads 1 (an index into its colour map) or 3 or 4 (RGB[A], integers 0..255
+// or fractions 0..1) without checking the count or converting safely: other counts read past
+// the line's numbers, and values out of range are undefined behaviour in its conversions.
+void check_off_colour(const std::vector<double>& values, std::size_t first, const std::string& name,
+                      const std::string& what) {
+    const std::size_t count = values.size() - first;
+    if (count == 0) return;
+    if (count != 1 && count != 3 && count != 4)
+        refuse(name, "OFF " + what + " has " + str(count) +
+                         " colour values; a colour is 1 index, or 3 or 4 components");
+    const auto bad = [&] {
+        refuse(name, "OFF " + what +
+                         " has a colour out of range (an index 0..148, components 0..255 or 0..1)");
+    };
+    if (count == 1) {
+        const double id = values[first];
+        if (!(id >= 0 && id <= 148)) bad();
+        return;
+    }
+    bool integers = true;
+    for (std::size_t k = first; k < first + 3; ++k)
+        if (std::floor(values[k]) != values[k]) integers = false;
+    for (std::size_t k = first; k < first + 3; ++k) {
+        const double v = integers ? values[k] : values[k] * 255;
+        if (!(v >= 0 && v < 256)) bad();
+    }
+}
+
 std::uint32_t big_endian32(const unsigned char* p) {
     return (std::uint32_t(p[0]) << 24) | (std::uint32_t(p[1]) << 16) | (std::uint32_t(p[2]) << 8) |
            std::uint32_t(p[3]);
@@ -288,12 +338,23 @@ MeshFileCounts check_off(std::string_view bytes, const std::string& name) {
         refuse(name, "not an OFF file (no OFF keyword on its first line)");
     prefix.remove_suffix(3);
     const bool n_dimensional = !prefix.empty() && prefix.back() == 'n';
+    if (n_dimensional) prefix.remove_suffix(1);
+    const bool homogeneous = !prefix.empty() && prefix.back() == '4';
+    if (homogeneous) prefix.remove_suffix(1);
+    const bool normals = !prefix.empty() && prefix.back() == 'N';
+    if (normals) prefix.remove_suffix(1);
+    const bool colours = !prefix.empty() && prefix.back() == 'C';
+    if (colours) prefix.remove_suffix(1);
+    if (prefix == "ST")
+        refuse(name, "OFF texture coordinates (" + std::string(keyword) +
+                         ") are not read; remove them (OFF, COFF, NOFF, 4OFF)");
+    if (!prefix.empty()) refuse(name, "unknown OFF keyword '" + std::string(keyword) + "'");
     const bool binary = tokens.size() > 1 && tokens[1] == "BINARY";
     std::vector<std::string_view> numbers(tokens.begin() + 1 + (binary ? 1 : 0), tokens.end());
     MeshFileCounts counts;
 
     if (binary) {
-        if (!prefix.empty())
+        if (keyword != "OFF")
             refuse(name, "binary " + std::string(keyword) +
                              " files are not read; convert to ASCII OFF or PLY");
         std::uint64_t pos = lines.reader.pos;
@@ -342,6 +403,11 @@ MeshFileCounts check_off(std::string_view bytes, const std::string& name) {
     const auto nv = next_number();
     const auto nf = next_number();
     if (!nv || !nf) refuse(name, "OFF header has no vertex and face counts");
+    // CGAL reads the edge count too, from the next line if need be: without it, the first
+    // number of the data would be taken for it and the data read shifted.
+    if (!next_number()) refuse(name, "OFF header has no edge count (the third number)");
+    // CGAL reads the first vertex from the rest of that line.
+    if (!numbers.empty()) refuse(name, "OFF header has numbers after its three counts");
     counts.vertices = *nv;
     counts.faces = *nf;
     const std::uint64_t rest = bytes.size() - lines.reader.pos + 1;
@@ -349,9 +415,18 @@ MeshFileCounts check_off(std::string_view bytes, const std::string& name) {
     if (*nv > rest / 6 || *nf > rest / 2 || *nv * 6 + *nf * 2 > rest)
         refuse(name, "OFF header declares " + str(*nv) + " vertices and " + str(*nf) +
                          " faces; the file (" + str(bytes.size()) + " bytes) cannot hold them");
-    for (std::uint64_t v = 0; v < *nv; ++v)
-        if (!lines.next())
+    // Coordinates (and normals) a vertex line starts with; CGAL reads past a short line.
+    const std::size_t coordinates = (homogeneous ? 4 : 3) * (normals ? 2 : 1);
+    for (std::uint64_t v = 0; v < *nv; ++v) {
+        const auto line = lines.next();
+        if (!line)
             refuse(name, "OFF data end at vertex " + str(v) + " of " + str(*nv) + " declared");
+        const auto values = off_numbers(split(*line));
+        if (!values || values->size() < coordinates)
+            refuse(name, "OFF vertex " + str(v) + " is not a line of " + str(coordinates) +
+                             " numbers or more");
+        if (colours) check_off_colour(*values, coordinates, name, "vertex " + str(v));
+    }
     for (std::uint64_t f = 0; f < *nf; ++f) {
         const auto line = lines.next();
         if (!line) refuse(name, "OFF data end at face " + str(f) + " of " + str(*nf) + " declared");
@@ -374,6 +449,11 @@ MeshFileCounts check_off(std::string_view bytes, const std::string& name) {
             if (!index || *index >= *nv)
                 refuse(name, "OFF face " + str(f) + " refers to vertex '" + std::string(face[k]) +
                                  "'; the file has " + str(*nv) + " vertices");
+        }
+        if (colours) {
+            const auto values = off_numbers(face);
+            if (!values) refuse(name, "OFF face " + str(f) + " is not a line of numbers");
+            check_off_colour(*values, *n + 1, name, "face " + str(f));
         }
     }
     return counts;

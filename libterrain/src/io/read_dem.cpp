@@ -89,7 +89,7 @@ Dem read_dem(const std::string& path, const ReadDemOptions& options, const Progr
     const bool all_valid = band->GetMaskFlags() == GMF_ALL_VALID;
 
     const std::size_t width = static_cast<std::size_t>(dem.width);
-    check_dem_size(path, dem, *band, summary ? 0.0 : options.planned_bytes_per_pixel);
+    check_dem_size(path, dem, *band, summary ? nullptr : &options.memory);
     if (!summary)
         dem.values.assign(width * static_cast<std::size_t>(dem.height),
                           std::numeric_limits<double>::quiet_NaN());

@@ -107,15 +107,23 @@ bool is_mesh_file(const std::string& path) {
 
 TriangleMesh read_mesh(const std::string& path, const ReadMeshOptions& options,
                        const ProgressFn& progress) {
+    return read_mesh(path, options, progress, MemoryPlan{});
+}
+
+TriangleMesh read_mesh(const std::string& path, const ReadMeshOptions& options,
+                       const ProgressFn& progress, const MemoryPlan& memory) {
     if (!std::filesystem::exists(path))
         throw Error("mesh", "'" + path + "' does not exist; check the path");
     if (!is_mesh_file(path)) throw Error("mesh", "'" + path + "' is not a .off, .ply or .obj mesh");
     // Headers and counts checked before CGAL's parser sees the file; the peak of reading,
     // repairing and checking estimated from them.
     const auto counts = check_mesh_file(path, lower_extension(path));
-    check_memory("reading the mesh '" + path + "'", 200.0 * double(counts.vertices) +
-                                                        300.0 * double(counts.faces) +
-                                                        16.0 * double(counts.indices));
+    if (memory.checked)
+        check_memory("the mesh '" + path + "' (" + std::to_string(counts.vertices) + " vertices, " +
+                         std::to_string(counts.faces) + " faces)",
+                     memory.mesh_bytes(double(counts.vertices), double(counts.faces),
+                                       double(counts.indices)),
+                     memory.limit);
     std::vector<Point> points;
     std::vector<Polygon> polygons;
     bool ok = false;

@@ -1,11 +1,13 @@
 #include "validate_dem.hpp"
 
+#include <cpl_vsi.h>
 #include <gdal_priv.h>
 #include <ogr_spatialref.h>
 
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <string>
 #include <vector>
 
 #include "gdal_support.hpp"
@@ -76,12 +78,28 @@ void validate_dem_grid(const std::string& path, const Dem& dem, const OGRSpatial
 }
 
 void check_dem_size(const std::string& path, const Dem& dem, GDALRasterBand& band,
-                    double bytes_per_pixel) {
+                    const MemoryPlan* plan) {
     const double pixels = double(dem.width) * double(dem.height);
-    if (bytes_per_pixel > 0)
+    if (plan && plan->checked)
         check_memory("the " + std::to_string(dem.width) + "x" + std::to_string(dem.height) +
                          " grid of '" + path + "'",
-                     bytes_per_pixel * pixels);
+                     plan->dem_bytes(pixels), plan->limit);
+    // ASCII grids (GDAL's AAIGrid, GRASSASCIIGrid and ISG drivers) find a line by reading
+    // every line before it, again for each one that failed: asking for the last row of a
+    // grid whose text ends early takes time exponential in the missing lines. Their size is
+    // bounded by the text instead (a value takes at least two characters), and the rows,
+    // read from the top, stop at the first one missing.
+    const auto* driver = band.GetDataset() ? band.GetDataset()->GetDriver() : nullptr;
+    const std::string driver_name = driver ? driver->GetDescription() : "";
+    if (driver_name == "AAIGrid" || driver_name == "GRASSASCIIGrid" || driver_name == "ISG") {
+        VSIStatBufL stat;
+        if (VSIStatL(path.c_str(), &stat) == 0 && 2 * pixels - 1 > double(stat.st_size))
+            throw Error("read", "'" + path + "' declares " + std::to_string(dem.width) + "x" +
+                                    std::to_string(dem.height) +
+                                    " values but its text holds at most " +
+                                    std::to_string((stat.st_size + 1) / 2));
+        return;
+    }
     // The last row read back: a file whose data end early fails here, before the grid is
     // allocated and before all the rows before it are read.
     std::vector<double> row(static_cast<std::size_t>(dem.width));

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "terrain/core/dem.hpp"
+#include "terrain/core/memory_budget.hpp"
 
 class GDALRasterBand;
 class OGRSpatialReference;
@@ -25,11 +26,11 @@ constexpr double kMinPixelDegrees = 1e-9;
 // The grid of `dem` (width, height, transform, body) under `srs` (null: no CRS).
 void validate_dem_grid(const std::string& path, const Dem& dem, const OGRSpatialReference* srs);
 
-// The band's declared size against the memory budget (`bytes_per_pixel` of peak memory; 0:
-// not checked), and its last row read back (a raster whose data end early, such as a PDS
-// label declaring more rows than its image holds, is refused before the grid is allocated).
+// The band's declared size against the memory budget (`plan`; null: not checked), and its
+// last row read back (a raster whose data end early, such as a PDS label declaring more rows
+// than its image holds, is refused before the grid is allocated).
 void check_dem_size(const std::string& path, const Dem& dem, GDALRasterBand& band,
-                    double bytes_per_pixel);
+                    const MemoryPlan* plan);
 
 // Scale and offset of the band (before reading).
 void validate_scale(const std::string& path, double scale, double offset);

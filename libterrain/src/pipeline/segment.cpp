@@ -21,6 +21,7 @@
 #include "terrain/io/write_region_polygons.hpp"
 #include "terrain/io/write_segment_outputs.hpp"
 #include "terrain/mesh/dem_to_mesh.hpp"
+#include "terrain/pipeline/memory_plan.hpp"
 
 namespace terrain::pipeline {
 
@@ -44,16 +45,19 @@ std::optional<MeshFrame> parse_frame(const std::string& name) {
 
 Input load_input(const std::string& path, const InputOptions& options, const ProgressFn& progress) {
     const auto t0 = clock::now();
+    const MemoryPlan plan = memory_plan(options.planned_field, options.max_memory);
     if (io::is_mesh_file(path)) {
         io::ReadMeshOptions read_options;
         read_options.repair = options.repair;
         Input input;
-        input.mesh = io::read_mesh(path, read_options, progress);
+        input.mesh = io::read_mesh(path, read_options, progress, plan);
         input.read_seconds = since(t0);
         return input;
     }
     const auto frame = parse_frame(options.frame);
-    Dem dem = io::read_dem(path, options.dem, scaled_progress(progress, 0, 0.3));
+    io::ReadDemOptions dem_options = options.dem;
+    dem_options.memory = plan;
+    Dem dem = io::read_dem(path, dem_options, scaled_progress(progress, 0, 0.3));
     const double read_seconds = since(t0);
     mesh::DemToMeshOptions mesh_options;
     mesh_options.frame = frame;
@@ -422,7 +426,9 @@ SegmentResult segment_to_directory(const std::string& input_path, const std::str
                                    const SegmentOptions& options, const ProgressFn& progress) {
     check_options(options);
     OutputDirectory dir(output_dir, overwrite);
-    auto input = load_input(input_path, input_options, scaled_progress(progress, 0, 0.15));
+    InputOptions planned = input_options;
+    planned.planned_field = options.field;  // the plan of the field segmented
+    auto input = load_input(input_path, planned, scaled_progress(progress, 0, 0.15));
     auto result = segment(std::move(input), options, scaled_progress(progress, 0.15, 0.7));
     WriteOptions write;
     write.release_memory = true;

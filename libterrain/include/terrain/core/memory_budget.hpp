@@ -22,8 +22,35 @@ std::uint64_t parse_memory_size(const std::string& text);
 // "3.2 GB", "512 MB", "900 B"
 std::string format_bytes(double bytes);
 
+// The expected peak of reading an input and of the work planned on it, from its declared
+// size: a fixed part (the process with GDAL, PROJ, CGAL and the thread pool) plus parts
+// proportional to the DEM's pixels, or the mesh file's vertices, faces and face corners; for
+// a DEM at least `floor_bytes` (a stage whose peak does not grow with the input: encoding
+// the preview). pipeline::memory_plan gives the plan of each field (docs/robustness.md).
+struct MemoryPlan {
+    double floor_bytes = 0;
+    double base_bytes = 0;
+    double bytes_per_pixel = 8;  // the grid of doubles alone
+    double bytes_per_vertex = 200, bytes_per_face = 300, bytes_per_corner = 16;  // reading
+    std::uint64_t limit = 0;  // bytes; 0: the process-wide limit, if any (set_memory_limit)
+    bool checked = true;      // false: no check (reading a DEM one row at a time)
+
+    double dem_bytes(double pixels) const {
+        const double grows = base_bytes + bytes_per_pixel * pixels;
+        return grows > floor_bytes ? grows : floor_bytes;
+    }
+    double mesh_bytes(double vertices, double faces, double corners) const {
+        return base_bytes + bytes_per_vertex * vertices + bytes_per_face * faces +
+               bytes_per_corner * corners;
+    }
+};
+
 // Throws terrain::Error (stage "memory") when `bytes` exceed the limit or the memory
-// available; `what` names the work ("reading a 20000x20000 DEM").
-void check_memory(const std::string& what, double bytes);
+// available; `what` names the work ("the 20000x20000 grid of 'x.tif'"). `limit`: the
+// caller's own limit in bytes (pipeline::InputOptions::max_memory); 0 takes the
+// process-wide one of set_memory_limit, if any. The one line names the bytes needed and
+// the bytes the limit or the system allows, rounded and exact:
+//   "... needs about 152 MB (159383552 bytes) but the memory limit is 140 MB (146800640 bytes)"
+void check_memory(const std::string& what, double bytes, std::uint64_t limit = 0);
 
 }  // namespace terrain

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "terrain/core/memory_budget.hpp"
 #include "terrain/core/progress.hpp"
 #include "terrain/mesh/triangle_mesh.hpp"
 
@@ -22,6 +23,11 @@ struct ReadMeshOptions {
 // terrain::Error (stage "mesh") naming the first bad element.
 TriangleMesh read_mesh(const std::string& path, const ReadMeshOptions& options = {},
                        const ProgressFn& progress = {});
+// The same with the memory plan of the work that follows (pipeline::memory_plan), checked
+// from the counts of the file's header before CGAL reads it; the overload above checks the
+// peak of reading alone (MemoryPlan's defaults).
+TriangleMesh read_mesh(const std::string& path, const ReadMeshOptions& options,
+                       const ProgressFn& progress, const MemoryPlan& memory);
 
 // True for the extensions read_mesh reads (.off .ply .obj, any case).
 bool is_mesh_file(const std::string& path);

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "terrain/core/dem.hpp"
+#include "terrain/core/memory_budget.hpp"
 #include "terrain/core/progress.hpp"
 
 namespace terrain::io {
@@ -14,9 +15,9 @@ struct ReadDemOptions {
     std::optional<ElevationKind> elevation;  // unset: detect (docs/bodies-and-elevation.md)
     bool nan_as_nodata = false;              // NaN/Inf pixels become holes instead of an error
     std::optional<double> pixel_size;        // metres per pixel for rasters with no geotransform
-    // Peak bytes per pixel of the work planned on the grid (8: the grid alone), checked
-    // against the memory budget (terrain/core/memory_budget.hpp) before anything is read.
-    double planned_bytes_per_pixel = 8;
+    // The peak of the work planned on the grid (by default the grid alone), checked against
+    // the memory budget (terrain/core/memory_budget.hpp) before the pixels are read.
+    MemoryPlan memory;
 };
 
 // Scale and offset of the band are applied; NoData (and the band's mask) become NaN.

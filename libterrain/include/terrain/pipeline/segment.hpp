@@ -44,6 +44,12 @@ struct InputOptions {
     // planetary and geographic CRSs, map otherwise).
     std::string frame = "auto";
     bool repair = false;  // mesh files: repair degenerate or non-manifold elements
+    // The memory plan (pipeline/memory_plan.hpp): the field computed after reading ("" for
+    // reading and meshing only) and a limit in bytes (0: none but the memory available).
+    // load_input checks the input's declared size against it before reading; it replaces
+    // dem.memory.
+    std::string planned_field = "shape-index";
+    std::uint64_t max_memory = 0;
 };
 
 // The frame named by InputOptions::frame; throws terrain::Error (stage "mesh") otherwise.

@@ -1,0 +1,20 @@
+#pragma once
+// The memory plan of the pipeline: the expected peak of reading an input and computing a
+// field, a Reeb graph and the segmentation on it, from the input's declared size, so that
+// every caller (the command line, the Python module, the QGIS provider) refuses the same
+// input with the same line before anything large is read (docs/robustness.md, "Memory
+// budget", gives the measurements the figures come from).
+
+#include <cstdint>
+#include <string>
+
+#include "terrain/core/memory_budget.hpp"
+
+namespace terrain::pipeline {
+
+// The plan of reading an input and working on it with `field` ("shape-index", "height",
+// "sdf"; "" for reading and meshing only, as `terrain mesh` does), with the caller's limit
+// in bytes (0: the memory available only). Throws terrain::Error for an unknown field.
+MemoryPlan memory_plan(const std::string& field, std::uint64_t limit = 0);
+
+}  // namespace terrain::pipeline

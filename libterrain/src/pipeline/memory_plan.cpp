@@ -1,0 +1,40 @@
+#include "terrain/pipeline/memory_plan.hpp"
+
+#include "terrain/field/vertex_field.hpp"
+
+namespace terrain::pipeline {
+namespace {
+constexpr double MB = 1024.0 * 1024.0;
+}  // namespace
+
+// Fitted to the peak resident memory (/usr/bin/time -v) of `terrain mesh` and `terrain
+// segment` on the samples and shared DEMs (8 400 to 1 036 800 pixels) and on meshes written
+// from them (8 400 to 1 033 922 vertices, two faces a vertex), with a margin of about 25 %
+// over the measured slope; the table is in docs/robustness.md.
+MemoryPlan memory_plan(const std::string& field, std::uint64_t limit) {
+    MemoryPlan plan;
+    plan.limit = limit;
+    plan.bytes_per_corner = 0;  // counted in the faces (triangles)
+    // Mesh files: reading the polygon soup dominates (about 420 bytes a vertex measured
+    // for the shape index, 500 for the SDF).
+    plan.base_bytes = 50 * MB;
+    plan.bytes_per_vertex = 130;
+    plan.bytes_per_face = 200;
+    const bool sdf = !field.empty() && field::parse_field_kind(field) == field::FieldKind::sdf;
+    if (sdf) {
+        plan.bytes_per_vertex = 150;
+        plan.bytes_per_face = 240;
+    }
+    // DEMs: 143 bytes a pixel measured for reading and meshing, 181 for segmenting with the
+    // shape index or the height (whose preview, encoded after the large data are freed,
+    // makes a floor of about 146 MB), 545 with the SDF.
+    if (field.empty()) {
+        plan.bytes_per_pixel = 180;
+    } else {
+        plan.floor_bytes = 160 * MB;
+        plan.bytes_per_pixel = sdf ? 680 : 235;
+    }
+    return plan;
+}
+
+}  // namespace terrain::pipeline

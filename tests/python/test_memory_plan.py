@@ -1,0 +1,80 @@
+"""The memory plan (docs/robustness.md): the command line and the Python module check an
+input's estimated peak memory against the same limit, and refuse it with the same line."""
+
+import re
+
+import pytest
+
+import terrain
+from conftest import SAMPLE_FILES
+
+NEEDED = re.compile(r"needs about [^(]+\((\d+) bytes\) but the memory limit is [^(]+\((\d+) bytes\)$")
+
+
+def needed_bytes(cli, command, path, out, *args):
+    """The estimate the command line names when refusing under a limit of one byte."""
+    done = cli(command, path, "-o", out, "-q", "--max-memory", "1", *args)
+    assert done.returncode == 1, done.stderr
+    line = done.stderr.strip()
+    assert "\n" not in line
+    match = NEEDED.search(line)
+    assert match, line
+    assert int(match.group(2)) == 1
+    return int(match.group(1))
+
+
+@pytest.mark.parametrize("field", ["shape-index", "height"])
+def test_a_dem_just_over_the_limit_is_refused_alike_and_just_under_it_runs(cli, tmp_path, field):
+    dem = str(SAMPLE_FILES["vesta"])
+    needed = needed_bytes(cli, "segment", dem, tmp_path / "probe", "--field", field)
+    # The estimate grows with the grid: at least the process and 100 bytes a pixel.
+    assert needed > 256 * 1024 * 100
+
+    below = needed - 1
+    done = cli("segment", dem, "-o", tmp_path / "below", "-q", "--field", field,
+               "--max-memory", below)
+    assert done.returncode == 1
+    assert not (tmp_path / "below").exists()
+    with pytest.raises(terrain.Error) as refused:
+        terrain.segment(dem, field=field, max_memory=below)
+    assert done.stderr.strip() == "terrain segment: " + str(refused.value)
+    assert f"({needed} bytes)" in str(refused.value)
+    assert f"({below} bytes)" in str(refused.value)
+    # The same limit as a size with a unit, and the same check in the other entry points.
+    with pytest.raises(terrain.Error, match="memory limit is 1 MB"):
+        terrain.shape_index(dem, max_memory="1M")
+    with pytest.raises(terrain.Error, match="memory limit"):
+        terrain.sweep(dem, field=field, max_memory=below)
+
+    done = cli("segment", dem, "-o", tmp_path / "at", "-q", "--field", field,
+               "--max-memory", needed)
+    assert done.returncode == 0, done.stderr
+    result = terrain.segment(dem, field=field, max_memory=needed)
+    assert result.region_count > 1
+
+
+def test_a_mesh_for_the_sdf_is_planned_alike(cli, tmp_path):
+    mesh = tmp_path / "moon.ply"
+    assert cli("mesh", SAMPLE_FILES["moon4c"], "-o", mesh, "-q").returncode == 0
+    args = ("--field", "sdf", "--allow-open", "--rays", "5")
+    needed = needed_bytes(cli, "segment", mesh, tmp_path / "probe", *args)
+    shape_needed = needed_bytes(cli, "segment", mesh, tmp_path / "probe", "--field", "shape-index")
+    assert needed > shape_needed  # the SDF's plan is the larger
+
+    done = cli("segment", mesh, "-o", tmp_path / "below", "-q", *args, "--max-memory", needed - 1)
+    assert done.returncode == 1
+    with pytest.raises(terrain.Error) as refused:
+        terrain.segment(str(mesh), field="sdf", allow_open=True, rays=5, max_memory=needed - 1)
+    assert done.stderr.strip() == "terrain segment: " + str(refused.value)
+
+    done = cli("segment", mesh, "-o", tmp_path / "at", "-q", *args, "--max-memory", needed)
+    assert done.returncode == 0, done.stderr
+    assert terrain.segment(str(mesh), field="sdf", allow_open=True, rays=5,
+                           max_memory=needed).region_count >= 1
+
+
+def test_bad_limits_are_refused(tmp_path):
+    dem = str(SAMPLE_FILES["vesta"])
+    for bad in ("lots", "-5G", 0):
+        with pytest.raises(terrain.Error, match="not a memory size"):
+            terrain.segment(dem, max_memory=bad)
