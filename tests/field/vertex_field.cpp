@@ -22,7 +22,7 @@ Dem small_dem() {
 
 }  // namespace
 
-TEST_CASE("field names parse and print back; others are refused", "[vertex_field]") {
+TEST_CASE("field names parse and print back, others are refused", "[vertex_field]") {
     for (auto kind : {FieldKind::shape_index, FieldKind::sdf, FieldKind::height})
         CHECK(field::parse_field_kind(field::to_string(kind)) == kind);
     CHECK(std::string(field::to_string(FieldKind::shape_index)) == "shape-index");

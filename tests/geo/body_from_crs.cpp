@@ -48,7 +48,7 @@ TEST_CASE("a PROJ string with only a radius is named by that radius", "[body]") 
     CHECK(body_from_crs("+proj=eqc +R=123456 +no_defs").name == "unknown");
 }
 
-TEST_CASE("no CRS is a local metric grid; garbage is an error", "[body]") {
+TEST_CASE("no CRS is a local metric grid, garbage is an error", "[body]") {
     const auto local = body_from_crs("");
     CHECK(local.is_local_grid());
     CHECK(local.semi_major_axis == 0);

@@ -171,7 +171,7 @@ TEST_CASE("preview.png: the colour bar shows the landform classes' colours in or
 }
 
 TEST_CASE(
-    "preview.png: ticks, scale and north from the DEM's CRS; text where a font is found, "
+    "preview.png: ticks, scale and north from the DEM's CRS, text where a font is found, "
     "none and no failure without one",
     "[write_preview]") {
     const auto t = vesta_tile();

@@ -106,7 +106,7 @@ TEST_CASE("Closed surfaces of genus g have g loops, also under a noisy field", "
     }
 }
 
-TEST_CASE("Disk-like DEMs give a tree; a hole in the DEM can give a loop", "[reeb]") {
+TEST_CASE("Disk-like DEMs give a tree, a hole in the DEM can give a loop", "[reeb]") {
     const auto dem = test::grid_dem(40, 30, [](int c, int r) { return 0.3 * c + 0.01 * r; });
     const auto mesh = mesh::dem_to_mesh(dem);
     CHECK(checked(mesh, field::height_field(mesh, &dem)).loops == 0);

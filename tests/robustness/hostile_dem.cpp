@@ -194,3 +194,24 @@ TEST_CASE("a truncated ASCII grid is refused at once instead of rereading its li
     CHECK_THAT(r.err, Contains("text holds at most"));
     CHECK_FALSE(std::filesystem::exists(dir / "m.ply"));
 }
+
+TEST_CASE("a GeoTIFF whose one row of blocks is larger than memory is refused",
+          "[robustness][dem]") {
+    // Found by fuzz_dem: 505 bytes declaring 65 304 x 24 pixel-interleaved pixels of 63 487
+    // Int16 bands. Reading one row of band 1 makes GDAL allocate the whole interleaved block,
+    // 8.3 GB, which the budget (one band) did not count.
+    const auto dir = scratch_dir("hostile_interleaved");
+    const std::string input = std::string(TERRAIN_SOURCE_DIR) +
+                              "/tests/robustness/cases/dem_pixel_interleaved_63487_bands.tif";
+    for (const char* command : {"info", "mesh"}) {
+        std::vector<std::string> args = {command, input};
+        if (std::string(command) == "mesh")
+            args.insert(args.end(), {"-o", (dir / "m.ply").string(), "-q"});
+        const auto r = run_limited(args, 30, 2048);
+        INFO(command);
+        CHECK(r.status == 1);
+        CHECK(line_count(r.err) == 1);
+        CHECK_THAT(r.err, Contains("block"));
+    }
+    CHECK_FALSE(std::filesystem::exists(dir / "m.ply"));
+}

@@ -177,6 +177,10 @@ TEST_CASE("OFF colours and vertex lines CGAL's scanner reads unchecked are refus
         // face's "5 0" taken for a colour (5 x 255 does not fit a byte: undefined behaviour).
         {"COFF\n# 0\n 0\n1 \n 0\n0 5 0\n20\n2 C4", "OFF face 0 has 2 colour values"},
         {"OFF\n3 1\n0 0 0\n" + tail, "numbers after its three counts"},
+        // Found by fuzz_mesh_off: a comment glued to the keyword ("OFF#4 4 0") is a comment
+        // to a reader that cuts lines at '#', not to CGAL's scanner, which then took a face
+        // index of 7.8e23 for a size_t (undefined behaviour).
+        {"OFF#4 4 0\n0 0 0\n0 0 0\n0 1 0\n0 0 30 \n1 2x", "comment glued to the OFF keyword"},
     };
     int i = 0;
     for (const auto& [text, expected] : cases) {

@@ -166,7 +166,7 @@ TEST_CASE("Dividing absorbed vertices on the Vesta tile: connected, deterministi
     CHECK(segment_both(mesh, field).divided.labels == run.divided.labels);
 }
 
-TEST_CASE("Dividing with nothing absorbed changes nothing; mismatched sizes throw",
+TEST_CASE("Dividing with nothing absorbed changes nothing, mismatched sizes throw",
           "[segment][divide]") {
     const auto dem = test::grid_dem(30, 20, [](int c, int r) { return c * c + r * r; });
     const auto mesh = mesh::dem_to_mesh(dem);

@@ -116,7 +116,7 @@ TEST_CASE("Region growing is deterministic across runs and thread counts", "[seg
     CHECK(labels_with(2, workers) == one);  // and again
 }
 
-TEST_CASE("A constant field is one region; a genus-2 plate keeps regions connected", "[segment]") {
+TEST_CASE("A constant field is one region, a genus-2 plate keeps regions connected", "[segment]") {
     const auto plate = test::plate_mesh(20, 8, 2);
     const std::vector<float> flat(plate.vertex_count(), 50.f);
     const auto g = reeb::build_reeb_graph(plate, flat);

@@ -48,7 +48,7 @@ double max_height(const terrain::Dem& dem) {
 
 }  // namespace
 
-TEST_CASE("the same options give the same bytes; another seed another surface", "[synth]") {
+TEST_CASE("the same options give the same bytes, another seed another surface", "[synth]") {
     const auto a = generate_vesta_tile(small_tile());
     const auto b = generate_vesta_tile(small_tile());
     REQUIRE(a.values.size() == 128u * 128u);

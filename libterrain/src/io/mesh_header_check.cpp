@@ -332,6 +332,12 @@ MeshFileCounts check_off(std::string_view bytes, const std::string& name) {
     if (!header) refuse(name, "empty OFF file");
     auto tokens = split(*header);
     std::string_view keyword = tokens[0];
+    // A '#' right after the keyword starts a comment here, not to CGAL's scanner, which reads
+    // the counts from what follows it: the two readings would differ.
+    if (const char* end = keyword.data() + keyword.size();
+        end < bytes.data() + bytes.size() && *end == '#')
+        refuse(name, "a comment glued to the OFF keyword ('" + std::string(keyword) +
+                         "#...'); put a space or a line break before '#'");
     // [ST][C][N][4][n]OFF
     std::string_view prefix = keyword;
     if (prefix.size() < 3 || prefix.substr(prefix.size() - 3) != "OFF")
