@@ -7,7 +7,6 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
-#include <queue>
 
 #include "support/test_meshes.hpp"
 #include "support/test_support.hpp"
@@ -91,30 +90,10 @@ void check_regions(const TriangleMesh& mesh, const segment::Segmentation& s) {
     REQUIRE(s.labels.size() == mesh.vertex_count());
     REQUIRE(std::all_of(s.labels.begin(), s.labels.end(),
                         [&](std::uint32_t l) { return l >= 1 && l <= s.region_count; }));
-    std::vector<int> pieces(s.region_count + 1, 0);
-    std::vector<char> seen(mesh.vertex_count(), 0);
-    for (std::size_t v0 = 0; v0 < mesh.vertex_count(); ++v0) {
-        if (seen[v0]) continue;
-        ++pieces[s.labels[v0]];
-        std::queue<std::size_t> q;
-        q.push(v0);
-        seen[v0] = 1;
-        while (!q.empty()) {
-            const auto v = q.front();
-            q.pop();
-            for (auto i = mesh.neighbor_offsets[v]; i < mesh.neighbor_offsets[v + 1]; ++i) {
-                const auto w =
-                    static_cast<std::size_t>(mesh.neighbors[static_cast<std::size_t>(i)]);
-                if (!seen[w] && s.labels[w] == s.labels[v]) {
-                    seen[w] = 1;
-                    q.push(w);
-                }
-            }
-        }
-    }
+    const auto pieces = test::region_pieces(mesh, s.labels, s.region_count);
     for (std::uint32_t r = 1; r <= s.region_count; ++r) {
         INFO("region " << r);
-        CHECK(pieces[r] == 1);
+        CHECK(pieces[r - 1] == 1);
     }
 }
 

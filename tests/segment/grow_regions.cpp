@@ -3,7 +3,6 @@
 #include <catch2/catch.hpp>
 
 #include <atomic>
-#include <queue>
 
 #include "support/test_meshes.hpp"
 #include "support/test_support.hpp"
@@ -20,28 +19,7 @@ namespace {
 
 // Number of mesh-connected pieces of each region (index label-1).
 std::vector<int> pieces(const TriangleMesh& mesh, const segment::Segmentation& s) {
-    std::vector<int> count(s.region_count, 0);
-    std::vector<char> seen(mesh.vertex_count(), 0);
-    for (std::size_t v0 = 0; v0 < mesh.vertex_count(); ++v0) {
-        if (seen[v0]) continue;
-        ++count[s.labels[v0] - 1];
-        std::queue<std::size_t> q;
-        q.push(v0);
-        seen[v0] = 1;
-        while (!q.empty()) {
-            const auto v = q.front();
-            q.pop();
-            for (auto i = mesh.neighbor_offsets[v]; i < mesh.neighbor_offsets[v + 1]; ++i) {
-                const auto w =
-                    static_cast<std::size_t>(mesh.neighbors[static_cast<std::size_t>(i)]);
-                if (!seen[w] && s.labels[w] == s.labels[v]) {
-                    seen[w] = 1;
-                    q.push(w);
-                }
-            }
-        }
-    }
-    return count;
+    return test::region_pieces(mesh, s.labels, s.region_count);
 }
 
 struct Case {

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <queue>
 #include <random>
 
 #include "terrain/geo/body.hpp"
@@ -123,6 +124,32 @@ std::vector<float> noise_field(std::size_t n, unsigned seed) {
     std::vector<float> out(n);
     for (auto& x : out) x = static_cast<float>(rng() % 1000000u) * 1e-4f;
     return out;
+}
+
+std::vector<int> region_pieces(const TriangleMesh& mesh, const std::vector<std::uint32_t>& labels,
+                               std::uint32_t count) {
+    std::vector<int> pieces(count, 0);
+    std::vector<char> seen(mesh.vertex_count(), 0);
+    for (std::size_t v0 = 0; v0 < mesh.vertex_count(); ++v0) {
+        if (seen[v0]) continue;
+        ++pieces[labels[v0] - 1];
+        std::queue<std::size_t> q;
+        q.push(v0);
+        seen[v0] = 1;
+        while (!q.empty()) {
+            const auto v = q.front();
+            q.pop();
+            for (auto i = mesh.neighbor_offsets[v]; i < mesh.neighbor_offsets[v + 1]; ++i) {
+                const auto w =
+                    static_cast<std::size_t>(mesh.neighbors[static_cast<std::size_t>(i)]);
+                if (!seen[w] && labels[w] == labels[v]) {
+                    seen[w] = 1;
+                    q.push(w);
+                }
+            }
+        }
+    }
+    return pieces;
 }
 
 }  // namespace terrain::test

@@ -2,6 +2,7 @@
 // Analytic meshes for the topology tests: grids from height functions (with NoData holes),
 // tori and a thickened plate with holes (a closed surface of any genus).
 
+#include <cstdint>
 #include <functional>
 #include <vector>
 
@@ -31,6 +32,11 @@ TriangleMesh plate_mesh(int w, int h, int holes);
 TriangleMesh permute_mesh(const TriangleMesh& mesh, const std::vector<std::int32_t>& perm);
 std::vector<float> permute_field(const std::vector<float>& field,
                                  const std::vector<std::int32_t>& perm);
+
+// The number of mesh-connected pieces of each label 1..count (index label - 1): a region is
+// connected when its count is 1. Labels must be in 1..count.
+std::vector<int> region_pieces(const TriangleMesh& mesh, const std::vector<std::uint32_t>& labels,
+                               std::uint32_t count);
 
 // Uniform noise in [0, 100), reproducible from the seed.
 std::vector<float> noise_field(std::size_t n, unsigned seed);
