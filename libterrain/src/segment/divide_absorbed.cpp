@@ -79,16 +79,19 @@ std::vector<std::uint32_t> finer_to_here(const std::vector<std::uint32_t>& finer
     return out;
 }
 
+double edge_length(const TriangleMesh& mesh, std::size_t a, std::size_t b) {
+    const auto& p = mesh.positions[a];
+    const auto& q = mesh.positions[b];
+    return std::sqrt(double(p[0] - q[0]) * (p[0] - q[0]) + double(p[1] - q[1]) * (p[1] - q[1]) +
+                     double(p[2] - q[2]) * (p[2] - q[2]));
+}
+
 double mean_edge_length(const TriangleMesh& mesh) {
     double sum = 0;
     std::size_t count = 0;
     for (std::size_t v = 0; v < mesh.vertex_count(); ++v)
         for (i32 k = mesh.neighbor_offsets[v]; k < mesh.neighbor_offsets[v + 1]; ++k) {
-            const auto& p = mesh.positions[v];
-            const auto& q = mesh.positions[idx(mesh.neighbors[idx(k)])];
-            sum += std::sqrt(double(p[0] - q[0]) * (p[0] - q[0]) +
-                             double(p[1] - q[1]) * (p[1] - q[1]) +
-                             double(p[2] - q[2]) * (p[2] - q[2]));
+            sum += edge_length(mesh, v, idx(mesh.neighbors[idx(k)]));
             ++count;
         }
     return count == 0 || sum <= 0 ? 1.0 : sum / double(count);
@@ -181,11 +184,7 @@ DivideCounts divide_absorbed(const TriangleMesh& mesh, const reeb::ReebGraph& gr
     const auto push_around = [&](std::size_t w) {
         neighbours(w, [&](std::size_t u) {
             if (labels[u] != 0) return;
-            const auto& p = mesh.positions[u];
-            const auto& q = mesh.positions[w];
-            const double len = std::sqrt(double(p[0] - q[0]) * (p[0] - q[0]) +
-                                         double(p[1] - q[1]) * (p[1] - q[1]) +
-                                         double(p[2] - q[2]) * (p[2] - q[2]));
+            const double len = edge_length(mesh, u, w);
             const float c = cost[w] + std::fabs(field[u] - mean[labels[w]]) +
                             step * static_cast<float>(len / mean_edge);
             if (c > cost[u] || (c == cost[u] && labels[w] >= offer[u])) return;
