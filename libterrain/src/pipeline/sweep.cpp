@@ -93,12 +93,6 @@ std::vector<AreaThreshold> parse_min_areas(const std::string& text) {
 
 namespace {
 
-// What a continued scale no longer needs from the finer one (its graph's arcs and vertex
-// lists stay until the coarser scale is simplified from them: this is called after).
-void release(reeb::SimplifyResult& r) {
-    r = reeb::SimplifyResult{};
-}
-
 // One scale to run: its area ratio, name and area threshold (0 for a sweep over ratios).
 struct ScaleSpec {
     double ratio = 0;
@@ -162,7 +156,7 @@ SweepResult run_sweep(Input input, const std::vector<ScaleSpec>& specs,
     auto& scales = out.scales;
     scales.resize(specs.size());
     const auto t0 = clock::now();
-    std::vector<reeb::SimplifyResult> simplified(specs.size());
+    reeb::SimplifyResult finer;  // the last scale simplified: the next one continues it
     tbb::task_group growing;
     try {
         for (std::size_t i = 0; i < specs.size(); ++i) {
@@ -170,15 +164,14 @@ SweepResult run_sweep(Input input, const std::vector<ScaleSpec>& specs,
             SegmentOptions scale_options = options;
             scale_options.simplify.area_ratio = specs[i].ratio;
             scale_options.min_area.clear();
-            simplified[i] = reeb::simplify(
-                base.input.mesh, i == 0 ? graph : simplified[i - 1].graph, scale_options.simplify);
+            auto simplified = reeb::simplify(base.input.mesh, i == 0 ? graph : finer.graph,
+                                             scale_options.simplify);
             // Absorbed at this scale or a finer one.
-            if (i > 0) {
-                for (std::size_t v = 0; v < simplified[i].absorbed.size(); ++v)
-                    simplified[i].absorbed[v] |= simplified[i - 1].absorbed[v];
-                release(simplified[i - 1]);
-            }
-            auto result = grow_simplified(base.input, base.field, scale_options, simplified[i],
+            if (i > 0)
+                for (std::size_t v = 0; v < simplified.absorbed.size(); ++v)
+                    simplified.absorbed[v] |= finer.absorbed[v];
+            finer = std::move(simplified);  // and the finer scale's is freed
+            auto result = grow_simplified(base.input, base.field, scale_options, finer,
                                           i == 0 ? nullptr : &scales[i - 1].segmentation.labels);
             auto& scale = scales[i];
             scale.ratio = specs[i].ratio;
@@ -203,7 +196,7 @@ SweepResult run_sweep(Input input, const std::vector<ScaleSpec>& specs,
         throw;
     }
     growing.wait();
-    simplified.clear();
+    finer = {};
     // On a DEM, with the regions of valid pixels in no triangle (segment::label_pixels).
     for (auto& scale : scales)
         scale.segmentation.region_count = static_cast<std::uint32_t>(scale.regions.regions.size());
