@@ -311,21 +311,20 @@ std::vector<std::string> write_segment_directory(SegmentResult& result,
     out.polygons.driver = options.format;
     out.preview_caption.input = fs::path(input_path).filename().string();
     out.preview_caption.field = options.field;
-    out.preview_caption.parameters = {
-        options.field != "shape-index" ? std::string()
-        : options.shape_index.radius > 0
-            ? "radius " + JsonWriter::number(options.shape_index.radius) + " m"
-            : std::to_string(options.shape_index.rings) + " rings",
-        "persistence " + JsonWriter::number(options.simplify.persistence),
+    auto& caption = out.preview_caption.parameters;
+    if (options.field == "shape-index")
+        caption.push_back(options.shape_index.radius > 0
+                              ? "radius " + JsonWriter::number(options.shape_index.radius) + " m"
+                              : std::to_string(options.shape_index.rings) + " rings");
+    caption.push_back("persistence " + JsonWriter::number(options.simplify.persistence));
+    caption.push_back(
         "area ratio " + JsonWriter::number(result.area_ratio_percent) + " %" +
-            (options.min_area.empty() ? std::string() : " (min area " + options.min_area + ")"),
-        "cost " +
-            std::string(options.cost == "auto" ? (result.input.dem ? "graph" : "standard")
-                                               : options.cost) +
-            ", saddle penalty " + JsonWriter::number(options.saddle_penalty),
-        "absorbed " + options.absorbed};
-    if (out.preview_caption.parameters.front().empty())
-        out.preview_caption.parameters.erase(out.preview_caption.parameters.begin());
+        (options.min_area.empty() ? std::string() : " (min area " + options.min_area + ")"));
+    caption.push_back("cost " +
+                      std::string(options.cost == "auto" ? (result.input.dem ? "graph" : "standard")
+                                                         : options.cost) +
+                      ", saddle penalty " + JsonWriter::number(options.saddle_penalty));
+    caption.push_back("absorbed " + options.absorbed);
     // The preview is written last, once the large data is freed.
     io::PreviewImage preview;
     const bool deferred = write.release_memory && result.input.dem;
