@@ -92,6 +92,10 @@ TEST_CASE("label_pixels: a checkerboard of valid pixels is labelled everywhere",
     CHECK(t.graph.regions[2].area_m2 == Approx(test::labelled_area(dem, t.pixels, 3)));
     CHECK(t.graph.regions[3].pixel_count == 1);
     CHECK(std::isnan(t.graph.regions[3].field_mean));
+    // No field value, so no landform class (not the class of a shape index of 50).
+    CHECK(t.graph.regions[3].landform == segment::Landform::unknown);
+    CHECK(std::string(segment::to_string(t.graph.regions[3].landform)) == "unknown");
+    CHECK(t.graph.regions[0].landform != segment::Landform::unknown);
     for (std::uint32_t id = 1; id <= 4; ++id)
         CHECK(t.graph.regions[id - 1].area_m2 == Approx(test::labelled_area(dem, t.pixels, id)));
     // The same labels again: the rule is deterministic.
@@ -188,4 +192,5 @@ TEST_CASE("terrain segment labels every valid pixel of a country-shaped DEM", "[
     CHECK(counted == valid_pixels);
     CHECK(regions[int(top) - 1].GetLong("pixel_count") == 1);
     CHECK(regions[int(top) - 1].GetLong("vertex_count") == 0);
+    CHECK(regions[int(top) - 1].GetString("landform") == "unknown");
 }

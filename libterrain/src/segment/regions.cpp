@@ -267,7 +267,7 @@ void label_unmeshed_pixels(const Dem& dem, bool wrap, std::vector<std::uint32_t>
 
 Landform landform_of(double shape_index) {
     // Bin edges at 100 (2k + 1) / 16: 6.25, 18.75, ..., 93.75.
-    if (std::isnan(shape_index)) return Landform::saddle;
+    if (std::isnan(shape_index)) return Landform::unknown;
     const double s = std::clamp(shape_index, 0.0, 100.0);
     const int bin = static_cast<int>(std::floor((s * 16.0 / 100.0 + 1.0) / 2.0));
     return static_cast<Landform>(std::min(bin, 8));
@@ -275,7 +275,8 @@ Landform landform_of(double shape_index) {
 
 const char* to_string(Landform landform) {
     static const char* const names[] = {"cup",          "trough", "rut",  "saddle rut", "saddle",
-                                        "saddle ridge", "ridge",  "dome", "cap"};
+                                        "saddle ridge", "ridge",  "dome", "cap",
+                                        "unknown"};
     return names[static_cast<int>(landform)];
 }
 

@@ -28,11 +28,13 @@ enum class Landform : std::uint8_t {
     saddle_ridge,
     ridge,
     dome,
-    cap
+    cap,
+    unknown  // no field value: a region of pixels that no triangle holds
 };
 
-Landform landform_of(double shape_index);  // values outside [0,100] are clamped
-const char* to_string(Landform landform);  // "cup", ..., "saddle rut", ..., "cap"
+// Values outside [0,100] are clamped; NaN (no value) is `unknown`.
+Landform landform_of(double shape_index);
+const char* to_string(Landform landform);  // "cup", ..., "saddle rut", ..., "cap", "unknown"
 
 // What the representative points are in: lon/lat degrees on the body (a DEM with a CRS),
 // the DEM's map/pixel coordinates (a DEM without CRS), or the mesh's x, y, z (file meshes).
