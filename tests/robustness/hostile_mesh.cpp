@@ -4,6 +4,8 @@
 
 #include <cstdint>
 #include <cstring>
+#include <fstream>
+#include <sstream>
 
 #include "hostile_support.hpp"
 #include "terrain/core/error.hpp"
@@ -13,6 +15,16 @@ using Catch::Matchers::Contains;
 using namespace terrain::test;
 
 namespace {
+
+// The bytes of an input a fuzz target found, kept in tests/robustness/cases.
+std::string read_case(const std::string& name) {
+    std::ifstream in(std::string(TERRAIN_SOURCE_DIR) + "/tests/robustness/cases/" + name,
+                     std::ios::binary);
+    REQUIRE(in);
+    std::ostringstream bytes;
+    bytes << in.rdbuf();
+    return bytes.str();
+}
 
 std::string le32(std::uint32_t v) {
     std::string s(4, '\0');
@@ -181,6 +193,15 @@ TEST_CASE("OFF colours and vertex lines CGAL's scanner reads unchecked are refus
         // to a reader that cuts lines at '#', not to CGAL's scanner, which then took a face
         // index of 7.8e23 for a size_t (undefined behaviour).
         {"OFF#4 4 0\n0 0 0\n0 0 0\n0 1 0\n0 0 30 \n1 2x", "comment glued to the OFF keyword"},
+        // Found by fuzz_mesh_off: once a face (vertex) has a colour CGAL reads one for every
+        // later face (vertex), past the numbers of a line without one (a heap overflow in
+        // File_scanner_OFF::scan_color). The fuzzer's input is replayed below.
+        {"COFF\n3 2 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2 0 255 0\n3 0 2 1\n",
+         "OFF face 1 has no colour after one with a colour"},
+        {"COFF\n3 1 0\n0 0 0 7\n1 0 0\n0 1 0\n3 0 1 2\n",
+         "OFF vertex 1 has no colour after one with a colour"},
+        {read_case("off_face_without_colour_after_coloured.off"),
+         "OFF face 2 has no colour after one with a colour"},
     };
     int i = 0;
     for (const auto& [text, expected] : cases) {

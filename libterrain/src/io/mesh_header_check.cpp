@@ -296,10 +296,19 @@ std::optional<std::vector<double>> off_numbers(const std::vector<std::string_vie
 // CGAL's scanner reads 1 (an index into its colour map) or 3 or 4 (RGB[A], integers 0..255
 // or fractions 0..1) without checking the count or converting safely: other counts read past
 // the line's numbers, and values out of range are undefined behaviour in its conversions.
+// Once one vertex (face) has a colour, it reads a colour for every later vertex (face), past
+// the numbers of a line that has none: `seen` carries that from line to line.
 void check_off_colour(const std::vector<double>& values, std::size_t first, const std::string& name,
-                      const std::string& what) {
+                      const std::string& what, bool& seen) {
     const std::size_t count = values.size() - first;
-    if (count == 0) return;
+    if (count == 0) {
+        if (seen)
+            refuse(name, "OFF " + what +
+                             " has no colour after one with a colour; give every one a colour "
+                             "or none");
+        return;
+    }
+    seen = true;
     if (count != 1 && count != 3 && count != 4)
         refuse(name, "OFF " + what + " has " + str(count) +
                          " colour values; a colour is 1 index, or 3 or 4 components");
@@ -423,6 +432,7 @@ MeshFileCounts check_off(std::string_view bytes, const std::string& name) {
                          " faces; the file (" + str(bytes.size()) + " bytes) cannot hold them");
     // Coordinates (and normals) a vertex line starts with; CGAL reads past a short line.
     const std::size_t coordinates = (homogeneous ? 4 : 3) * (normals ? 2 : 1);
+    bool vertex_colours = false, face_colours = false;
     for (std::uint64_t v = 0; v < *nv; ++v) {
         const auto line = lines.next();
         if (!line)
@@ -431,7 +441,7 @@ MeshFileCounts check_off(std::string_view bytes, const std::string& name) {
         if (!values || values->size() < coordinates)
             refuse(name, "OFF vertex " + str(v) + " is not a line of " + str(coordinates) +
                              " numbers or more");
-        if (colours) check_off_colour(*values, coordinates, name, "vertex " + str(v));
+        if (colours) check_off_colour(*values, coordinates, name, "vertex " + str(v), vertex_colours);
     }
     for (std::uint64_t f = 0; f < *nf; ++f) {
         const auto line = lines.next();
@@ -459,7 +469,7 @@ MeshFileCounts check_off(std::string_view bytes, const std::string& name) {
         if (colours) {
             const auto values = off_numbers(face);
             if (!values) refuse(name, "OFF face " + str(f) + " is not a line of numbers");
-            check_off_colour(*values, *n + 1, name, "face " + str(f));
+            check_off_colour(*values, *n + 1, name, "face " + str(f), face_colours);
         }
     }
     return counts;
