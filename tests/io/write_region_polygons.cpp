@@ -274,10 +274,10 @@ TEST_CASE("regions.gpkg keeps the DEM's full CRS, the same bytes every run",
         CHECK(srs->IsProjected());
         CHECK(srs->IsSame(&dem_srs));
         CHECK(std::string(srs->GetAuthorityCode("GEOGCS")) == "200000400");
-        // QGIS's default style of the layer: one layer_styles row.
+        // QGIS's default style of the layer and one by landform: two layer_styles rows.
         OGRLayer* styles = r.ds->GetLayerByName("layer_styles");
         REQUIRE(styles);
-        CHECK(styles->GetFeatureCount() == 1);
+        CHECK(styles->GetFeatureCount() == 2);
         check_features(r, t, [](double x, double y) { return std::array<double, 2>{x, y}; });
         for (const auto& f : r.features)
             CHECK(wkbFlatten(f->GetGeometryRef()->getGeometryType()) == wkbMultiPolygon);

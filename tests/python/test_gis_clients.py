@@ -236,9 +236,15 @@ def test_gpkg_layer_style_row(cli, moon, tmp_path):
     assert cli("segment", moon, "-o", out, "-q", "--format", "GPKG").returncode == 0
     ds = ogr.Open(str(out / "regions.gpkg"))
     styles = ds.GetLayerByName("layer_styles")
-    assert styles is not None and styles.GetFeatureCount() == 1
-    row = styles.GetNextFeature()
+    # The default (each region in its colour) and one by landform class.
+    assert styles is not None and styles.GetFeatureCount() == 2
+    rows = {f.GetField("styleName"): f for f in styles}
+    assert set(rows) == {"regions", "regions by landform"}
+    row = rows["regions"]
     assert row.GetField("f_table_name") == "regions" and row.GetField("useAsDefault") == 1
+    landform_row = rows["regions by landform"]
+    assert landform_row.GetField("f_table_name") == "regions"
+    assert landform_row.GetField("useAsDefault") == 0
     regions = ds.GetLayerByName("regions")
     assert row.GetField("f_geometry_column") == regions.GetGeometryColumn()
     qml = ET.fromstring(row.GetField("styleQML").split("\n", 1)[1])
@@ -252,6 +258,22 @@ def test_gpkg_layer_style_row(cli, moon, tmp_path):
         rgb = symbols[c.get("symbol")].find("layer/Option/Option[@name='color']").get("value")
         r, g, b, _ = map(int, rgb.split(","))
         assert "#%02x%02x%02x" % (r, g, b) == fills[int(c.get("value"))]
+    # By landform: one category per class, every region's class among them, cups blue and
+    # caps red (the preview's colours).
+    qml = ET.fromstring(landform_row.GetField("styleQML").split("\n", 1)[1])
+    renderer = qml.find("renderer-v2")
+    assert renderer.get("type") == "categorizedSymbol" and renderer.get("attr") == "landform"
+    symbols = {s.get("name"): s for s in renderer.findall("symbols/symbol")}
+    colour = {}
+    for c in renderer.findall("categories/category"):
+        rgb = symbols[c.get("symbol")].find("layer/Option/Option[@name='color']").get("value")
+        colour[c.get("value")] = tuple(map(int, rgb.split(",")))[:3]
+    assert list(colour) == ["cup", "trough", "rut", "saddle rut", "saddle", "saddle ridge",
+                            "ridge", "dome", "cap", "unknown"]
+    assert len(set(colour.values())) == len(colour)
+    assert colour["cup"][2] > colour["cup"][0] and colour["cap"][0] > colour["cap"][2]
+    regions.ResetReading()
+    assert {f.GetField("landform") for f in regions} <= set(colour)
 
 
 @pytest.mark.parametrize("name,geographic,projected", [

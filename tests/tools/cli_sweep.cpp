@@ -92,7 +92,7 @@ TEST_CASE("terrain sweep: scales agree with segment, counts fall, lineage adds u
             CHECK(regions[k].GetDouble("parent_share") == largest);
         }
     }
-    // The GeoPackage has one layer per scale, and layer_styles with a style for each.
+    // The GeoPackage has one layer per scale, and layer_styles with two styles for each.
     std::unique_ptr<GDALDataset> gpkg(GDALDataset::FromHandle(GDALOpenEx(
         (out / "regions.gpkg").string().c_str(), GDAL_OF_VECTOR, nullptr, nullptr, nullptr)));
     REQUIRE(gpkg);
@@ -100,7 +100,7 @@ TEST_CASE("terrain sweep: scales agree with segment, counts fall, lineage adds u
     CHECK(gpkg->GetLayerByName("regions_0.25") != nullptr);
     OGRLayer* styles = gpkg->GetLayerByName("layer_styles");
     REQUIRE(styles);
-    CHECK(styles->GetFeatureCount() == 5);
+    CHECK(styles->GetFeatureCount() == 10);  // by region (the default) and by landform
     // Bad scales: one line, status 1; --area-ratio is not the sweep's option.
     r = run_cli({"sweep", dem, "-o", (dir / "bad").string(), "-q", "--area-ratios", "0.1,abc"});
     CHECK(r.status == 1);

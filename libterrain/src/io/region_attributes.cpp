@@ -4,6 +4,7 @@
 #include <cstdio>
 
 #include "terrain/io/region_colour.hpp"
+#include "terrain/io/write_preview.hpp"
 
 namespace terrain::io {
 namespace {
@@ -49,6 +50,11 @@ std::array<std::uint8_t, 4> region_colour(std::uint32_t id) {
     for (int k = 0; k < 3; ++k)
         out[std::size_t(k)] = static_cast<std::uint8_t>(std::lround(rgb[k] * 255));
     return out;
+}
+
+std::array<std::uint8_t, 3> landform_colour(segment::Landform landform) {
+    if (landform == segment::Landform::unknown) return {160, 160, 160};
+    return preview_field_colour(segment::landform_centre(landform));
 }
 
 const char* to_string(segment::PointFrame frame) {

@@ -362,7 +362,7 @@ FramedMap frame_preview(const PreviewImage& image) {
     if (frame.landform_classes)
         for (int k = 0; k < 9; ++k) {
             bar_labels.push_back(segment::to_string(static_cast<segment::Landform>(k)));
-            bar_values.push_back(k == 0 ? 3.125 : (k == 8 ? 96.875 : 12.5 * k));
+            bar_values.push_back(segment::landform_centre(static_cast<segment::Landform>(k)));
         }
     else
         for (int k = 0; k <= 4; ++k) {

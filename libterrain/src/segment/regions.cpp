@@ -273,6 +273,12 @@ Landform landform_of(double shape_index) {
     return static_cast<Landform>(std::min(bin, 8));
 }
 
+double landform_centre(Landform landform) {
+    if (landform == Landform::unknown) return std::numeric_limits<double>::quiet_NaN();
+    const int k = static_cast<int>(landform);
+    return k == 0 ? 3.125 : (k == 8 ? 96.875 : 12.5 * k);
+}
+
 const char* to_string(Landform landform) {
     static const char* const names[] = {"cup",          "trough", "rut",  "saddle rut", "saddle",
                                         "saddle ridge", "ridge",  "dome", "cap",

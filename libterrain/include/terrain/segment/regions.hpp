@@ -35,6 +35,9 @@ enum class Landform : std::uint8_t {
 // Values outside [0,100] are clamped; NaN (no value) is `unknown`.
 Landform landform_of(double shape_index);
 const char* to_string(Landform landform);  // "cup", ..., "saddle rut", ..., "cap", "unknown"
+// The middle of a class's shape-index interval (3.125 for cup, 12.5 k, 96.875 for cap); NaN
+// for unknown.
+double landform_centre(Landform landform);
 
 // What the representative points are in: lon/lat degrees on the body (a DEM with a CRS),
 // the DEM's map/pixel coordinates (a DEM without CRS), or the mesh's x, y, z (file meshes).
