@@ -56,14 +56,18 @@ def hills(size=96):
     return z + 100
 
 
-def write_raster(path, values, driver, geotransform=None):
-    from osgeo import gdal
+def write_raster(path, values, driver, geotransform=None, crs=None):
+    from osgeo import gdal, osr
 
     gdal.UseExceptions()
     mem = gdal.GetDriverByName("MEM").Create("", values.shape[1], values.shape[0], 1,
                                              gdal.GDT_UInt16 if driver == "PNG" else gdal.GDT_Float32)
     if geotransform:
         mem.SetGeoTransform(geotransform)
+    if crs:
+        srs = osr.SpatialReference()
+        srs.SetFromUserInput(crs)
+        mem.SetProjection(srs.ExportToWkt(["FORMAT=WKT2_2019"]))
     mem.GetRasterBand(1).WriteArray(values)
     gdal.GetDriverByName(driver).CreateCopy(str(path), mem)
     return path
@@ -343,3 +347,46 @@ def test_planetary_outputs_carry_the_iau_2015_crs(cli, tmp_path, name, geographi
     tif = pyproj.CRS(gdal.Open(str(out / "labels.tif")).GetSpatialRef().ExportToWkt(["FORMAT=WKT2_2019"]))
     # GeoTIFF's keys hold no IAU code: the names and sphere are kept, the same CRS.
     assert tif.geodetic_crs.equals(f"IAU_2015:{geographic}", ignore_axis_order=True)
+
+
+@pytest.mark.parametrize("crs,pixel,lonlat,projected", [
+    # Mars: an equirectangular DEM in PROJ's IAU_2015 code (clon 0), 2 km pixels.
+    ("IAU_2015:49910", 2000.0, ("IAU_2015", "49900"), ("IAU_2015", "49910")),
+    # Earth: UTM zone 11 N on WGS 84, 30 m pixels; GeoJSON is RFC 7946 (WGS 84 lon/lat).
+    ("EPSG:32611", 30.0, ("EPSG", "4326"), ("EPSG", "32611")),
+])
+def test_mars_and_earth_crs_identified_with_an_authority(cli, tmp_path, crs, pixel, lonlat,
+                                                         projected):
+    import geopandas as gpd  # installed by the set-up: a missing client fails
+    import pyproj  # installed by the set-up: a missing client fails
+    from osgeo import gdal, ogr
+
+    dem = write_raster(tmp_path / "dem.tif", hills() * 20, "GTiff",
+                       (400000.0, pixel, 0.0, 3800000.0, 0.0, -pixel), crs)
+    out, gpkg = tmp_path / "out", tmp_path / "gpkg"
+    assert cli("segment", dem, "-o", out, "-q").returncode == 0
+    assert cli("segment", dem, "-o", gpkg, "-q", "--format", "GPKG").returncode == 0
+    # labels.tif and the GeoPackage: PROJ identifies the DEM's CRS by its code (what
+    # `projinfo --identify` does; pyproj calls the same proj_identify).
+    ds = gdal.Open(str(out / "labels.tif"))
+    tif = pyproj.CRS(ds.GetSpatialRef().ExportToWkt(["FORMAT=WKT2_2019"]))
+    assert tif.to_authority(min_confidence=70) == projected
+    assert tif.geodetic_crs.to_authority(min_confidence=70) == lonlat
+    vector = ogr.Open(str(gpkg / "regions.gpkg"))
+    srs = vector.GetLayerByName("regions").GetSpatialRef()
+    assert (srs.GetAuthorityName(None).replace("IAU", "IAU_2015").replace("_2015_2015", "_2015"),
+            srs.GetAuthorityCode(None)) == projected
+    # GeoJSON: lon/lat on the body; geopandas reads the body's CRS (through fiona's WKT1,
+    # without the code on Mars, hence `equals`) and transforms it to the projected one, where
+    # the polygons cover the DEM's footprint.
+    regions = gpd.read_file(out / "regions.geojson")
+    assert regions.crs.equals(":".join(lonlat), ignore_axis_order=True)
+    assert regions.geometry.is_valid.all()
+    xmin, ymin, xmax, ymax = regions.to_crs(":".join(projected)).total_bounds
+    assert abs(xmin - 400000) < pixel and abs(ymax - 3800000) < pixel
+    assert abs(xmax - (400000 + 96 * pixel)) < pixel and abs(ymin - (3800000 - 96 * pixel)) < pixel
+    # The GeoPackage through geopandas (fiona hands it WKT1, which loses the code of the
+    # Martian CRS but not its body): to lon/lat on the body, the GeoJSON's footprint.
+    polygons = gpd.read_file(gpkg / "regions.gpkg", layer="regions")
+    bounds = polygons.to_crs(":".join(lonlat)).total_bounds
+    assert abs(bounds - regions.total_bounds).max() < 1e-6

@@ -43,13 +43,34 @@ def qgis_crs(tmp_path, *paths):
     return out
 
 
+def mars_dem(path):
+    """A synthetic Martian DEM in IAU_2015:49910 (equirectangular, clon 0), 2 km pixels."""
+    import numpy as np
+    from osgeo import gdal, osr
+
+    gdal.UseExceptions()
+    y, x = np.mgrid[0:64, 0:64].astype(float)
+    z = 800 * np.exp(-((x - 20) ** 2 + (y - 30) ** 2) / 120) - 500 * np.exp(
+        -((x - 45) ** 2 + (y - 20) ** 2) / 90)
+    ds = gdal.GetDriverByName("GTiff").Create(str(path), 64, 64, 1, gdal.GDT_Float32)
+    srs = osr.SpatialReference()
+    srs.SetFromUserInput("IAU_2015:49910")
+    ds.SetProjection(srs.ExportToWkt(["FORMAT=WKT2_2019"]))
+    ds.SetGeoTransform((400000.0, 2000.0, 0.0, 3800000.0, 0.0, -2000.0))
+    ds.GetRasterBand(1).WriteArray(z)
+    ds = None
+    return path
+
+
 @pytest.mark.parametrize("dem,geographic,projected", [
     ("moon_ldem4_copernicus.tif", "30100", "30115"),  # equirectangular, clon = 180
     ("vesta_hamo_tile.lbl", "200000400", None),       # its projection has no code of its own
+    ("mars", "49900", "49910"),                       # made here
 ])
 def test_qgis_names_the_geopackage_crs(tmp_path, dem, geographic, projected):
     out = tmp_path / "out"
-    done = subprocess.run([os.environ["TERRAIN_CLI"], "segment", str(DATA / dem), "-o", str(out),
+    source = mars_dem(tmp_path / "mars.tif") if dem == "mars" else DATA / dem
+    done = subprocess.run([os.environ["TERRAIN_CLI"], "segment", str(source), "-o", str(out),
                            "-q", "--format", "GPKG"], capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr
     gpkg = out / "regions.gpkg"
