@@ -40,28 +40,72 @@ int python(const std::string& code) {
     return std::system(("/usr/bin/python3 " + script.string()).c_str());
 }
 
+// Every pixel of a crop of the Vesta sample its own region: the crop, its labels and graph.
+struct PixelRegions {
+    Dem dem;
+    std::vector<std::uint32_t> pixels;
+    segment::RegionGraph graph;
+};
+PixelRegions pixel_regions(int width, int height) {
+    PixelRegions p{test::crop(io::read_dem(test::sample("vesta_hamo_tile.lbl")), 0, 0, width,
+                              height),
+                   {},
+                   {}};
+    p.pixels.resize(p.dem.size());
+    p.graph.point_frame = segment::PointFrame::map;
+    for (std::size_t i = 0; i < p.dem.size(); ++i) {
+        p.pixels[i] = static_cast<std::uint32_t>(i + 1);
+        segment::Region r;
+        r.id = p.pixels[i];
+        r.pixel_count = 1;
+        r.vertex_count = 1;
+        r.area_m2 = 1;
+        r.field_mean = double(i % 101);
+        r.landform = segment::landform_of(r.field_mean);
+        p.graph.regions.push_back(r);
+    }
+    return p;
+}
+
 }  // namespace
+
+TEST_CASE("labels.tif from 256 to 65535 regions: UInt16 with a colour table, a valid COG",
+          "[write_label_raster][label_colours]") {
+    const auto p = pixel_regions(40, 30);  // 1200 regions
+    const auto dir = test::scratch_dir("label_colours_uint16");
+    const auto path = (dir / "labels.tif").string();
+    io::write_label_raster(p.dem, p.pixels, p.graph, path, false);
+    GDALAllRegister();
+    {
+        std::unique_ptr<GDALDataset> ds(GDALDataset::Open(path.c_str(), GDAL_OF_RASTER));
+        REQUIRE(ds);
+        GDALRasterBand* band = ds->GetRasterBand(1);
+        CHECK(band->GetRasterDataType() == GDT_UInt16);
+        const GDALColorTable* table = band->GetColorTable();
+        REQUIRE(table);
+        const auto c = io::region_colour(1200);
+        const GDALColorEntry* e = table->GetColorEntry(1200);
+        REQUIRE(e);
+        CHECK((e->c1 == c[0] && e->c2 == c[1] && e->c3 == c[2]));
+        std::uint32_t last = 0;
+        REQUIRE(band->RasterIO(GF_Read, 39, 29, 1, 1, &last, 1, 1, GDT_UInt32, 0, 0) == CE_None);
+        CHECK(last == 1200);
+    }
+    // GDAL's own validator of the Cloud-Optimized GeoTIFF layout (python3-gdal's sample).
+    CHECK(python("import sys\n"
+                 "from osgeo_utils.samples import validate_cloud_optimized_geotiff as v\n"
+                 "warnings, errors, details = v.validate('" +
+                 path +
+                 "', full_check=True)\n"
+                 "sys.exit(1 if errors else 0)\n") == 0);
+}
 
 TEST_CASE(
     "labels.tif beyond 65535 regions: UInt32, no colour table, an attribute table and a "
     "style, read by rasterio",
     "[write_label_raster][label_colours]") {
     // Every pixel of a 300 x 240 Vesta crop its own region: 72000 regions.
-    const Dem dem = test::crop(io::read_dem(test::sample("vesta_hamo_tile.lbl")), 0, 0, 300, 240);
-    std::vector<std::uint32_t> pixels(dem.size());
-    segment::RegionGraph graph;
-    graph.point_frame = segment::PointFrame::map;
-    for (std::size_t i = 0; i < dem.size(); ++i) {
-        pixels[i] = static_cast<std::uint32_t>(i + 1);
-        segment::Region r;
-        r.id = pixels[i];
-        r.pixel_count = 1;
-        r.vertex_count = 1;
-        r.area_m2 = 1;
-        r.field_mean = double(i % 101);
-        r.landform = segment::landform_of(r.field_mean);
-        graph.regions.push_back(r);
-    }
+    const auto [dem, pixels, graph] = pixel_regions(300, 240);
     REQUIRE(graph.regions.size() == 72000);
     const auto dir = test::scratch_dir("label_colours_uint32");
     const auto path = (dir / "labels.tif").string();

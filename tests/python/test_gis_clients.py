@@ -99,6 +99,18 @@ def test_georeferenced_dem_gives_no_warning(cli, moon, tmp_path):
     assert done.returncode == 0 and "warning" not in done.stderr, done.stderr
 
 
+def test_labels_tif_is_a_cloud_optimized_geotiff(cli, tmp_path):
+    from osgeo_utils.samples import validate_cloud_optimized_geotiff as cog
+
+    from conftest import SAMPLE_FILES
+
+    for name in ("vesta", "moon4c", "moon1g"):
+        out = tmp_path / name
+        assert cli("segment", SAMPLE_FILES[name], "-o", out, "-q").returncode == 0
+        warnings, errors, details = cog.validate(str(out / "labels.tif"), full_check=True)
+        assert not errors, (name, errors)
+
+
 def test_labels_tif_has_internal_overviews(cli, tmp_path):
     from osgeo import gdal
 
@@ -184,7 +196,7 @@ def test_labels_tif_colours_in_rasterio_and_qgis_style(moon_out):
     data = json.loads((moon_out / "adjacency.json").read_text())
     fills = {n["id"]: n["fill"] for n in data["nodes"]}
     with rasterio.open(moon_out / "labels.tif") as src:
-        assert src.dtypes[0] == "uint16"
+        assert src.dtypes[0] == "uint8"  # fewer than 256 regions
         colormap = src.colormap(1)
         labels = src.read(1)
     assert int(labels.max()) == len(fills)

@@ -28,17 +28,21 @@ std::unique_ptr<GDALDataset> create_grid_tiff(const Dem& grid, bool with_transfo
     std::unique_ptr<GDALDataset> ds(driver->Create(temp_path.c_str(), grid.width, grid.height, 1,
                                                    type, const_cast<char**>(options)));
     if (!ds) throw Error("write", "cannot create '" + path + "'" + errors.suffix());
+    set_grid_georeference(*ds, grid, with_transform);
+    return ds;
+}
+
+void set_grid_georeference(GDALDataset& ds, const Dem& grid, bool with_transform) {
     if (with_transform) {
         GeoTransform t = grid.transform;
-        ds->SetGeoTransform(t.data());
+        ds.SetGeoTransform(t.data());
     }
     if (!grid.crs_wkt.empty()) {
         // A planetary CRS as the IAU_2015 CRS of its body, when PROJ holds it.
         OGRSpatialReference srs;
         if (srs.SetFromUserInput(geo::output_crs_wkt(grid.crs_wkt).c_str()) == OGRERR_NONE)
-            ds->SetSpatialRef(&srs);
+            ds.SetSpatialRef(&srs);
     }
-    return ds;
 }
 
 void close_dataset(std::unique_ptr<GDALDataset>& ds, const std::string& path,

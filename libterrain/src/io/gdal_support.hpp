@@ -30,6 +30,10 @@ using geo::GdalErrorCapture;
 // Throws terrain::Error (stage "write") unless `count` is one value per pixel of `grid`.
 void check_grid_size(const Dem& grid, std::size_t count);
 
+// The grid's geotransform (when `with_transform`) and CRS (the body's IAU_2015 CRS when PROJ
+// holds it) on a dataset.
+void set_grid_georeference(GDALDataset& ds, const Dem& grid, bool with_transform);
+
 // A GeoTIFF of the grid's size with `type` bands, its geotransform (when `with_transform`)
 // and CRS; throws terrain::Error naming `path` when GDAL cannot create it.
 std::unique_ptr<GDALDataset> create_grid_tiff(const Dem& grid, bool with_transform,

@@ -1,6 +1,7 @@
 #include <gdal_priv.h>
 #include <gdal_rat.h>
 #include <ogr_spatialref.h>
+#include <vrtdataset.h>
 
 #include <algorithm>
 #include <array>
@@ -151,43 +152,71 @@ void write_label_raster(const Dem& dem, const std::vector<std::uint32_t>& pixels
     const GdalErrorCapture errors;
     check_output_path(path + ".aux.xml", overwrite);
     check_output_path(label_style_path(path), overwrite);
-    // UInt16 with a colour table while the ids fit (GeoTIFF holds colour tables for 8 and
-    // 16-bit bands only), UInt32 beyond.
-    const bool sixteen = graph.regions.size() < 65536;
+    // The smallest type that holds the ids: Byte or UInt16 with a colour table (GeoTIFF holds
+    // colour tables for 8 and 16-bit bands only, of 256 or 65 536 entries, one per directory:
+    // 1.5 KB or 384 KB each), UInt32 beyond.
+    const bool paletted = graph.regions.size() < 65536;
+    const GDALDataType type = graph.regions.size() < 256 ? GDT_Byte
+                              : paletted                 ? GDT_UInt16
+                                                         : GDT_UInt32;
     AtomicOutput output(path, overwrite);
     TemporaryFiles temporary(output);
     std::vector<std::string> files;
     {
-        const char* options[] = {"COMPRESS=DEFLATE", "PREDICTOR=2", "TILED=YES", nullptr};
+        // The labels as GDAL sees them without a copy: a MEM band over `pixels`, read through
+        // a VRT as `type`, with the colour table, NoData and description.
+        std::unique_ptr<GDALDataset> mem(
+            GetGDALDriverManager()->GetDriverByName("MEM")->Create("", dem.width, dem.height, 0,
+                                                                   GDT_UInt32, nullptr));
+        if (!mem) throw Error("write", "cannot create '" + path + "'" + errors.suffix());
+        char pointer[64] = {};
+        CPLPrintPointer(pointer, const_cast<std::uint32_t*>(pixels.data()), sizeof pointer);
+        CPLStringList band_options;
+        band_options.SetNameValue("DATAPOINTER", pointer);
+        if (mem->AddBand(GDT_UInt32, band_options.List()) != CE_None)
+            throw Error("write", "cannot create '" + path + "'" + errors.suffix());
+        std::unique_ptr<VRTDataset> source(
+            static_cast<VRTDataset*>(GDALDataset::FromHandle(VRTCreate(dem.width, dem.height))));
         // A DEM read without geotransform gets the grid terrain used (docs/outputs.md).
-        auto ds = create_grid_tiff(dem, true, output.temp_path(), path,
-                                   sixteen ? GDT_UInt16 : GDT_UInt32, options, errors);
-        GDALRasterBand* band = ds->GetRasterBand(1);
+        set_grid_georeference(*source, dem, true);
+        source->AddBand(type, nullptr);
+        auto* band = static_cast<VRTSourcedRasterBand*>(source->GetRasterBand(1));
+        band->AddSimpleSource(mem->GetRasterBand(1));
         band->SetNoDataValue(0);
         band->SetDescription("region id");
-        if (sixteen) {
+        if (paletted) {
             const auto table = region_colour_table(graph.regions.size());
             band->SetColorInterpretation(GCI_PaletteIndex);
             if (band->SetColorTable(const_cast<GDALColorTable*>(&table)) != CE_None)
                 throw Error("write",
                             "cannot store the colour table of '" + path + "'" + errors.suffix());
         }
+        // A Cloud-Optimized GeoTIFF: 256 x 256 DEFLATE tiles, overviews down to about 64
+        // pixels (nearest: every overview pixel is one region's id), the directories first
+        // and the smallest overview's tiles before the larger ones', BigTIFF when needed.
+        const auto factors = overview_factors(dem);
+        CPLStringList options;
+        options.SetNameValue("COMPRESS", "DEFLATE");
+        options.SetNameValue("PREDICTOR", "YES");
+        options.SetNameValue("BLOCKSIZE", "256");
+        options.SetNameValue("BIGTIFF", "IF_SAFER");
+        options.SetNameValue("RESAMPLING", "NEAREST");
+        if (factors.empty())
+            options.SetNameValue("OVERVIEWS", "NONE");
+        else
+            options.SetNameValue("OVERVIEW_COUNT", std::to_string(factors.size()).c_str());
+        GDALDriver* cog = GetGDALDriverManager()->GetDriverByName("COG");
+        if (!cog) throw Error("write", "GDAL has no COG driver (GDAL 3.1 or later is needed)");
+        std::unique_ptr<GDALDataset> ds(cog->CreateCopy(output.temp_path().c_str(), source.get(),
+                                                        FALSE, options.List(), nullptr, nullptr));
+        if (!ds) throw Error("write", "cannot write '" + path + "'" + errors.suffix());
+        source.reset();
+        mem.reset();
+        // The attribute table goes to the .aux.xml (GeoTIFF has none), written on closing.
         auto rat = region_attribute_table(graph);
-        if (band->SetDefaultRAT(&rat) != CE_None)
+        if (ds->GetRasterBand(1)->SetDefaultRAT(&rat) != CE_None)
             throw Error("write",
                         "cannot store the attribute table of '" + path + "'" + errors.suffix());
-        if (band->RasterIO(GF_Write, 0, 0, dem.width, dem.height,
-                           const_cast<std::uint32_t*>(pixels.data()), dem.width, dem.height,
-                           GDT_UInt32, 0, 0) != CE_None)
-            throw Error("write", "writing '" + path + "' failed" + errors.suffix());
-        // Internal overviews (nearest: every overview pixel is one region's id).
-        const auto factors = overview_factors(dem);
-        const int bands[] = {1};
-        if (!factors.empty() &&
-            ds->BuildOverviews("NEAREST", static_cast<int>(factors.size()), factors.data(), 1,
-                               bands, nullptr, nullptr, nullptr) != CE_None)
-            throw Error("write", "cannot build the overviews of '" + path + "'" + errors.suffix());
-        ds->FlushCache();
         files = dataset_files(ds.get());
         close_dataset(ds, path, errors);  // also writes the .aux.xml
     }
