@@ -69,7 +69,7 @@ PixelRegions pixel_regions(int width, int height) {
 
 }  // namespace
 
-TEST_CASE("labels.tif from 256 to 65535 regions: UInt16 with a colour table, a valid COG",
+TEST_CASE("labels.tif with 1200 regions: UInt16 with a colour table, a valid COG",
           "[write_label_raster][label_colours]") {
     const auto p = pixel_regions(40, 30);  // 1200 regions
     const auto dir = test::scratch_dir("label_colours_uint16");

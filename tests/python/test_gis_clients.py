@@ -196,7 +196,7 @@ def test_labels_tif_colours_in_rasterio_and_qgis_style(moon_out):
     data = json.loads((moon_out / "adjacency.json").read_text())
     fills = {n["id"]: n["fill"] for n in data["nodes"]}
     with rasterio.open(moon_out / "labels.tif") as src:
-        assert src.dtypes[0] == "uint8"  # fewer than 256 regions
+        assert src.dtypes[0] == "uint16"
         colormap = src.colormap(1)
         labels = src.read(1)
     assert int(labels.max()) == len(fills)

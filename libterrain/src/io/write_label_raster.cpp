@@ -152,13 +152,10 @@ void write_label_raster(const Dem& dem, const std::vector<std::uint32_t>& pixels
     const GdalErrorCapture errors;
     check_output_path(path + ".aux.xml", overwrite);
     check_output_path(label_style_path(path), overwrite);
-    // The smallest type that holds the ids: Byte or UInt16 with a colour table (GeoTIFF holds
-    // colour tables for 8 and 16-bit bands only, of 256 or 65 536 entries, one per directory:
-    // 1.5 KB or 384 KB each), UInt32 beyond.
+    // UInt16 with a colour table while the ids fit (the CLI's contract; GeoTIFF holds colour
+    // tables for 8 and 16-bit bands only), UInt32 beyond.
     const bool paletted = graph.regions.size() < 65536;
-    const GDALDataType type = graph.regions.size() < 256 ? GDT_Byte
-                              : paletted                 ? GDT_UInt16
-                                                         : GDT_UInt32;
+    const GDALDataType type = paletted ? GDT_UInt16 : GDT_UInt32;
     AtomicOutput output(path, overwrite);
     TemporaryFiles temporary(output);
     std::vector<std::string> files;
