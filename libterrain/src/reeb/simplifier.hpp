@@ -81,6 +81,7 @@ class Simplifier : WorkingGraph {
 
     // The cancellation rules (cancellation.cpp).
     i32 redirect(i32 a) const;
+    bool would_turn_a_loop(i32 a) const;
     void cancel(i32 a, SimplifyResult& result);
     void fit_arc(i32 b, i32 keep);
     bool regularize(i32 n, std::vector<i32>& out);

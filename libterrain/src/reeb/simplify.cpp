@@ -57,7 +57,12 @@ void Simplifier::run(const ProgressFn& progress, SimplifyResult& result) {
         __builtin_prefetch(&arcs_[next]);  // its ends are fetched once a is cancelled
         arcs_[idx(a)].queued = kNotQueued;
         if (!candidate(a)) continue;  // no longer one since it was queued
-        cancel(redirect(a), result);
+        const i32 b = redirect(a);
+        if (would_turn_a_loop(b)) {  // it waits (cancellation.cpp)
+            ++result.loop_waits;
+            continue;
+        }
+        cancel(b, result);
         prefetch_ends(next);
         if ((++done & 0xfff) == 0 && initial > 0)
             report_progress(progress, std::min(0.9, 0.9 * done / static_cast<double>(initial)),

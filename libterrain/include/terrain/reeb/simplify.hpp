@@ -40,6 +40,9 @@ struct SimplifyResult {
     std::size_t turned_made_regular = 0;   // of made_regular: far ends of turned arcs
     std::size_t turned_made_extremum = 0;  // far ends of turned arcs left extrema (their
                                            // arcs are new candidates)
+    // Candidates that waited because their cancellation would have turned both arcs of a
+    // loop around (the loop would have closed in the rewritten field); each wait counts.
+    std::size_t loop_waits = 0;
     // Bytes of the working graph and the queue at the end of the cancellations (their arc
     // runs never shrink, so this is their peak).
     std::size_t working_bytes = 0;
