@@ -49,6 +49,23 @@ std::string binary_ply_with_list(std::uint32_t entries) {
     return s;
 }
 
+// Each case (file bytes, expected words) written as dir/case<i>.<ext> and given to `terrain
+// mesh`: one error line naming the problem, exit status 1, no output left.
+template <class Cases>
+void check_mesh_cases_refused(const std::filesystem::path& dir, const Cases& cases,
+                              const std::string& ext) {
+    int i = 0;
+    for (const auto& [text, expected] : cases) {
+        const auto input = write_bytes(dir / ("case" + std::to_string(i++) + "." + ext), text);
+        const auto r = run_limited({"mesh", input, "-o", (dir / "m.ply").string(), "-q"}, 30, 512);
+        INFO(text);
+        CHECK(r.status == 1);
+        CHECK(line_count(r.err) == 1);
+        CHECK_THAT(r.err, Contains(expected));
+    }
+    CHECK_FALSE(std::filesystem::exists(dir / "m.ply"));
+}
+
 // Every command that reads a mesh, with an output in `dir`.
 std::vector<std::vector<std::string>> mesh_commands(const std::string& input,
                                                     const std::filesystem::path& dir) {
@@ -111,16 +128,7 @@ TEST_CASE("OFF headers and faces declaring more than the file holds are refused"
          "OFF face 1 lists 2 of its 3 vertices"},
         {"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n", "refers to vertex '3'"},
     };
-    int i = 0;
-    for (const auto& [text, expected] : cases) {
-        const auto input = write_bytes(dir / ("case" + std::to_string(i++) + ".off"), text);
-        const auto r = run_limited({"mesh", input, "-o", (dir / "m.ply").string(), "-q"}, 30, 512);
-        INFO(text);
-        CHECK(r.status == 1);
-        CHECK(line_count(r.err) == 1);
-        CHECK_THAT(r.err, Contains(expected));
-    }
-    CHECK_FALSE(std::filesystem::exists(dir / "m.ply"));
+    check_mesh_cases_refused(dir, cases, "off");
 }
 
 TEST_CASE("PLY headers that lie or break the grammar are refused by the reader",
@@ -203,16 +211,7 @@ TEST_CASE("OFF colours and vertex lines CGAL's scanner reads unchecked are refus
         {read_case("off_face_without_colour_after_coloured.off"),
          "OFF face 2 has no colour after one with a colour"},
     };
-    int i = 0;
-    for (const auto& [text, expected] : cases) {
-        const auto input = write_bytes(dir / ("case" + std::to_string(i++) + ".off"), text);
-        const auto r = run_limited({"mesh", input, "-o", (dir / "m.ply").string(), "-q"}, 30, 512);
-        INFO(text);
-        CHECK(r.status == 1);
-        CHECK(line_count(r.err) == 1);
-        CHECK_THAT(r.err, Contains(expected));
-    }
-    CHECK_FALSE(std::filesystem::exists(dir / "m.ply"));
+    check_mesh_cases_refused(dir, cases, "off");
 
     // Colours as CGAL reads them (an index, RGB integers, RGBA, fractions) stay readable,
     // as do normals and homogeneous coordinates.
@@ -222,6 +221,7 @@ TEST_CASE("OFF colours and vertex lines CGAL's scanner reads unchecked are refus
         "NOFF\n3 1 0\n0 0 0 0 0 1\n1 0 0 0 0 1\n0 1 0 0 0 1\n3 0 1 2\n",
         "4OFF\n3 1 0\n0 0 0 1\n2 0 0 2\n0 1 0 1\n3 0 1 2\n",
     };
+    int i = 0;
     for (const auto& text : valid) {
         INFO(text);
         const auto input = write_bytes(dir / ("valid" + std::to_string(i++) + ".off"), text);
@@ -245,16 +245,7 @@ TEST_CASE("a PLY format line other than the second is refused, not read in anoth
         {"ply\nformat binary_little_endian 1.0\nformat ascii 1.0\n" + body, "second line"},
         {"ply\ncomment binary_little_endian 1.0\nformat ascii 1.0\n" + body, "second line"},
     };
-    int i = 0;
-    for (const auto& [text, expected] : cases) {
-        const auto input = write_bytes(dir / ("case" + std::to_string(i++) + ".ply"), text);
-        const auto r = run_limited({"mesh", input, "-o", (dir / "m.ply").string(), "-q"}, 30, 512);
-        INFO(text);
-        CHECK(r.status == 1);
-        CHECK(line_count(r.err) == 1);
-        CHECK_THAT(r.err, Contains(expected));
-    }
-    CHECK_FALSE(std::filesystem::exists(dir / "m.ply"));
+    check_mesh_cases_refused(dir, cases, "ply");
     const auto valid = write_bytes(dir / "valid.ply", "ply\nformat ascii 1.0\n" + body);
     CHECK(terrain::io::read_mesh(valid).triangles.size() == 1);
 }
