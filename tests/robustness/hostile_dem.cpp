@@ -4,10 +4,15 @@
 
 #include <catch2/catch.hpp>
 
+#include <sys/resource.h>
+
 #include <cmath>
 #include <memory>
+#include <string>
 
 #include "hostile_support.hpp"
+#include "terrain/core/error.hpp"
+#include "terrain/io/read_dem.hpp"
 
 using Catch::Matchers::Contains;
 using namespace terrain::test;
@@ -214,4 +219,31 @@ TEST_CASE("a GeoTIFF whose one row of blocks is larger than memory is refused",
         CHECK_THAT(r.err, Contains("block"));
     }
     CHECK_FALSE(std::filesystem::exists(dir / "m.ply"));
+}
+
+TEST_CASE("read_dem's memory follows the rows it reads, not the size a header declares",
+          "[robustness][dem]") {
+    // Found by fuzz_dem: 826 bytes declaring 18464 x 65504 Byte pixels (1.2 G) whose first
+    // strip cannot be read. read_dem filled its 9.7 GB value array with NaN before reading
+    // row 0 (the budget allowed it on a machine with that much free memory); the command
+    // line was safe (`info` reads rows only, `mesh` refuses the 203 GB plan), the library
+    // was not.
+    const std::string input = std::string(TERRAIN_SOURCE_DIR) +
+                              "/tests/robustness/cases/dem_826_bytes_declaring_1g_pixels.tif";
+    rusage before{};
+    getrusage(RUSAGE_SELF, &before);
+    try {
+        (void)terrain::io::read_dem(input);
+        FAIL("read_dem accepted it");
+    } catch (const terrain::Error& e) {
+        // "cannot read row 0", or on a machine with less free memory the budget's refusal.
+        const std::string what = e.what();
+        CHECK((what.find("cannot read row 0") != std::string::npos ||
+               what.find("needs about") != std::string::npos));
+    }
+    rusage after{};
+    getrusage(RUSAGE_SELF, &after);
+    const double grown_mb = double(after.ru_maxrss - before.ru_maxrss) / 1024.0;  // KB
+    INFO("peak resident set grew by " << grown_mb << " MB");
+    CHECK(grown_mb < 200);
 }
