@@ -109,6 +109,11 @@ def test_labels_tif_is_a_cloud_optimized_geotiff(cli, tmp_path):
         assert cli("segment", SAMPLE_FILES[name], "-o", out, "-q").returncode == 0
         warnings, errors, details = cog.validate(str(out / "labels.tif"), full_check=True)
         assert not errors, (name, errors)
+    # The sweep's labels.tif, one band per scale, likewise.
+    out = tmp_path / "sweep"
+    assert cli("sweep", SAMPLE_FILES["vesta"], "-o", out, "-q").returncode == 0
+    warnings, errors, details = cog.validate(str(out / "labels.tif"), full_check=True)
+    assert not errors, errors
 
 
 def test_labels_tif_has_internal_overviews(cli, tmp_path):

@@ -144,6 +144,47 @@ std::string label_style_path(const std::string& path) {
     return std::filesystem::path(path).replace_extension(".qml").string();
 }
 
+std::unique_ptr<GDALDataset> labels_in_place(const Dem& dem,
+                                             const std::vector<const std::vector<std::uint32_t>*>& bands,
+                                             const std::string& path, const GdalErrorCapture& errors) {
+    std::unique_ptr<GDALDataset> mem(GetGDALDriverManager()->GetDriverByName("MEM")->Create(
+        "", dem.width, dem.height, 0, GDT_UInt32, nullptr));
+    if (!mem) throw Error("write", "cannot create '" + path + "'" + errors.suffix());
+    for (const auto* values : bands) {
+        char pointer[64] = {};
+        CPLPrintPointer(pointer, const_cast<std::uint32_t*>(values->data()), sizeof pointer);
+        CPLStringList band_options;
+        band_options.SetNameValue("DATAPOINTER", pointer);
+        if (mem->AddBand(GDT_UInt32, band_options.List()) != CE_None)
+            throw Error("write", "cannot create '" + path + "'" + errors.suffix());
+    }
+    set_grid_georeference(*mem, dem, true);
+    return mem;
+}
+
+std::unique_ptr<GDALDataset> write_cloud_optimized(const Dem& dem, GDALDataset& source,
+                                                   const std::string& temp_path,
+                                                   const std::string& path,
+                                                   const GdalErrorCapture& errors) {
+    const auto factors = overview_factors(dem);
+    CPLStringList options;
+    options.SetNameValue("COMPRESS", "DEFLATE");
+    options.SetNameValue("PREDICTOR", "YES");
+    options.SetNameValue("BLOCKSIZE", "256");
+    options.SetNameValue("BIGTIFF", "IF_SAFER");
+    options.SetNameValue("RESAMPLING", "NEAREST");
+    if (factors.empty())
+        options.SetNameValue("OVERVIEWS", "NONE");
+    else
+        options.SetNameValue("OVERVIEW_COUNT", std::to_string(factors.size()).c_str());
+    GDALDriver* cog = GetGDALDriverManager()->GetDriverByName("COG");
+    if (!cog) throw Error("write", "GDAL has no COG driver (GDAL 3.1 or later is needed)");
+    std::unique_ptr<GDALDataset> ds(
+        cog->CreateCopy(temp_path.c_str(), &source, FALSE, options.List(), nullptr, nullptr));
+    if (!ds) throw Error("write", "cannot write '" + path + "'" + errors.suffix());
+    return ds;
+}
+
 void write_label_raster(const Dem& dem, const std::vector<std::uint32_t>& pixels,
                         const segment::RegionGraph& graph, const std::string& path,
                         bool overwrite) {
@@ -162,16 +203,7 @@ void write_label_raster(const Dem& dem, const std::vector<std::uint32_t>& pixels
     {
         // The labels as GDAL sees them without a copy: a MEM band over `pixels`, read through
         // a VRT as `type`, with the colour table, NoData and description.
-        std::unique_ptr<GDALDataset> mem(
-            GetGDALDriverManager()->GetDriverByName("MEM")->Create("", dem.width, dem.height, 0,
-                                                                   GDT_UInt32, nullptr));
-        if (!mem) throw Error("write", "cannot create '" + path + "'" + errors.suffix());
-        char pointer[64] = {};
-        CPLPrintPointer(pointer, const_cast<std::uint32_t*>(pixels.data()), sizeof pointer);
-        CPLStringList band_options;
-        band_options.SetNameValue("DATAPOINTER", pointer);
-        if (mem->AddBand(GDT_UInt32, band_options.List()) != CE_None)
-            throw Error("write", "cannot create '" + path + "'" + errors.suffix());
+        auto mem = labels_in_place(dem, {&pixels}, path, errors);
         std::unique_ptr<VRTDataset> source(
             static_cast<VRTDataset*>(GDALDataset::FromHandle(VRTCreate(dem.width, dem.height))));
         // A DEM read without geotransform gets the grid terrain used (docs/outputs.md).
@@ -188,25 +220,7 @@ void write_label_raster(const Dem& dem, const std::vector<std::uint32_t>& pixels
                 throw Error("write",
                             "cannot store the colour table of '" + path + "'" + errors.suffix());
         }
-        // A Cloud-Optimized GeoTIFF: 256 x 256 DEFLATE tiles, overviews down to about 64
-        // pixels (nearest: every overview pixel is one region's id), the directories first
-        // and the smallest overview's tiles before the larger ones', BigTIFF when needed.
-        const auto factors = overview_factors(dem);
-        CPLStringList options;
-        options.SetNameValue("COMPRESS", "DEFLATE");
-        options.SetNameValue("PREDICTOR", "YES");
-        options.SetNameValue("BLOCKSIZE", "256");
-        options.SetNameValue("BIGTIFF", "IF_SAFER");
-        options.SetNameValue("RESAMPLING", "NEAREST");
-        if (factors.empty())
-            options.SetNameValue("OVERVIEWS", "NONE");
-        else
-            options.SetNameValue("OVERVIEW_COUNT", std::to_string(factors.size()).c_str());
-        GDALDriver* cog = GetGDALDriverManager()->GetDriverByName("COG");
-        if (!cog) throw Error("write", "GDAL has no COG driver (GDAL 3.1 or later is needed)");
-        std::unique_ptr<GDALDataset> ds(cog->CreateCopy(output.temp_path().c_str(), source.get(),
-                                                        FALSE, options.List(), nullptr, nullptr));
-        if (!ds) throw Error("write", "cannot write '" + path + "'" + errors.suffix());
+        auto ds = write_cloud_optimized(dem, *source, output.temp_path(), path, errors);
         source.reset();
         mem.reset();
         // The attribute table goes to the .aux.xml (GeoTIFF has none), written on closing.

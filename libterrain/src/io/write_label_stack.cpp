@@ -2,6 +2,8 @@
 #include <gdal_priv.h>
 
 #include <memory>
+#include <string>
+#include <vector>
 
 #include "dataset_files.hpp"
 #include "gdal_support.hpp"
@@ -37,45 +39,40 @@ void write_label_stack(const Dem& dem, const std::vector<std::vector<std::uint32
     }
     AtomicOutput output(path, overwrite);
     TemporaryFiles temporary(output);
-    GDALDriver* gtiff = GetGDALDriverManager()->GetDriverByName("GTiff");
-    const char* options[] = {"COMPRESS=DEFLATE", "TILED=YES", "INTERLEAVE=BAND", nullptr};
-    std::unique_ptr<GDALDataset> ds(gtiff->Create(output.temp_path().c_str(), dem.width, dem.height,
-                                                  static_cast<int>(bands.size()), GDT_UInt32,
-                                                  const_cast<char**>(options)));
-    if (!ds) throw Error("write", "cannot create '" + path + "'" + errors.suffix());
-    ds->SetGeoTransform(const_cast<double*>(dem.transform.data()));
-    if (!dem.crs_wkt.empty()) ds->SetProjection(geo::output_crs_wkt(dem.crs_wkt).c_str());
+    // One UInt32 band per scale, read in place, written as a Cloud-Optimized GeoTIFF (pixel
+    // interleaved, as GDAL's COG driver writes several bands).
+    std::vector<const std::vector<std::uint32_t>*> values;
+    for (const auto& b : bands) values.push_back(&b);
+    auto mem = labels_in_place(dem, values, path, errors);
     for (std::size_t i = 0; i < bands.size(); ++i) {
-        GDALRasterBand* band = ds->GetRasterBand(static_cast<int>(i + 1));
+        GDALRasterBand* band = mem->GetRasterBand(static_cast<int>(i + 1));
         band->SetNoDataValue(0);
         band->SetDescription(descriptions[i].c_str());
-        if (band->RasterIO(GF_Write, 0, 0, dem.width, dem.height,
-                           const_cast<std::uint32_t*>(bands[i].data()), dem.width, dem.height,
-                           GDT_UInt32, 0, 0) != CE_None)
-            throw Error("write", "writing '" + path + "' failed" + errors.suffix());
-        if (!graphs.empty()) {
-            auto rat = region_attribute_table(*graphs[i]);
-            if (band->SetDefaultRAT(&rat) != CE_None)
-                throw Error("write", "cannot store the attribute table of band " +
+    }
+    auto ds = write_cloud_optimized(dem, *mem, output.temp_path(), path, errors);
+    mem.reset();
+    for (std::size_t i = 0; i < bands.size() && !graphs.empty(); ++i) {
+        // The attribute tables go to the .aux.xml (the file is open read-only: GDAL keeps what
+        // is set on it there), and band 1's colour table too when its ids fit in 16 bits:
+        // GeoTIFF stores one only for 8 and 16-bit single-sample images, and GDAL reads one
+        // from the .aux.xml for band 1. The GeoTIFF itself is the same with or without them.
+        GDALRasterBand* band = ds->GetRasterBand(static_cast<int>(i + 1));
+        auto rat = region_attribute_table(*graphs[i]);
+        if (band->SetDefaultRAT(&rat) != CE_None)
+            throw Error("write", "cannot store the attribute table of band " +
+                                     std::to_string(i + 1) + " of '" + path + "'" +
+                                     errors.suffix());
+        auto* pam = dynamic_cast<GDALPamRasterBand*>(band);
+        if (pam && i == 0 && graphs[i]->regions.size() < 65536) {
+            const auto table = region_colour_table(graphs[i]->regions.size());
+            if (pam->GDALPamRasterBand::SetColorInterpretation(GCI_PaletteIndex) != CE_None ||
+                pam->GDALPamRasterBand::SetColorTable(const_cast<GDALColorTable*>(&table)) !=
+                    CE_None)
+                throw Error("write", "cannot store the colour table of band " +
                                          std::to_string(i + 1) + " of '" + path + "'" +
                                          errors.suffix());
-            // Band 1's colour table, when its ids fit in 16 bits. GeoTIFF stores one only for
-            // 8 and 16-bit single-sample images, and GDAL reads one from the .aux.xml (its
-            // persistent auxiliary metadata, beside the attribute tables) for band 1 only; so
-            // it goes there and the GeoTIFF itself stays as it was.
-            auto* pam = dynamic_cast<GDALPamRasterBand*>(band);
-            if (pam && i == 0 && graphs[i]->regions.size() < 65536) {
-                const auto table = region_colour_table(graphs[i]->regions.size());
-                if (pam->GDALPamRasterBand::SetColorInterpretation(GCI_PaletteIndex) != CE_None ||
-                    pam->GDALPamRasterBand::SetColorTable(const_cast<GDALColorTable*>(&table)) !=
-                        CE_None)
-                    throw Error("write", "cannot store the colour table of band " +
-                                             std::to_string(i + 1) + " of '" + path + "'" +
-                                             errors.suffix());
-            }
         }
     }
-    ds->FlushCache();
     auto files = dataset_files(ds.get());
     CPLErrorReset();
     ds.reset();
