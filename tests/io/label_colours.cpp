@@ -47,10 +47,8 @@ struct PixelRegions {
     segment::RegionGraph graph;
 };
 PixelRegions pixel_regions(int width, int height) {
-    PixelRegions p{test::crop(io::read_dem(test::sample("vesta_hamo_tile.lbl")), 0, 0, width,
-                              height),
-                   {},
-                   {}};
+    PixelRegions p{
+        test::crop(io::read_dem(test::sample("vesta_hamo_tile.lbl")), 0, 0, width, height), {}, {}};
     p.pixels.resize(p.dem.size());
     p.graph.point_frame = segment::PointFrame::map;
     for (std::size_t i = 0; i < p.dem.size(); ++i) {

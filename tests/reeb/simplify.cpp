@@ -121,7 +121,8 @@ TEST_CASE("The rewritten field rebuilds into the same critical nodes", "[simplif
     CHECK(critical_nodes(reeb::build_reeb_graph(torus, r.field)) == critical_nodes(r.graph));
 }
 
-TEST_CASE("Arcs turned around elsewhere: their far nodes become regular, loops never turn", "[simplify]") {
+TEST_CASE("Arcs turned around elsewhere: their far nodes become regular, loops never turn",
+          "[simplify]") {
     // A cancellation moves the kept node's value; an arc of it whose far node is now on the
     // other side turns around, and that far node may be left with one arc below and one
     // above (it must become regular) or become an extremum (its arcs are new candidates).
@@ -288,4 +289,3 @@ TEST_CASE("Simplification refuses a graph whose lists hold arc ends or shared no
     shared.arc_nodes[shared.arc_offsets[listed[1]]] = g.arc_nodes[g.arc_offsets[listed[0]]];
     CHECK_THROWS_WITH(reeb::simplify(mesh, shared, {}), Catch::Contains("not valid"));
 }
-

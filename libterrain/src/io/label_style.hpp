@@ -27,9 +27,9 @@ void write_label_style(std::ostream& out, const segment::RegionGraph& graph, int
 
 // A GDAL MEM dataset of the grid's size whose UInt32 bands are `bands` themselves (no copy;
 // they must outlive it), georeferenced as the grid.
-std::unique_ptr<GDALDataset> labels_in_place(const Dem& dem,
-                                             const std::vector<const std::vector<std::uint32_t>*>& bands,
-                                             const std::string& path, const GdalErrorCapture& errors);
+std::unique_ptr<GDALDataset> labels_in_place(
+    const Dem& dem, const std::vector<const std::vector<std::uint32_t>*>& bands,
+    const std::string& path, const GdalErrorCapture& errors);
 
 // `source` written at `temp_path` by GDAL's COG driver: 256 x 256 DEFLATE tiles (horizontal
 // predictor), overviews down to about 64 pixels (nearest: every overview pixel is one region's

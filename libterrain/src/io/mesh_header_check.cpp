@@ -441,7 +441,8 @@ MeshFileCounts check_off(std::string_view bytes, const std::string& name) {
         if (!values || values->size() < coordinates)
             refuse(name, "OFF vertex " + str(v) + " is not a line of " + str(coordinates) +
                              " numbers or more");
-        if (colours) check_off_colour(*values, coordinates, name, "vertex " + str(v), vertex_colours);
+        if (colours)
+            check_off_colour(*values, coordinates, name, "vertex " + str(v), vertex_colours);
     }
     for (std::uint64_t f = 0; f < *nf; ++f) {
         const auto line = lines.next();

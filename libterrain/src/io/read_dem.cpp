@@ -99,8 +99,8 @@ Dem read_dem(const std::string& path, const ReadDemOptions& options, const Progr
         // even that fails here, at the cost of one block. (Not the last row: ASCII grids find
         // a row by reading every row before it, again for each missing one.)
         std::vector<double> probe(width);
-        if (band->RasterIO(GF_Read, 0, 0, dem.width, 1, probe.data(), dem.width, 1, GDT_Float64,
-                           0, 0) != CE_None)
+        if (band->RasterIO(GF_Read, 0, 0, dem.width, 1, probe.data(), dem.width, 1, GDT_Float64, 0,
+                           0) != CE_None)
             throw Error("read", "cannot read row 0 of '" + path + "'" + errors.suffix());
         dem.values.reserve(width * static_cast<std::size_t>(dem.height));
     }

@@ -144,9 +144,9 @@ std::string label_style_path(const std::string& path) {
     return std::filesystem::path(path).replace_extension(".qml").string();
 }
 
-std::unique_ptr<GDALDataset> labels_in_place(const Dem& dem,
-                                             const std::vector<const std::vector<std::uint32_t>*>& bands,
-                                             const std::string& path, const GdalErrorCapture& errors) {
+std::unique_ptr<GDALDataset> labels_in_place(
+    const Dem& dem, const std::vector<const std::vector<std::uint32_t>*>& bands,
+    const std::string& path, const GdalErrorCapture& errors) {
     std::unique_ptr<GDALDataset> mem(GetGDALDriverManager()->GetDriverByName("MEM")->Create(
         "", dem.width, dem.height, 0, GDT_UInt32, nullptr));
     if (!mem) throw Error("write", "cannot create '" + path + "'" + errors.suffix());

@@ -279,9 +279,11 @@ std::string sql_quoted(const std::string& text) {
 void add_wkt2_definitions(GDALDataset& ds, const OGRSpatialReference* srs, const std::string& path,
                           const GdalErrorCapture& errors) {
     bool has_column = false;
-    if (OGRLayer* info = ds.ExecuteSQL("PRAGMA table_info(gpkg_spatial_ref_sys)", nullptr, nullptr)) {
+    if (OGRLayer* info =
+            ds.ExecuteSQL("PRAGMA table_info(gpkg_spatial_ref_sys)", nullptr, nullptr)) {
         for (auto& row : *info)
-            if (std::string(row->GetFieldAsString("name")) == "definition_12_063") has_column = true;
+            if (std::string(row->GetFieldAsString("name")) == "definition_12_063")
+                has_column = true;
         ds.ReleaseResultSet(info);
     }
     if (!has_column) {
@@ -343,7 +345,9 @@ std::vector<std::string> write_ogr(GDALDriver& driver, const std::string& temp,
     // GeoPackage stamps the current time (on creation, on SQL that changes a table, on close)
     // unless told a fixed one: same bytes every run.
     struct FixedDate {
-        FixedDate() { CPLSetThreadLocalConfigOption("OGR_CURRENT_DATE", "2000-01-01T00:00:00.000Z"); }
+        FixedDate() {
+            CPLSetThreadLocalConfigOption("OGR_CURRENT_DATE", "2000-01-01T00:00:00.000Z");
+        }
         ~FixedDate() { CPLSetThreadLocalConfigOption("OGR_CURRENT_DATE", nullptr); }
     } fixed_date;
     std::unique_ptr<GDALDataset> ds(
@@ -400,8 +404,8 @@ std::vector<std::string> write_ogr(GDALDriver& driver, const std::string& temp,
         add_layer_style(*ds, layer_name, layer_name, true, "region colours (terrain)",
                         polygon_style_qml(graph), path, errors);
         add_layer_style(*ds, layer_name, layer_name + " by landform", false,
-                        "landform classes of the shape index (terrain)", landform_style_qml(),
-                        path, errors);
+                        "landform classes of the shape index (terrain)", landform_style_qml(), path,
+                        errors);
         add_wkt2_definitions(*ds, srs, path, errors);
     }
     auto files = dataset_files(ds.get());

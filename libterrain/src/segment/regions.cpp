@@ -281,8 +281,7 @@ double landform_centre(Landform landform) {
 
 const char* to_string(Landform landform) {
     static const char* const names[] = {"cup",          "trough", "rut",  "saddle rut", "saddle",
-                                        "saddle ridge", "ridge",  "dome", "cap",
-                                        "unknown"};
+                                        "saddle ridge", "ridge",  "dome", "cap",        "unknown"};
     return names[static_cast<int>(landform)];
 }
 
