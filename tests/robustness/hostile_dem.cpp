@@ -206,8 +206,7 @@ TEST_CASE("a GeoTIFF whose one row of blocks is larger than memory is refused",
     // Int16 bands. Reading one row of band 1 makes GDAL allocate the whole interleaved block,
     // 8.3 GB, which the budget (one band) did not count.
     const auto dir = scratch_dir("hostile_interleaved");
-    const std::string input = std::string(TERRAIN_SOURCE_DIR) +
-                              "/tests/robustness/cases/dem_pixel_interleaved_63487_bands.tif";
+    const std::string input = case_path("dem_pixel_interleaved_63487_bands.tif");
     for (const char* command : {"info", "mesh"}) {
         std::vector<std::string> args = {command, input};
         if (std::string(command) == "mesh")
@@ -228,8 +227,7 @@ TEST_CASE("read_dem's memory follows the rows it reads, not the size a header de
     // row 0 (the budget allowed it on a machine with that much free memory); the command
     // line was safe (`info` reads rows only, `mesh` refuses the 203 GB plan), the library
     // was not.
-    const std::string input = std::string(TERRAIN_SOURCE_DIR) +
-                              "/tests/robustness/cases/dem_826_bytes_declaring_1g_pixels.tif";
+    const std::string input = case_path("dem_826_bytes_declaring_1g_pixels.tif");
     rusage before{};
     getrusage(RUSAGE_SELF, &before);
     try {

@@ -4,8 +4,6 @@
 
 #include <cstdint>
 #include <cstring>
-#include <fstream>
-#include <sstream>
 
 #include "hostile_support.hpp"
 #include "terrain/core/error.hpp"
@@ -15,16 +13,6 @@ using Catch::Matchers::Contains;
 using namespace terrain::test;
 
 namespace {
-
-// The bytes of an input a fuzz target found, kept in tests/robustness/cases.
-std::string read_case(const std::string& name) {
-    std::ifstream in(std::string(TERRAIN_SOURCE_DIR) + "/tests/robustness/cases/" + name,
-                     std::ios::binary);
-    REQUIRE(in);
-    std::ostringstream bytes;
-    bytes << in.rdbuf();
-    return bytes.str();
-}
 
 std::string le32(std::uint32_t v) {
     std::string s(4, '\0');
@@ -208,7 +196,7 @@ TEST_CASE("OFF colours and vertex lines CGAL's scanner reads unchecked are refus
          "OFF face 1 has no colour after one with a colour"},
         {"COFF\n3 1 0\n0 0 0 7\n1 0 0\n0 1 0\n3 0 1 2\n",
          "OFF vertex 1 has no colour after one with a colour"},
-        {read_case("off_face_without_colour_after_coloured.off"),
+        {file_bytes(case_path("off_face_without_colour_after_coloured.off")),
          "OFF face 2 has no colour after one with a colour"},
     };
     check_mesh_cases_refused(dir, cases, "off");

@@ -31,6 +31,10 @@ CliResult run_limited(const std::vector<std::string>& args, int seconds, int mem
     return run_program("timeout", all);
 }
 
+std::string case_path(const std::string& name) {
+    return std::string(TERRAIN_SOURCE_DIR) + "/tests/robustness/cases/" + name;
+}
+
 std::string write_bytes(const std::filesystem::path& path, const std::string& bytes) {
     std::ofstream out(path, std::ios::binary);
     out << bytes;

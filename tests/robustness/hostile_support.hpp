@@ -16,6 +16,9 @@ namespace terrain::test {
 // build).
 CliResult run_limited(const std::vector<std::string>& args, int seconds = 60, int memory_mb = 3072);
 
+// The path of an input a fuzz target found, kept in tests/robustness/cases.
+std::string case_path(const std::string& name);
+
 // Writes `bytes` to `path`; returns the path.
 std::string write_bytes(const std::filesystem::path& path, const std::string& bytes);
 
