@@ -131,6 +131,26 @@ i32 Simplifier::redirect(i32 a) const {
     return best;
 }
 
+// Which end of candidate arc a stays and which goes. A saddle (or a degenerate extremum)
+// stays and keeps its value. Two extrema meet at the midpoint of their values, the lower one
+// staying, unless one of them has no other arc and the other has more (a degenerate
+// extremum, also a saddle): then the first is absorbed into the second, which keeps its
+// value, as a saddle would. The midpoint there would move the degenerate extremum and turn
+// its other arcs around, and the rewritten field would no longer match the graph.
+Simplifier::Pairing Simplifier::pairing(i32 a) const {
+    const Arc& arc = arcs_[idx(a)];
+    const i32 lo = arc.end[0], hi = arc.end[1];
+    const bool lo_ext = down(lo) == 0, hi_ext = up(hi) == 0;
+    Pairing p;
+    p.both = lo_ext && hi_ext;
+    p.midpoint = p.both && (degree(lo) == 1) == (degree(hi) == 1);
+    p.keep = !p.midpoint && (p.both ? degree(lo) == 1 : lo_ext) ? hi : lo;
+    p.gone = p.keep == lo ? hi : lo;
+    p.value = p.midpoint ? 0.5f * (critical_[idx(lo)].value + critical_[idx(hi)].value)
+                         : critical_[idx(p.keep)].value;
+    return p;
+}
+
 // Whether cancelling arc a would turn around an arc that has a parallel twin (one of two arcs
 // joining the same two nodes: a loop of the graph, which no cancellation may close). The
 // kept node's new value would leave the far end of both arcs on the other side, and
@@ -139,31 +159,22 @@ i32 Simplifier::redirect(i32 a) const {
 // holes at area ratio 5 % rebuilt 66 critical nodes from a field whose graph had 9). Such a
 // cancellation waits; the arc is looked at again when a cancellation changes its ends.
 bool Simplifier::would_turn_a_loop(i32 a) const {
-    const Arc& arc = arcs_[idx(a)];
-    const i32 lo = arc.end[0], hi = arc.end[1];
-    const bool lo_ext = down(lo) == 0, hi_ext = up(hi) == 0;
-    const bool both = lo_ext && hi_ext;
-    const bool midpoint = both && (degree(lo) == 1) == (degree(hi) == 1);
-    i32 keep = lo;
-    if (!midpoint && (both ? degree(lo) == 1 : lo_ext)) keep = hi;
-    const i32 gone = keep == lo ? hi : lo;
-    const float v = midpoint ? 0.5f * (critical_[idx(lo)].value + critical_[idx(hi)].value)
-                             : critical_[idx(keep)].value;
+    const Pairing p = pairing(a);
     bool turns = false;
-    // An arc of node n (other than a) ends at the kept node at value v afterwards: it turns
-    // when its far end is then on the other side of v than the arc says.
+    // An arc of node n (other than a) ends at the kept node at p.value afterwards: it turns
+    // when its far end is then on the other side of that value than the arc says.
     const auto check = [&](i32 n) {
-        if (turns || (n == keep && !midpoint)) return;  // keep's arcs stay as they are
+        if (turns || (n == p.keep && !p.midpoint)) return;  // keep's arcs stay as they are
         for_each_arc(n, [&](i32 b) {
             if (turns || b == a) return;
             const auto& e = arcs_[idx(b)].end;
             const bool n_upper = e[1] == n;
             const float far = value(n_upper ? e[0] : e[1]);
-            if ((n_upper ? far > v : far < v) && has_parallel_arc(b)) turns = true;
+            if ((n_upper ? far > p.value : far < p.value) && has_parallel_arc(b)) turns = true;
         });
     };
-    check(gone);
-    check(keep);
+    check(p.gone);
+    check(p.keep);
     return turns;
 }
 
@@ -171,21 +182,12 @@ void Simplifier::cancel(i32 a, SimplifyResult& result) {
     turned_.clear();
     Arc& arc = arcs_[idx(a)];
     const i32 lo = arc.end[0], hi = arc.end[1];
-    const bool lo_ext = down(lo) == 0, hi_ext = up(hi) == 0;
-    // Two extrema: they meet at the midpoint of their values, unless one of them has no
-    // other arc and the other has more (a degenerate extremum, also a saddle): then the
-    // first is absorbed into the second, which keeps its value, as a saddle would. The
-    // midpoint there would move the degenerate extremum and turn its other arcs around,
-    // and the rewritten field would no longer match the graph.
-    const bool both = lo_ext && hi_ext;
-    const bool midpoint = both && (degree(lo) == 1) == (degree(hi) == 1);
-    i32 keep = lo;  // the midpoint, or a saddle (or degenerate extremum) below
-    if (!midpoint && (both ? degree(lo) == 1 : lo_ext)) keep = hi;
-    const i32 gone = keep == lo ? hi : lo;
+    const Pairing p = pairing(a);
+    const i32 keep = p.keep, gone = p.gone;
+    const bool midpoint = p.midpoint, both = p.both;
     const double share_before = critical_[idx(keep)].area / static_cast<double>(degree(keep));
     const bool ext_before = extremum(keep);
-    if (midpoint)
-        critical_[idx(keep)].value = 0.5f * (critical_[idx(lo)].value + critical_[idx(hi)].value);
+    critical_[idx(keep)].value = p.value;
     ++(both ? result.extremum_extremum : result.saddle_extremum);
     CriticalNode& k = critical_[idx(keep)];
     k.flags |= kModified;

@@ -81,6 +81,13 @@ class Simplifier : WorkingGraph {
 
     // The cancellation rules (cancellation.cpp).
     i32 redirect(i32 a) const;
+    struct Pairing {
+        i32 keep = kNone, gone = kNone;
+        bool midpoint = false;  // two extrema meeting at the midpoint of their values
+        bool both = false;      // two extrema
+        float value = 0;        // keep's value afterwards
+    };
+    Pairing pairing(i32 a) const;
     bool would_turn_a_loop(i32 a) const;
     void cancel(i32 a, SimplifyResult& result);
     void fit_arc(i32 b, i32 keep);
