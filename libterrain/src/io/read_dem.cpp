@@ -90,20 +90,10 @@ Dem read_dem(const std::string& path, const ReadDemOptions& options, const Progr
 
     const std::size_t width = static_cast<std::size_t>(dem.width);
     check_dem_size(path, dem, *band, summary ? nullptr : &options.memory);
-    // The grid's values are reserved (address space only) and each row is added as it is
-    // read, so that the memory used follows what the file gives, not what its header claims:
-    // an 826-byte GeoTIFF declaring 18464 x 65504 pixels used to fill 9.7 GB with NaN before
-    // its first row failed to read.
-    if (!summary) {
-        // The first row is read before anything is reserved: a header whose file cannot back
-        // even that fails here, at the cost of one block. (Not the last row: ASCII grids find
-        // a row by reading every row before it, again for each missing one.)
-        std::vector<double> probe(width);
-        if (band->RasterIO(GF_Read, 0, 0, dem.width, 1, probe.data(), dem.width, 1, GDT_Float64, 0,
-                           0) != CE_None)
-            throw Error("read", "cannot read row 0 of '" + path + "'" + errors.suffix());
-        dem.values.reserve(width * static_cast<std::size_t>(dem.height));
-    }
+    // Each row of the grid's values is added as it is read, and the whole grid is reserved
+    // (address space only) once the first row has been read: the memory used follows what
+    // the file gives, not what its header claims. An 826-byte GeoTIFF declaring 18464 x 65504
+    // pixels used to fill 9.7 GB with NaN before its first row failed to read.
     std::vector<double> row_values(summary ? width : 0);
     std::vector<unsigned char> mask_row(all_valid ? 0 : width);
     std::size_t valid = 0, not_finite = 0;
@@ -130,9 +120,11 @@ Dem read_dem(const std::string& path, const ReadDemOptions& options, const Progr
                 continue;
             }
         }
-        if (!summary)
+        if (!summary) {
+            if (row == 1) dem.values.reserve(width * static_cast<std::size_t>(dem.height));
             dem.values.resize(static_cast<std::size_t>(row + 1) * width,
                               std::numeric_limits<double>::quiet_NaN());
+        }
         double* out =
             summary ? row_values.data() : dem.values.data() + static_cast<std::size_t>(row) * width;
         if (band->RasterIO(GF_Read, 0, row, dem.width, 1, out, dem.width, 1, GDT_Float64, 0, 0) !=
