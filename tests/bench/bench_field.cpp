@@ -1,7 +1,11 @@
 // Benchmark: shape index on the mesh of a 1000x1000 DEM of 30 m pixels: --rings 2 and 3, and
-// --radius of 2, 5, 10 and 20 pixels by the grid method (and by the mesh method up to 10
-// pixels, whose cost grows with the number of pixels in the disk).
-//   build/tests/bench/bench_field [size] [runs] [only: run the cases whose name has this]
+// --radius of 2, 5, 10, 20 and 40 pixels with the disk window (grid method: summed-area
+// tables, a cost independent of the radius) and the ball window (grid method, and the mesh
+// method up to 10 pixels, whose cost grows with the number of pixels in the ball). Prints
+// seconds, vertices per second, the ratio to --rings 2 and the peak resident bytes per pixel.
+//   build/tests/bench/bench_field [size] [runs] [only: run the cases whose name has one of
+//   these '|'-separated strings; --rings 2 always runs, as the reference]
+#include <sys/resource.h>
 #include <tbb/info.h>
 
 #include <algorithm>
@@ -28,7 +32,13 @@ int main(int argc, char** argv) {
                 tbb::info::default_concurrency(), runs);
     double rings2 = 0;
     auto run = [&](const std::string& name, const field::ShapeIndexOptions& options) {
-        if (name.find(only) == std::string::npos) return;
+        bool wanted = only.empty() || name == "--rings 2";
+        for (std::size_t at = 0; !wanted && at <= only.size();) {
+            const auto end = std::min(only.find('|', at), only.size());
+            wanted = name.find(only.substr(at, end - at)) != std::string::npos;
+            at = end + 1;
+        }
+        if (!wanted) return;
         double best = 1e300;
         for (int i = 0; i < runs; ++i) {
             const auto t0 = std::chrono::steady_clock::now();
@@ -37,23 +47,36 @@ int main(int argc, char** argv) {
                 best, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
         }
         if (rings2 == 0) rings2 = best;
-        std::printf("shape index %-28s %.3f s  %5.2f M vertices/s  %5.2fx --rings 2\n",
+        std::printf("shape index %-36s %.3f s  %5.2f M vertices/s  %5.2fx --rings 2\n",
                     name.c_str(), best, mesh.vertex_count() / best / 1e6, best / rings2);
     };
     field::ShapeIndexOptions rings2_options, rings3;
     rings3.rings = 3;
     run("--rings 2", rings2_options);
     run("--rings 3", rings3);
-    for (const auto method : {field::ShapeIndexMethod::grid, field::ShapeIndexMethod::mesh})
-        for (int r : {2, 5, 10, 20}) {
-            if (method == field::ShapeIndexMethod::mesh && r > 10) continue;
+    struct Case {
+        field::ShapeIndexWindow window;
+        field::ShapeIndexMethod method;
+        int max_pixels;
+    };
+    for (const auto& c : {Case{field::ShapeIndexWindow::disk, field::ShapeIndexMethod::grid, 40},
+                          Case{field::ShapeIndexWindow::ball, field::ShapeIndexMethod::grid, 20},
+                          Case{field::ShapeIndexWindow::ball, field::ShapeIndexMethod::mesh, 10}})
+        for (int r : {2, 5, 10, 20, 40}) {
+            if (r > c.max_pixels) continue;
             field::ShapeIndexOptions options;
             options.radius = r * pixel;
-            options.method = method;
+            options.method = c.method;
+            options.window = c.window;
             char name[64];
-            std::snprintf(name, sizeof name, "--radius %g (%d px), %s", options.radius, r,
-                          method == field::ShapeIndexMethod::grid ? "grid" : "mesh");
+            std::snprintf(name, sizeof name, "--radius %g (%d px), %s, %s", options.radius, r,
+                          c.window == field::ShapeIndexWindow::disk ? "disk" : "ball",
+                          c.method == field::ShapeIndexMethod::grid ? "grid" : "mesh");
             run(name, options);
         }
+    rusage usage{};
+    getrusage(RUSAGE_SELF, &usage);
+    std::printf("peak resident %.0f MB, %.0f bytes per pixel (DEM, mesh and one field)\n",
+                usage.ru_maxrss / 1024.0, usage.ru_maxrss * 1024.0 / mesh.vertex_count());
     return 0;
 }

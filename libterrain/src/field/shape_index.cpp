@@ -13,26 +13,12 @@
 #include <numbers>
 #include <span>
 
+#include "shape_index_fit.hpp"
 #include "terrain/core/error.hpp"
 
 namespace terrain::field {
+namespace detail {
 namespace {
-
-using Vec3 = std::array<double, 3>;
-
-Vec3 sub(const std::array<float, 3>& a, const std::array<float, 3>& b) {
-    return {double(a[0]) - b[0], double(a[1]) - b[1], double(a[2]) - b[2]};
-}
-Vec3 cross(const Vec3& a, const Vec3& b) {
-    return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
-double dot(const Vec3& a, const Vec3& b) {
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-Vec3 normalized(const Vec3& a) {
-    const double n = std::sqrt(dot(a, a));
-    return n > 0 ? Vec3{a[0] / n, a[1] / n, a[2] / n} : Vec3{0, 0, 1};
-}
 
 // Area-weighted vertex normals; triangles are counter-clockwise seen from outside/above.
 std::vector<Vec3> vertex_normals(const TriangleMesh& mesh) {
@@ -47,45 +33,74 @@ std::vector<Vec3> vertex_normals(const TriangleMesh& mesh) {
     return normals;
 }
 
-struct Scratch {
-    std::vector<std::uint32_t> stamp;
-    std::uint32_t current = 0;
-    std::vector<std::int32_t> gathered;
-};
-
-// The neighbourhood of v (gathered[0] is v itself): `rings` rings of mesh edges, or everything
-// within `radius` metres reachable through vertices within it.
+// The neighbourhood of v: `rings` rings of mesh edges, or everything within `radius` metres
+// (a ball) reachable through vertices within it.
 void gather(const TriangleMesh& mesh, std::int32_t v, const ShapeIndexOptions& options,
             Scratch& s) {
-    if (s.stamp.size() != mesh.vertex_count()) s.stamp.assign(mesh.vertex_count(), 0);
-    if (++s.current == 0) {
-        std::fill(s.stamp.begin(), s.stamp.end(), 0);
-        s.current = 1;
-    }
-    s.gathered.clear();
-    s.stamp[v] = s.current;
+    if (!(options.radius > 0))
+        return gather_where(
+            mesh, v, options.rings, [](std::int32_t) { return true; }, s);
     const auto& centre = mesh.positions[v];
     const double r2 = options.radius * options.radius;
-    std::size_t begin = 0;
-    s.gathered.push_back(v);
-    for (int ring = 0; options.radius > 0 || ring < options.rings; ++ring) {
-        const std::size_t end = s.gathered.size();
-        if (begin == end) break;
-        for (std::size_t i = begin; i < end; ++i) {
-            const auto u = s.gathered[i];
-            for (auto k = mesh.neighbor_offsets[u]; k < mesh.neighbor_offsets[u + 1]; ++k) {
-                const auto w = mesh.neighbors[k];
-                if (s.stamp[w] == s.current) continue;
-                s.stamp[w] = s.current;
-                if (options.radius > 0) {
-                    const Vec3 d = sub(mesh.positions[w], centre);
-                    if (dot(d, d) > r2) continue;
-                }
-                s.gathered.push_back(w);
+    gather_where(
+        mesh, v, -1,
+        [&](std::int32_t w) {
+            const Vec3 d = sub(mesh.positions[w], centre);
+            return dot(d, d) <= r2;
+        },
+        s);
+}
+
+}  // namespace
+
+GridLayout grid_layout(const TriangleMesh& mesh) {
+    GridLayout g;
+    g.width = mesh.grid_width, g.height = mesh.grid_height;
+    g.seam = mesh.seam_closed;
+    g.pixel_vertex.assign(std::size_t(g.width) * std::size_t(g.height), -1);
+    for (std::size_t v = mesh.vertex_pixel.size(); v-- > 0;)
+        g.pixel_vertex[std::size_t(mesh.vertex_pixel[v])] = std::int32_t(v);
+    // A collapsed pole row is one vertex: it takes the mesh path.
+    for (int row : mesh.pole_rows)
+        if (row >= 0)
+            std::fill_n(g.pixel_vertex.begin() + std::ptrdiff_t(row) * g.width, g.width, -1);
+    // On a body, the disk window's tiles are made smaller where 64 pixels span more than
+    // kMaxDiskTileAngle: from the longest distance between neighbouring pixels and the
+    // largest distance from the body's centre among about 64 x 64 pixels spread over the grid.
+    if (mesh.frame == MeshFrame::body) {
+        double spacing = 0, radius = 0;
+        const int row_step = std::max(1, g.height / 64), col_step = std::max(1, g.width / 64);
+        const auto at = [&](int c, int r) {
+            return g.pixel_vertex[std::size_t(r) * std::size_t(g.width) + std::size_t(c)];
+        };
+        for (int r = 0; r + 1 < g.height; r += row_step)
+            for (int c = 0; c + 1 < g.width; c += col_step) {
+                const auto v = at(c, r);
+                if (v < 0) continue;
+                const auto& p = mesh.positions[std::size_t(v)];
+                const Vec3 q{mesh.origin[0] + p[0], mesh.origin[1] + p[1], mesh.origin[2] + p[2]};
+                radius = std::max(radius, std::sqrt(dot(q, q)));
+                for (const auto w : {at(c + 1, r), at(c, r + 1)})
+                    if (w >= 0) {
+                        const Vec3 d = sub(mesh.positions[std::size_t(w)], p);
+                        spacing = std::max(spacing, std::sqrt(dot(d, d)));
+                    }
             }
-        }
-        begin = end;
+        if (spacing > 0)
+            g.disk_tile = int(std::clamp(kMaxDiskTileAngle * radius / spacing, 8.0, 64.0));
     }
+    return g;
+}
+
+namespace {
+
+bool dem_mesh(const TriangleMesh& mesh) {
+    return mesh.grid_width > 0 && mesh.grid_height > 0 &&
+           mesh.vertex_pixel.size() == mesh.vertex_count();
+}
+
+bool disk_applies(const TriangleMesh& mesh, const ShapeIndexOptions& options) {
+    return options.radius > 0 && options.window == ShapeIndexWindow::disk && dem_mesh(mesh);
 }
 
 // Solves the symmetric positive system A x = b (n <= 5) by Cholesky; false if singular.
@@ -118,14 +133,7 @@ bool solve_spd(std::array<std::array<double, N>, N>& a, std::array<double, N>& b
     return true;
 }
 
-// The normal equations of the fit h = a u^2 + b uv + c v^2 (+ d u + e v) in raw tangent
-// coordinates (lower triangles of ata), the neighbour count m and their mean distance.
-struct NormalEquations {
-    std::array<std::array<double, 5>, 5> ata{};
-    std::array<double, 5> atb{};
-    std::size_t m = 0;
-    double scale = 0;
-};
+}  // namespace
 
 // Solves the fit with coordinates divided by `scale` (so that it is scale-free; dividing only
 // rescales the equations) and returns the principal curvatures in units of 1/scale; false
@@ -182,6 +190,8 @@ std::array<Vec3, 2> tangent_frame(const Vec3& normal) {
     return {t1, cross(normal, t1)};
 }
 
+namespace {
+
 // Fits h = a u^2 + b uv + c v^2 (+ d u + e v) to the neighbourhood in the tangent frame of
 // `normal`, coordinates divided by their mean distance so the fit is scale-free. Returns
 // false when the neighbourhood is too small. Curvatures come back in units of 1/scale.
@@ -210,12 +220,22 @@ bool fit_curvatures(const TriangleMesh& mesh, std::int32_t v, const Vec3& normal
     return solve_curvatures(e, out);
 }
 
-// The mesh path for one vertex: gather its neighbourhood on the mesh and fit.
+}  // namespace
+
+// The mesh path for one vertex: gather its neighbourhood on the mesh and fit. With
+// `disk_grid` (the disk window applies) the neighbourhood is the vertex's disk, except at a
+// collapsed pole, whose pixel is no place on the ground: it takes the ball.
 bool mesh_fit(const TriangleMesh& mesh, std::int32_t v, const Vec3& normal,
-              const ShapeIndexOptions& options, Scratch& s, PrincipalCurvatures& k, double& scale) {
+              const ShapeIndexOptions& options, const GridLayout* disk_grid, Scratch& s,
+              PrincipalCurvatures& k, double& scale) {
+    const bool pole = v == mesh.pole_vertices[0] || v == mesh.pole_vertices[1];
+    if (disk_grid && !pole)
+        return disk_mesh_fit(mesh, *disk_grid, v, normal, options.radius, s, k, scale);
     gather(mesh, v, options, s);
     return fit_curvatures(mesh, v, normal, s.gathered.data() + 1, s.gathered.size() - 1, k, scale);
 }
+
+namespace {
 
 // ---------------------------------------------------------------------------------------------
 // The grid path (DEM meshes with a metric radius). The fit above needs, per vertex, sums over
@@ -372,38 +392,18 @@ NormalEquations equations_from_moments(const double* m, const Vec3& normal) {
     return e;
 }
 
-constexpr int kTile = 64;       // output pixels per tile side
-constexpr int kMaxReach = 128;  // a window reaching further (pixels) takes the mesh path
-
-struct GridLayout {
-    int width = 0, height = 0;
-    bool seam = false;
-    std::vector<std::int32_t> pixel_vertex;  // the vertex a pixel owns, or -1
-};
-
-struct GridScratch {
-    std::vector<Vec3> position;   // region pixels; x NaN where no vertex
-    std::vector<double> prefix;   // per region row, (cols + 1) x kMoments running sums
-    std::vector<int> lo, hi;      // the current window's span in each row offset
-    std::vector<double> spacing;  // adjacent-pixel distances, to size the region
-    Scratch mesh;
-};
-
-GridLayout grid_layout(const TriangleMesh& mesh) {
-    GridLayout g;
-    g.width = mesh.grid_width, g.height = mesh.grid_height;
-    g.seam = mesh.seam_closed;
-    g.pixel_vertex.assign(std::size_t(g.width) * std::size_t(g.height), -1);
-    for (std::size_t v = mesh.vertex_pixel.size(); v-- > 0;)
-        g.pixel_vertex[std::size_t(mesh.vertex_pixel[v])] = std::int32_t(v);
-    // A collapsed pole row is one vertex: it takes the mesh path.
-    for (int row : mesh.pole_rows)
-        if (row >= 0)
-            std::fill_n(g.pixel_vertex.begin() + std::ptrdiff_t(row) * g.width, g.width, -1);
-    return g;
+// Moves moments about the reference to moments about the vertex at `centre` (sum (e - t)^a
+// from sum e^a, axis by axis), fits and hands the result to `body`.
+void fit_from_moments(double* moments, const Vec3& centre, const Vec3& ref, const Vec3& normal,
+                      std::int32_t v, const VertexFn& body) {
+    const Vec3 t{centre[0] - ref[0], centre[1] - ref[1], centre[2] - ref[2]};
+#pragma GCC unroll 105
+    for (const auto& step : kShift) moments[step.target] -= t[step.axis] * moments[step.source];
+    PrincipalCurvatures k;
+    const auto equations = equations_from_moments(moments, normal);
+    const bool fitted = solve_curvatures(equations, k);
+    body(v, fitted, k, equations.scale);
 }
-
-using VertexFn = std::function<void(std::int32_t, bool, const PrincipalCurvatures&, double)>;
 
 // The vertices of one tile of output pixels [c0, c0 + kTile) x [r0, r0 + kTile).
 void grid_tile(const TriangleMesh& mesh, const GridLayout& g, const std::vector<Vec3>& normals,
@@ -417,14 +417,10 @@ void grid_tile(const TriangleMesh& mesh, const GridLayout& g, const std::vector<
     const auto fallback = [&](std::int32_t v) {
         PrincipalCurvatures k;
         double scale = 0;
-        const bool ok = mesh_fit(mesh, v, normals[std::size_t(v)], options, s.mesh, k, scale);
+        const bool ok =
+            mesh_fit(mesh, v, normals[std::size_t(v)], options, nullptr, s.mesh, k, scale);
         body(v, ok, k, scale);
         ++mesh_fallbacks;
-    };
-    const auto fallback_tile = [&] {
-        for (int row = r0; row < r1; ++row)
-            for (int col = c0; col < c1; ++col)
-                if (const auto v = vertex_at(col, row); v >= 0) fallback(v);
     };
     // How far (in pixels) the ball can reach: from the short end of the tile's distances
     // between neighbouring pixels, with a margin; a window reaching the margin takes the
@@ -446,52 +442,18 @@ void grid_tile(const TriangleMesh& mesh, const GridLayout& g, const std::vector<
         return r > kMaxReach ? kMaxReach + 1 : int(std::ceil(r));
     };
     const int mx = reach(1, 0), my = reach(0, 1);
-    if (mx > kMaxReach || my > kMaxReach) return fallback_tile();
-    // The region: the tile and its margins (rows clipped to the grid; columns clipped, or
-    // wrapped across the seam of a global grid).
-    const int rr0 = std::max(0, r0 - my), rr1 = std::min(H, r1 + my);
-    for (int row : mesh.pole_rows)
-        if (row >= rr0 && row < rr1) return fallback_tile();
-    int cc0 = c0 - mx, cc1 = c1 + mx;
-    if (g.seam) {
-        if (cc1 - cc0 > W) return fallback_tile();
-    } else {
-        cc0 = std::max(0, cc0), cc1 = std::min(W, cc1);
+    Region region;
+    const auto status =
+        region_sums<kMoments>(mesh, g, r0, r1, c0, c1, mx, my, true, s, region, monomials);
+    if (status == RegionStatus::empty) return;
+    if (status == RegionStatus::mesh_path) {
+        for (int row = r0; row < r1; ++row)
+            for (int col = c0; col < c1; ++col)
+                if (const auto v = vertex_at(col, row); v >= 0) fallback(v);
+        return;
     }
-    const int rows = rr1 - rr0, cols = cc1 - cc0;
-    const auto region_col = [&](int col) { return ((col % W) + W) % W; };
-    // The tile's reference point: its first vertex.
-    Vec3 ref{0, 0, 0};
-    bool any = false;
-    for (int row = r0; row < r1 && !any; ++row)
-        for (int col = c0; col < c1 && !any; ++col)
-            if (const auto v = vertex_at(col, row); v >= 0) {
-                const auto& p = mesh.positions[std::size_t(v)];
-                ref = {p[0], p[1], p[2]}, any = true;
-            }
-    if (!any) return;
-    s.position.resize(std::size_t(rows) * std::size_t(cols));
-    s.prefix.resize(std::size_t(rows) * std::size_t(cols + 1) * kMoments);
-    for (int lr = 0; lr < rows; ++lr) {
-        double* running = &s.prefix[std::size_t(lr) * std::size_t(cols + 1) * kMoments];
-        std::fill_n(running, kMoments, 0.0);
-        for (int lc = 0; lc < cols; ++lc) {
-            const auto v = vertex_at(region_col(cc0 + lc), rr0 + lr);
-            Vec3& p = s.position[std::size_t(lr) * std::size_t(cols) + std::size_t(lc)];
-            double* next = running + kMoments;
-            if (v < 0) {
-                p = {std::numeric_limits<double>::quiet_NaN(), 0, 0};
-                std::copy_n(running, kMoments, next);
-            } else {
-                const auto& q = mesh.positions[std::size_t(v)];
-                p = {q[0], q[1], q[2]};
-                double mono[kMoments];
-                monomials({p[0] - ref[0], p[1] - ref[1], p[2] - ref[2]}, mono);
-                for (int k = 0; k < kMoments; ++k) next[k] = running[k] + mono[k];
-            }
-            running = next;
-        }
-    }
+    const int rr0 = region.rr0, cc0 = region.cc0, rows = region.rows, cols = region.cols;
+    const Vec3 ref = region.ref;
     const double r2 = options.radius * options.radius;
     const int offsets = 2 * my + 1;
     s.lo.assign(std::size_t(offsets), 0);
@@ -596,23 +558,14 @@ void grid_tile(const TriangleMesh& mesh, const GridLayout& g, const std::vector<
                 const double* b = row_sums + std::size_t(hi + 1) * kMoments;
                 for (int k = 0; k < kMoments; ++k) moments[k] += b[k] - a[k];
             }
-            const Vec3 t{centre[0] - ref[0], centre[1] - ref[1], centre[2] - ref[2]};
-            // sum (e - t)^a from sum e^a, axis by axis.
-#pragma GCC unroll 105
-            for (const auto& step : kShift)
-                moments[step.target] -= t[step.axis] * moments[step.source];
-            PrincipalCurvatures k;
-            const auto equations = equations_from_moments(moments, normals[std::size_t(v)]);
-            const bool fitted = solve_curvatures(equations, k);
-            body(v, fitted, k, equations.scale);
+            fit_from_moments(moments, centre, ref, normals[std::size_t(v)], v, body);
         }
     }
 }
 
 bool grid_applies(const TriangleMesh& mesh, const ShapeIndexOptions& options) {
     if (options.method == ShapeIndexMethod::mesh || !(options.radius > 0)) return false;
-    const bool grid = mesh.grid_width > 0 && mesh.grid_height > 0 &&
-                      mesh.vertex_pixel.size() == mesh.vertex_count();
+    const bool grid = dem_mesh(mesh);
     if (options.method == ShapeIndexMethod::grid && !grid)
         throw Error("field", "the grid method needs a mesh made from a DEM");
     return grid;
@@ -620,18 +573,20 @@ bool grid_applies(const TriangleMesh& mesh, const ShapeIndexOptions& options) {
 
 // Every vertex once through `body`, by tiles of pixels; vertices no pixel owns (pinched
 // copies, collapsed poles) and windows the tiles cannot hold take the mesh path.
-std::size_t grid_for_each_vertex(const TriangleMesh& mesh, const ShapeIndexOptions& options,
-                                 const std::vector<Vec3>& normals, const ProgressFn& progress,
-                                 const VertexFn& body) {
-    const auto g = grid_layout(mesh);
+std::size_t grid_for_each_vertex(const TriangleMesh& mesh, const GridLayout& g,
+                                 const ShapeIndexOptions& options, const std::vector<Vec3>& normals,
+                                 const ProgressFn& progress, const VertexFn& body) {
+    const bool disk = disk_applies(mesh, options);
+    const GridLayout* disk_grid = disk ? &g : nullptr;
     tbb::enumerable_thread_specific<GridScratch> scratch;
     tbb::enumerable_thread_specific<std::size_t> fallbacks(0);
-    const int tile_rows = (g.height + kTile - 1) / kTile, tile_cols = (g.width + kTile - 1) / kTile;
+    const int tile = disk ? g.disk_tile : kTile;
+    const int tile_rows = (g.height + tile - 1) / tile, tile_cols = (g.width + tile - 1) / tile;
     for (int tr = 0; tr < tile_rows; ++tr) {
         tbb::parallel_for(tbb::blocked_range<int>(0, tile_cols, 1), [&](const auto& r) {
             for (int tc = r.begin(); tc < r.end(); ++tc)
-                grid_tile(mesh, g, normals, options, tr * kTile, tc * kTile, scratch.local(),
-                          fallbacks.local(), body);
+                (disk ? disk_tile : grid_tile)(mesh, g, normals, options, tr * tile, tc * tile,
+                                               scratch.local(), fallbacks.local(), body);
         });
         report_progress(progress, double(tr + 1) / tile_rows, "shape index");
     }
@@ -645,7 +600,8 @@ std::size_t grid_for_each_vertex(const TriangleMesh& mesh, const ShapeIndexOptio
             const auto v = unowned[i];
             PrincipalCurvatures k;
             double scale = 0;
-            const bool ok = mesh_fit(mesh, v, normals[std::size_t(v)], options, s.mesh, k, scale);
+            const bool ok =
+                mesh_fit(mesh, v, normals[std::size_t(v)], options, disk_grid, s.mesh, k, scale);
             body(v, ok, k, scale);
         }
     });
@@ -660,10 +616,14 @@ void for_each_vertex(const TriangleMesh& mesh, const ShapeIndexOptions& options,
     if (options.radius < 0 || !std::isfinite(options.radius))
         throw Error("field", "--radius must be a positive number of metres");
     const auto normals = vertex_normals(mesh);
-    if (grid_applies(mesh, options)) {
-        grid_for_each_vertex(mesh, options, normals, progress, body);
+    const bool grid = grid_applies(mesh, options), disk = disk_applies(mesh, options);
+    GridLayout layout;
+    if (grid || disk) layout = grid_layout(mesh);
+    if (grid) {
+        grid_for_each_vertex(mesh, layout, options, normals, progress, body);
         return;
     }
+    const GridLayout* disk_grid = disk ? &layout : nullptr;
     const auto n = static_cast<std::int32_t>(mesh.vertex_count());
     tbb::enumerable_thread_specific<Scratch> scratch;
     const std::int32_t chunk = 1 << 16;
@@ -674,7 +634,7 @@ void for_each_vertex(const TriangleMesh& mesh, const ShapeIndexOptions& options,
             for (std::int32_t v = r.begin(); v < r.end(); ++v) {
                 PrincipalCurvatures k;
                 double scale = 0;
-                const bool ok = mesh_fit(mesh, v, normals[v], options, s, k, scale);
+                const bool ok = mesh_fit(mesh, v, normals[v], options, disk_grid, s, k, scale);
                 body(v, ok, k, scale);
             }
         });
@@ -683,6 +643,9 @@ void for_each_vertex(const TriangleMesh& mesh, const ShapeIndexOptions& options,
 }
 
 }  // namespace
+}  // namespace detail
+
+using namespace detail;
 
 double shape_index(double k1, double k2) {
     if (k1 < k2) std::swap(k1, k2);
@@ -692,6 +655,11 @@ double shape_index(double k1, double k2) {
 
 const char* shape_index_method(const TriangleMesh& mesh, const ShapeIndexOptions& options) {
     return grid_applies(mesh, options) ? "grid" : "mesh";
+}
+
+const char* shape_index_window(const TriangleMesh& mesh, const ShapeIndexOptions& options) {
+    if (!(options.radius > 0)) return "rings";
+    return disk_applies(mesh, options) ? "disk" : "ball";
 }
 
 std::vector<PrincipalCurvatures> principal_curvatures(const TriangleMesh& mesh,

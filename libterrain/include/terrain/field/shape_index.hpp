@@ -13,10 +13,19 @@
 namespace terrain::field {
 
 // How the neighbourhood sums are made. mesh: per vertex over its gathered neighbours (cost
-// grows with their number). grid (meshes made from a DEM, with a radius): from per-row prefix
-// sums of the pixels' moments, a window row costing the same whatever its length
-// (docs/field.md, "The grid method"). automatic: grid when it applies, else mesh.
+// grows with their number). grid (meshes made from a DEM, with a radius): from sums of the
+// pixels' moments over tiles of the grid, summed-area tables for the disk window and row sums
+// for the ball (docs/field.md). automatic: grid when it applies, else mesh.
 enum class ShapeIndexMethod { automatic, mesh, grid };
+
+// The window of a --radius neighbourhood on a mesh made from a DEM (meshes read from files
+// always take the ball). disk: the pixels whose ground offset from the vertex, lifted onto its
+// tangent plane, is within the radius (a disk on flat ground), drawn on the grid as six bands
+// of rows, with a Monge fit over the horizontal plane; by the grid method its sums come from
+// summed-area tables at a cost that does not grow with the radius. ball: the vertices within
+// the radius in 3-D, reached through vertices within it, with the tangent-frame fit
+// (docs/field.md, "Windows and methods").
+enum class ShapeIndexWindow { disk, ball };
 
 struct ShapeIndexOptions {
     int rings = 2;      // neighbourhood: vertices within this many mesh edges
@@ -24,11 +33,15 @@ struct ShapeIndexOptions {
     // Curvedness times the mean neighbour distance below this is a planar point (SI 0).
     double planar_curvedness = 1e-4;
     ShapeIndexMethod method = ShapeIndexMethod::automatic;
+    ShapeIndexWindow window = ShapeIndexWindow::disk;
 };
 
 // The method shape_index_field takes for this mesh and these options: "grid" or "mesh".
 // Throws terrain::Error when `grid` is asked for a mesh not made from a DEM.
 const char* shape_index_method(const TriangleMesh& mesh, const ShapeIndexOptions& options);
+
+// The neighbourhood shape_index_field takes: "rings", "disk" or "ball".
+const char* shape_index_window(const TriangleMesh& mesh, const ShapeIndexOptions& options);
 
 struct PrincipalCurvatures {
     double k1 = 0, k2 = 0;  // k1 >= k2, positive where the surface is convex (a cap)

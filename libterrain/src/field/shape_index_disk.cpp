@@ -1,0 +1,412 @@
+// The disk window of --radius on DEM meshes (docs/field.md, "The disk window"): its shape
+// on the grid, its Monge fit, and its sums from per-tile summed-area tables.
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <numbers>
+#include <optional>
+
+#include "shape_index_fit.hpp"
+
+namespace terrain::field::detail {
+namespace {
+
+constexpr double kMaxDiskPixels = 1 << 20;
+
+// floor and ceil of |x| <= kMaxDiskPixels, without a call into libm.
+int ifloor(double x) {
+    const int i = int(x);
+    return i - (x < i);
+}
+int iceil(double x) {
+    const int i = int(x);
+    return i + (x > i);
+}
+
+// The window {a x^2 + 2 b x y + c y^2 <= 1} of pixel offsets (x columns, y rows).
+DiskWindow ellipse_window(double a, double b, double c) {
+    // sqrt(1 - m^2) at the middles m = 1/6, 1/2, 5/6 of the thirds of the half-height.
+    static constexpr double kWidth[3] = {0.98601329718326935, 0.86602540378443865,
+                                         0.55277079839256660};
+    DiskWindow d;
+    const double det = a * c - b * b;
+    if (!(a > 0) || !(det > 0)) return d;
+    const auto clamp = [](double x) { return std::clamp(x, -kMaxDiskPixels, kMaxDiskPixels); };
+    // At row y the ellipse spans the columns -b y / a +- sqrt(a - det y^2) / a; its
+    // half-height is sqrt(a / det), so at y = m sqrt(a / det) the half-width is
+    // sqrt(1 - m^2) / sqrt(a).
+    const double height = clamp(std::sqrt(a / det)), width = 1 / std::sqrt(a), shear = -b / a;
+    for (int side : {1, -1}) {
+        int previous = side > 0 ? -1 : 0;  // the row 0 band is on the + side
+        for (int k = 0; k < 3; ++k) {
+            const int hi = ifloor(height * (k + 1) / 3);
+            if (hi <= previous) continue;
+            const double centre = side * shear * height * (k + 0.5) / 3;
+            const double half = kWidth[k] * width;
+            DiskWindow::Band band;
+            band.row_lo = side > 0 ? previous + 1 : -hi;
+            band.row_hi = side > 0 ? hi : -(previous + 1);
+            band.col_lo = iceil(clamp(centre - half));
+            band.col_hi = ifloor(clamp(centre + half));
+            previous = hi;
+            if (band.col_lo > band.col_hi) continue;
+            d.band[std::size_t(d.bands++)] = band;
+            d.reach_x = std::max({d.reach_x, -band.col_lo, band.col_hi});
+            d.reach_y = std::max(d.reach_y, hi);
+        }
+    }
+    return d;
+}
+
+// The ground (horizontal: across `up`) offsets between pixel centres along columns and rows
+// at vertex v; each from
+// the vertices of the pixels on both sides (or one), or square to the other when neither has
+// one.
+struct GroundSpacing {
+    Vec3 up{0, 0, 1}, col{0, 0, 0}, row{0, 0, 0};
+    bool ok = false;
+};
+
+GroundSpacing ground_spacing(const TriangleMesh& mesh, const GridLayout& g, std::int32_t v,
+                             const Vec3& up) {
+    const auto pixel = mesh.vertex_pixel[std::size_t(v)];
+    const int col = pixel % g.width, row = pixel / g.width;
+    GroundSpacing out;
+    out.up = up;
+    const auto at = [&](int c, int r) -> std::int32_t {
+        if (r < 0 || r >= g.height) return -1;
+        if (c < 0 || c >= g.width) {
+            if (!g.seam) return -1;
+            c = (c + g.width) % g.width;
+        }
+        return g.pixel_vertex[std::size_t(r) * std::size_t(g.width) + std::size_t(c)];
+    };
+    const auto horizontal = [&](std::int32_t to, std::int32_t from, double share) {
+        const Vec3 d = sub(mesh.positions[std::size_t(to)], mesh.positions[std::size_t(from)]);
+        const double along = dot(d, up);
+        return Vec3{(d[0] - along * up[0]) * share, (d[1] - along * up[1]) * share,
+                    (d[2] - along * up[2]) * share};
+    };
+    const auto spacing = [&](int dc, int dr, Vec3& out_spacing) {
+        const auto before = at(col - dc, row - dr), after = at(col + dc, row + dr);
+        if (before >= 0 && after >= 0)
+            out_spacing = horizontal(after, before, 0.5);
+        else if (after >= 0)
+            out_spacing = horizontal(after, v, 1.0);
+        else if (before >= 0)
+            out_spacing = horizontal(v, before, 1.0);
+        else
+            return false;
+        return true;
+    };
+    const bool has_col = spacing(1, 0, out.col), has_row = spacing(0, 1, out.row);
+    // Columns run east and rows south on a north-up grid: col = up x row, row = col x up.
+    if (has_col && !has_row) out.row = cross(out.col, up);
+    if (has_row && !has_col) out.col = cross(up, out.row);
+    out.ok = has_col || has_row;
+    return out;
+}
+
+// The disk window of vertex v for a radius in metres (empty when no neighbouring pixel has
+// a vertex). The tangent plane it is lifted onto is the window's: the slope between the
+// pixels half the radius away on each side along columns and rows (clipped to the grid),
+// which on rough terrain follows the ball's footprint better than the vertex's own normal.
+DiskWindow vertex_disk(const TriangleMesh& mesh, const GridLayout& g, std::int32_t v,
+                       const Vec3& normal, const Vec3& up, double radius) {
+    const auto s = ground_spacing(mesh, g, v, up);
+    if (!s.ok) return {};
+    const auto pixel = mesh.vertex_pixel[std::size_t(v)];
+    const int col = pixel % g.width, row = pixel / g.width;
+    const auto at = [&](int c, int r) -> std::int32_t {
+        if (r < 0 || r >= g.height) return -1;
+        if (c < 0 || c >= g.width) {
+            if (!g.seam) return -1;
+            c = ((c % g.width) + g.width) % g.width;
+        }
+        return g.pixel_vertex[std::size_t(r) * std::size_t(g.width) + std::size_t(c)];
+    };
+    // The rise along the ground offset `step` (pixels dc, dr) over the window's half-width.
+    const auto rise = [&](const Vec3& spacing, int dc, int dr) -> std::optional<double> {
+        const double length = std::sqrt(dot(spacing, spacing));
+        if (!(length > 0)) return std::nullopt;
+        const int k = int(std::clamp(0.5 * radius / length + 0.5, 1.0, 64.0));
+        for (int j = k; j >= 1; --j) {
+            const auto a = at(col - j * dc, row - j * dr), b = at(col + j * dc, row + j * dr);
+            if (a < 0 || b < 0) continue;
+            const Vec3 d = sub(mesh.positions[std::size_t(b)], mesh.positions[std::size_t(a)]);
+            return dot(d, s.up) / (2.0 * j);
+        }
+        return std::nullopt;
+    };
+    // The vertical rise per pixel step along columns and rows; the vertex normal's where the
+    // pixels on both sides are missing.
+    const double nup = std::max(0.2, dot(normal, s.up));
+    const double uc = rise(s.col, 1, 0).value_or(-dot(normal, s.col) / nup);
+    const double ur = rise(s.row, 0, 1).value_or(-dot(normal, s.row) / nup);
+    const double r2 = radius * radius;
+    return ellipse_window((dot(s.col, s.col) + uc * uc) / r2, (dot(s.col, s.row) + uc * ur) / r2,
+                          (dot(s.row, s.row) + ur * ur) / r2);
+}
+
+// The disk neighbourhood of v on the mesh: the vertices whose pixels are in its window (a
+// global grid's columns wrap), reached through vertices whose pixels are.
+void gather_disk(const TriangleMesh& mesh, const GridLayout& g, std::int32_t v,
+                 const DiskWindow& disk, Scratch& s) {
+    const int W = g.width;
+    const auto pv = mesh.vertex_pixel[std::size_t(v)];
+    const int cv = pv % W, rv = pv / W;
+    gather_where(
+        mesh, v, -1,
+        [&](std::int32_t w) {
+            const auto pw = mesh.vertex_pixel[std::size_t(w)];
+            int dc = pw % W - cv;
+            if (g.seam) {
+                dc = ((dc % W) + W) % W;
+                if (dc > W / 2) dc -= W;
+            }
+            return disk.contains(dc, pw / W - rv);
+        },
+        s);
+}
+
+// ---------------------------------------------------------------------------------------------
+// The disk window's fit. A DEM is a graph over its grid, so with the disk window the fit is
+// the Monge patch h = a u^2 + b uv + c v^2 + d u + e v of the vertex's neighbours over the
+// horizontal plane of its tile's frame (u, v across the vertical `up` of the tile's first
+// vertex, h along it; offsets from the vertex); the principal curvatures come from the same
+// fundamental forms. Its normal equations need 22 moments: sum u^i v^j (i + j <= 4),
+// sum h u^i v^j (i + j <= 2) and sum h^2 (for the neighbours' mean distance). Unlike the
+// tangent frame's 35, they need no turning into each vertex's own frame.
+struct MongeFrame {
+    Vec3 e1{1, 0, 0}, e2{0, 1, 0}, up{0, 0, 1};
+};
+
+constexpr int kMonge = 22;
+
+// Index of sum u^i v^j (i + j <= 4) and of sum h u^i v^j (i + j <= 2), and of sum h^2.
+constexpr int uv_index(int i, int j) {
+    const int d = i + j;
+    return d * (d + 1) / 2 + j;
+}
+constexpr int huv_index(int i, int j) {
+    return 15 + uv_index(i, j);
+}
+constexpr int kHH = 21;
+
+// The tile frame of the tile holding pixel (col, row): its up is the body's radial direction
+// (the z axis in a map frame) at the tile's first vertex.
+MongeFrame tile_frame(const TriangleMesh& mesh, const GridLayout& g, int col, int row) {
+    MongeFrame f;
+    if (mesh.frame != MeshFrame::body) return f;
+    const int t = g.disk_tile;
+    const int r0 = row / t * t, c0 = col / t * t;
+    const int r1 = std::min(g.height, r0 + t), c1 = std::min(g.width, c0 + t);
+    for (int r = r0; r < r1; ++r)
+        for (int c = c0; c < c1; ++c)
+            if (const auto v =
+                    g.pixel_vertex[std::size_t(r) * std::size_t(g.width) + std::size_t(c)];
+                v >= 0) {
+                const auto& p = mesh.positions[std::size_t(v)];
+                f.up = normalized(
+                    {mesh.origin[0] + p[0], mesh.origin[1] + p[1], mesh.origin[2] + p[2]});
+                const auto [t1, t2] = tangent_frame(f.up);
+                f.e1 = t1, f.e2 = t2;
+                return f;
+            }
+    return f;
+}
+
+// The 22 monomials of the offset d in the frame.
+void monge_monomials(const MongeFrame& f, const Vec3& d, double* out) {
+    const double u = dot(d, f.e1), v = dot(d, f.e2), h = dot(d, f.up);
+    const double pu[5] = {1, u, u * u, u * u * u, u * u * u * u};
+    const double pv[5] = {1, v, v * v, v * v * v, v * v * v * v};
+#pragma GCC unroll 5
+    for (int deg = 0; deg <= 4; ++deg)
+#pragma GCC unroll 5
+        for (int j = 0; j <= deg; ++j) out[uv_index(deg - j, j)] = pu[deg - j] * pv[j];
+#pragma GCC unroll 6
+    for (int k = 0; k < 6; ++k) out[15 + k] = h * out[k];
+    out[kHH] = h * h;
+}
+
+// Moving the moments by (u0, v0) is a Taylor shift of each chain of moments that differ only
+// in the u (or v) exponent: M[e] -= u0 M[e - 1] for step = 1..n, e = n down to step. The
+// steps (axis, target, source) in order: u then v, for the 15 sum u^i v^j (n = 4 - the other
+// exponent) and the 6 sum h u^i v^j (n = 2 - the other exponent), 48 in all.
+struct MongeStep {
+    std::uint8_t axis, target, source;
+};
+constexpr int kMongeSteps = 48;
+constexpr std::array<MongeStep, kMongeSteps> kMongeShift = [] {
+    std::array<MongeStep, kMongeSteps> steps{};
+    int k = 0;
+    for (int axis = 0; axis < 2; ++axis)
+        for (int group = 0; group < 2; ++group) {
+            const int top = group == 0 ? 4 : 2;
+            const auto at = [&](int e, int other) {
+                const int i = axis == 0 ? e : other, j = axis == 0 ? other : e;
+                return group == 0 ? uv_index(i, j) : huv_index(i, j);
+            };
+            for (int other = 0; other <= top; ++other) {
+                const int n = top - other;
+                for (int step = 1; step <= n; ++step)
+                    for (int e = n; e >= step; --e)
+                        steps[std::size_t(k++)] = {std::uint8_t(axis), std::uint8_t(at(e, other)),
+                                                   std::uint8_t(at(e - 1, other))};
+            }
+        }
+    return steps;
+}();
+
+// Moves moments about the tile's reference to moments about the vertex at offset (u0, v0,
+// h0) from it.
+void monge_shift(double* m, double u0, double v0, double h0) {
+    const double t[2] = {u0, v0};
+#pragma GCC unroll 48
+    for (const auto& step : kMongeShift) m[step.target] -= t[step.axis] * m[step.source];
+    // sum (h - h0)^2 and sum (h - h0) u^i v^j.
+    m[kHH] += h0 * (h0 * m[uv_index(0, 0)] - 2 * m[huv_index(0, 0)]);
+#pragma GCC unroll 6
+    for (int k = 0; k < 6; ++k) m[15 + k] -= h0 * m[k];
+}
+
+// The normal equations of the Monge fit from the moments about the vertex.
+NormalEquations monge_equations(const double* m) {
+    NormalEquations e;
+    auto& a = e.ata;
+    a[0][0] = m[uv_index(4, 0)];
+    a[1][0] = m[uv_index(3, 1)], a[1][1] = m[uv_index(2, 2)];
+    a[2][0] = m[uv_index(2, 2)], a[2][1] = m[uv_index(1, 3)], a[2][2] = m[uv_index(0, 4)];
+    a[3][0] = m[uv_index(3, 0)], a[3][1] = m[uv_index(2, 1)], a[3][2] = m[uv_index(1, 2)],
+    a[3][3] = m[uv_index(2, 0)];
+    a[4][0] = m[uv_index(2, 1)], a[4][1] = m[uv_index(1, 2)], a[4][2] = m[uv_index(0, 3)],
+    a[4][3] = m[uv_index(1, 1)], a[4][4] = m[uv_index(0, 2)];
+    e.atb = {m[huv_index(2, 0)], m[huv_index(1, 1)], m[huv_index(0, 2)], m[huv_index(1, 0)],
+             m[huv_index(0, 1)]};
+    const double count = m[0] - 1;  // the vertex itself is in its window, at d = 0
+    e.m = count > 0 ? std::size_t(std::llround(count)) : 0;
+    // The mean neighbour distance, as the grid method of the ball takes it.
+    const double sum2 = m[uv_index(2, 0)] + m[uv_index(0, 2)] + m[kHH];
+    e.scale =
+        count > 0 ? std::sqrt(std::max(0.0, sum2) / count) * (2 * std::numbers::sqrt2 / 3) : 0.0;
+    return e;
+}
+
+}  // namespace
+
+// The disk window of v in its tile's frame, gathered on the mesh, and its Monge fit.
+bool disk_mesh_fit(const TriangleMesh& mesh, const GridLayout& g, std::int32_t v,
+                   const Vec3& normal, double radius, Scratch& s, PrincipalCurvatures& k,
+                   double& scale) {
+    const auto pixel = mesh.vertex_pixel[std::size_t(v)];
+    const auto frame = tile_frame(mesh, g, pixel % g.width, pixel / g.width);
+    gather_disk(mesh, g, v, vertex_disk(mesh, g, v, normal, frame.up, radius), s);
+    double m[kMonge] = {};
+    double mono[kMonge];
+    const auto& centre = mesh.positions[std::size_t(v)];
+    for (const auto w : s.gathered) {
+        monge_monomials(frame, sub(mesh.positions[std::size_t(w)], centre), mono);
+        for (int i = 0; i < kMonge; ++i) m[i] += mono[i];
+    }
+    const auto e = monge_equations(m);
+    scale = e.scale;
+    return solve_curvatures(e, k);
+}
+
+// The vertices of one tile of output pixels [c0, c0 + t) x [r0, r0 + t), t = g.disk_tile,
+// with the disk window: the region's row sums of the 22 Monge moments are summed down the rows too
+// (summed-area tables), so that each of a window's six bands costs four look-ups whatever
+// its size.
+void disk_tile(const TriangleMesh& mesh, const GridLayout& g, const std::vector<Vec3>& normals,
+               const ShapeIndexOptions& options, int r0, int c0, GridScratch& s,
+               std::size_t& mesh_fallbacks, const VertexFn& body) {
+    const int W = g.width, H = g.height;
+    const int tile = g.disk_tile;
+    const int r1 = std::min(H, r0 + tile), c1 = std::min(W, c0 + tile);
+    const auto vertex_at = [&](int col, int row) {
+        return g.pixel_vertex[std::size_t(row) * std::size_t(W) + std::size_t(col)];
+    };
+    const auto fallback = [&](std::int32_t v) {
+        PrincipalCurvatures k;
+        double scale = 0;
+        const bool ok = mesh_fit(mesh, v, normals[std::size_t(v)], options, &g, s.mesh, k, scale);
+        body(v, ok, k, scale);
+        ++mesh_fallbacks;
+    };
+    const auto frame = tile_frame(mesh, g, c0, r0);
+    // Each vertex's window, and the margins the windows the tables can hold need.
+    s.disks.resize(std::size_t(tile) * std::size_t(tile));  // set below where a vertex is
+    const auto disk_of = [&](int col, int row) -> DiskWindow& {
+        return s.disks[std::size_t(row - r0) * std::size_t(tile) + std::size_t(col - c0)];
+    };
+    int mx = 0, my = 0;
+    for (int row = r0; row < r1; ++row)
+        for (int col = c0; col < c1; ++col)
+            if (const auto v = vertex_at(col, row); v >= 0) {
+                const auto& d = disk_of(col, row) =
+                    vertex_disk(mesh, g, v, normals[std::size_t(v)], frame.up, options.radius);
+                if (d.reach_x <= kMaxReach && d.reach_y <= kMaxReach)
+                    mx = std::max(mx, d.reach_x), my = std::max(my, d.reach_y);
+            }
+    Region region;
+    const auto status =
+        region_sums<kMonge>(mesh, g, r0, r1, c0, c1, mx, my, false, s, region,
+                            [&](const Vec3& d, double* out) { monge_monomials(frame, d, out); });
+    if (status == RegionStatus::empty) return;
+    if (status == RegionStatus::mesh_path) {
+        for (int row = r0; row < r1; ++row)
+            for (int col = c0; col < c1; ++col)
+                if (const auto v = vertex_at(col, row); v >= 0) fallback(v);
+        return;
+    }
+    const int rows = region.rows, cols = region.cols;
+    const std::size_t stride = std::size_t(cols + 1) * kMonge;
+    for (int lr = 1; lr < rows; ++lr) {
+        const double* above = &s.prefix[std::size_t(lr - 1) * stride];
+        double* here = &s.prefix[std::size_t(lr) * stride];
+        for (std::size_t k = 0; k < stride; ++k) here[k] += above[k];
+    }
+    // Adds the sums over rows [ra, rb] and columns [ca, cb] of the region (clipped to it).
+    const auto add_rectangle = [&](double* moments, int ra, int rb, int ca, int cb) {
+        ra = std::max(ra, 0), rb = std::min(rb, rows - 1);
+        ca = std::max(ca, 0), cb = std::min(cb, cols - 1);
+        if (ra > rb || ca > cb) return;
+        const double* b0 = &s.prefix[std::size_t(rb) * stride + std::size_t(ca) * kMonge];
+        const double* b1 = &s.prefix[std::size_t(rb) * stride + std::size_t(cb + 1) * kMonge];
+        if (ra == 0) {
+            for (int k = 0; k < kMonge; ++k) moments[k] += b1[k] - b0[k];
+            return;
+        }
+        const double* a0 = &s.prefix[std::size_t(ra - 1) * stride + std::size_t(ca) * kMonge];
+        const double* a1 = &s.prefix[std::size_t(ra - 1) * stride + std::size_t(cb + 1) * kMonge];
+        for (int k = 0; k < kMonge; ++k) moments[k] += (b1[k] - b0[k]) - (a1[k] - a0[k]);
+    };
+    for (int row = r0; row < r1; ++row)
+        for (int col = c0; col < c1; ++col) {
+            const auto v = vertex_at(col, row);
+            if (v < 0) continue;
+            const DiskWindow& d = disk_of(col, row);
+            // Beyond the margins (a window wider than kMaxReach): the mesh path.
+            if (d.reach_x > mx || d.reach_y > my) {
+                fallback(v);
+                continue;
+            }
+            const int lr = row - region.rr0, lc = col - region.cc0;
+            double moments[kMonge] = {};
+            for (int k = 0; k < d.bands; ++k) {
+                const auto& b = d.band[std::size_t(k)];
+                add_rectangle(moments, lr + b.row_lo, lr + b.row_hi, lc + b.col_lo, lc + b.col_hi);
+            }
+            const auto& p = mesh.positions[std::size_t(v)];
+            const Vec3 t{p[0] - region.ref[0], p[1] - region.ref[1], p[2] - region.ref[2]};
+            monge_shift(moments, dot(t, frame.e1), dot(t, frame.e2), dot(t, frame.up));
+            PrincipalCurvatures k;
+            const auto equations = monge_equations(moments);
+            const bool fitted = solve_curvatures(equations, k);
+            body(v, fitted, k, equations.scale);
+        }
+}
+
+}  // namespace terrain::field::detail

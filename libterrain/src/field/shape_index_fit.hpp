@@ -1,0 +1,224 @@
+#pragma once
+// Internals shared by the shape index's methods, not installed: shape_index.cpp (the mesh
+// method, and the grid method of the ball window) and shape_index_disk.cpp (the disk
+// window). docs/field.md describes them.
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <functional>
+#include <limits>
+#include <vector>
+
+#include "terrain/field/shape_index.hpp"
+
+namespace terrain::field::detail {
+
+using Vec3 = std::array<double, 3>;
+
+inline Vec3 sub(const std::array<float, 3>& a, const std::array<float, 3>& b) {
+    return {double(a[0]) - b[0], double(a[1]) - b[1], double(a[2]) - b[2]};
+}
+inline Vec3 cross(const Vec3& a, const Vec3& b) {
+    return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+}
+inline double dot(const Vec3& a, const Vec3& b) {
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+inline Vec3 normalized(const Vec3& a) {
+    const double n = std::sqrt(dot(a, a));
+    return n > 0 ? Vec3{a[0] / n, a[1] / n, a[2] / n} : Vec3{0, 0, 1};
+}
+
+struct Scratch {
+    std::vector<std::uint32_t> stamp;
+    std::uint32_t current = 0;
+    std::vector<std::int32_t> gathered;
+};
+
+// The neighbourhood of v (gathered[0] is v itself): the vertices `inside` takes, reached
+// from v through vertices it takes, within `rings` rings of mesh edges (< 0: any number).
+template <class Inside>
+void gather_where(const TriangleMesh& mesh, std::int32_t v, int rings, const Inside& inside,
+                  Scratch& s) {
+    if (s.stamp.size() != mesh.vertex_count()) s.stamp.assign(mesh.vertex_count(), 0);
+    if (++s.current == 0) {
+        std::fill(s.stamp.begin(), s.stamp.end(), 0);
+        s.current = 1;
+    }
+    s.gathered.clear();
+    s.stamp[v] = s.current;
+    std::size_t begin = 0;
+    s.gathered.push_back(v);
+    for (int ring = 0; rings < 0 || ring < rings; ++ring) {
+        const std::size_t end = s.gathered.size();
+        if (begin == end) break;
+        for (std::size_t i = begin; i < end; ++i) {
+            const auto u = s.gathered[i];
+            for (auto k = mesh.neighbor_offsets[u]; k < mesh.neighbor_offsets[u + 1]; ++k) {
+                const auto w = mesh.neighbors[k];
+                if (s.stamp[w] == s.current) continue;
+                s.stamp[w] = s.current;
+                if (inside(w)) s.gathered.push_back(w);
+            }
+        }
+        begin = end;
+    }
+}
+
+struct GridLayout {
+    int width = 0, height = 0;
+    bool seam = false;
+    std::vector<std::int32_t> pixel_vertex;  // the vertex a pixel owns, or -1
+    int disk_tile = 64;                      // pixels per side of the disk window's tiles
+};
+
+// The disk window's tiles span at most this angle on the body: its fit is made in one frame
+// per tile, from moments about the tile's first vertex, whose precision falls with the
+// distance of a vertex from it.
+constexpr double kMaxDiskTileAngle = 0.05;  // radians
+
+constexpr int kTile = 64;       // output pixels per tile side
+constexpr int kMaxReach = 128;  // a window reaching further (pixels) takes the mesh path
+
+// The vertex a pixel owns (-1 where none, and on collapsed pole rows), the grid's seam and
+// the disk window's tile size.
+GridLayout grid_layout(const TriangleMesh& mesh);
+
+// The disk window: the pixels whose ground offset from the vertex, lifted onto the vertex's
+// tangent plane, is within the radius (the ball's footprint where the terrain is its tangent
+// plane: an ellipse of the grid, a disk on flat ground). It is drawn as three bands of rows
+// on each side of the vertex's row, each band covering a third of the ellipse's half-height
+// with the columns the ellipse spans at the band's middle row (the band's area is the
+// ellipse's, within 2 %): six rectangles, which the grid method sums from summed-area tables
+// in four look-ups each whatever their size.
+struct DiskWindow {
+    struct Band {
+        int row_lo = 0, row_hi = -1, col_lo = 0, col_hi = -1;  // offsets from the vertex
+    };
+    int bands = 0;
+    std::array<Band, 6> band{};
+    int reach_x = 0, reach_y = 0;  // the largest |column| and |row| offsets
+    bool contains(int dx, int dy) const {
+        for (int k = 0; k < bands; ++k) {
+            const auto& b = band[std::size_t(k)];
+            if (dy >= b.row_lo && dy <= b.row_hi) return dx >= b.col_lo && dx <= b.col_hi;
+        }
+        return false;
+    }
+};
+
+// The normal equations of the fit h = a u^2 + b uv + c v^2 (+ d u + e v) in raw tangent
+// coordinates (lower triangles of ata), the neighbour count m and their mean distance.
+struct NormalEquations {
+    std::array<std::array<double, 5>, 5> ata{};
+    std::array<double, 5> atb{};
+    std::size_t m = 0;
+    double scale = 0;
+};
+
+// Solves the fit (coordinates divided by e.scale) and returns the principal curvatures in
+// units of 1/scale; false when the neighbourhood is too small.
+bool solve_curvatures(NormalEquations e, PrincipalCurvatures& out);
+
+// The tangent frame (t1, t2) of a vertex normal.
+std::array<Vec3, 2> tangent_frame(const Vec3& normal);
+
+// The mesh path for one vertex: gather its neighbourhood on the mesh and fit. With
+// `disk_grid` (the disk window applies) the neighbourhood is the vertex's disk, except at a
+// collapsed pole, whose pixel is no place on the ground: it takes the ball.
+bool mesh_fit(const TriangleMesh& mesh, std::int32_t v, const Vec3& normal,
+              const ShapeIndexOptions& options, const GridLayout* disk_grid, Scratch& s,
+              PrincipalCurvatures& k, double& scale);
+
+struct GridScratch {
+    std::vector<Vec3> position;     // region pixels; x NaN where no vertex
+    std::vector<double> prefix;     // per region row, (cols + 1) x kMoments running sums
+    std::vector<int> lo, hi;        // the current window's span in each row offset
+    std::vector<double> spacing;    // adjacent-pixel distances, to size the region
+    std::vector<DiskWindow> disks;  // the tile's vertices' disk windows
+    Scratch mesh;
+};
+
+using VertexFn = std::function<void(std::int32_t, bool, const PrincipalCurvatures&, double)>;
+
+// What a tile of pixels [c0, c1) x [r0, r1) works on: the tile and margins of mx columns
+// and my rows (rows clipped to the grid; columns clipped, or wrapped across the seam of a
+// global grid), its reference point (the tile's first vertex), and per region row the
+// running sums of the N monomials `fill` makes of its pixels' positions about the reference
+// (and the positions, when asked for).
+struct Region {
+    int rr0 = 0, cc0 = 0, rows = 0, cols = 0;
+    Vec3 ref{0, 0, 0};
+};
+enum class RegionStatus { ok, empty, mesh_path };
+
+template <int N, class Fill>
+RegionStatus region_sums(const TriangleMesh& mesh, const GridLayout& g, int r0, int r1, int c0,
+                         int c1, int mx, int my, bool positions, GridScratch& s, Region& out,
+                         const Fill& fill) {
+    const int W = g.width, H = g.height;
+    if (mx > kMaxReach || my > kMaxReach) return RegionStatus::mesh_path;
+    const auto vertex_at = [&](int col, int row) {
+        return g.pixel_vertex[std::size_t(row) * std::size_t(W) + std::size_t(col)];
+    };
+    const int rr0 = std::max(0, r0 - my), rr1 = std::min(H, r1 + my);
+    for (int row : mesh.pole_rows)
+        if (row >= rr0 && row < rr1) return RegionStatus::mesh_path;
+    int cc0 = c0 - mx, cc1 = c1 + mx;
+    if (g.seam) {
+        if (cc1 - cc0 > W) return RegionStatus::mesh_path;
+    } else {
+        cc0 = std::max(0, cc0), cc1 = std::min(W, cc1);
+    }
+    const int rows = rr1 - rr0, cols = cc1 - cc0;
+    const auto region_col = [&](int col) { return ((col % W) + W) % W; };
+    Vec3 ref{0, 0, 0};
+    bool any = false;
+    for (int row = r0; row < r1 && !any; ++row)
+        for (int col = c0; col < c1 && !any; ++col)
+            if (const auto v = vertex_at(col, row); v >= 0) {
+                const auto& p = mesh.positions[std::size_t(v)];
+                ref = {p[0], p[1], p[2]}, any = true;
+            }
+    if (!any) return RegionStatus::empty;
+    if (positions) s.position.resize(std::size_t(rows) * std::size_t(cols));
+    s.prefix.resize(std::size_t(rows) * std::size_t(cols + 1) * N);
+    for (int lr = 0; lr < rows; ++lr) {
+        double* running = &s.prefix[std::size_t(lr) * std::size_t(cols + 1) * N];
+        std::fill_n(running, N, 0.0);
+        for (int lc = 0; lc < cols; ++lc) {
+            const auto v = vertex_at(region_col(cc0 + lc), rr0 + lr);
+            Vec3 p{std::numeric_limits<double>::quiet_NaN(), 0, 0};
+            double* next = running + N;
+            if (v < 0) {
+                std::copy_n(running, N, next);
+            } else {
+                const auto& q = mesh.positions[std::size_t(v)];
+                p = {q[0], q[1], q[2]};
+                double mono[N];
+                fill(Vec3{p[0] - ref[0], p[1] - ref[1], p[2] - ref[2]}, mono);
+                for (int k = 0; k < N; ++k) next[k] = running[k] + mono[k];
+            }
+            if (positions) s.position[std::size_t(lr) * std::size_t(cols) + std::size_t(lc)] = p;
+            running = next;
+        }
+    }
+    out = {rr0, cc0, rows, cols, ref};
+    return RegionStatus::ok;
+}
+
+// The disk window of v in its tile's frame, gathered on the mesh, and its Monge fit
+// (shape_index_disk.cpp).
+bool disk_mesh_fit(const TriangleMesh& mesh, const GridLayout& g, std::int32_t v,
+                   const Vec3& normal, double radius, Scratch& s, PrincipalCurvatures& k,
+                   double& scale);
+
+// The vertices of one tile of output pixels [c0, c0 + t) x [r0, r0 + t), t = g.disk_tile,
+// with the disk window, through `body` (shape_index_disk.cpp).
+void disk_tile(const TriangleMesh& mesh, const GridLayout& g, const std::vector<Vec3>& normals,
+               const ShapeIndexOptions& options, int r0, int c0, GridScratch& s,
+               std::size_t& mesh_fallbacks, const VertexFn& body);
+
+}  // namespace terrain::field::detail
