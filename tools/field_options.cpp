@@ -17,14 +17,23 @@ void add_field_options(po::options_description& options, FieldOptionValues& valu
         "shape index: fit over the vertices within N mesh edges (1..10)")(
         "radius", po::value(&si.radius)->default_value(0.0),
         "shape index: fit over the vertices within M metres instead of rings (at most 20 "
-        "mean edge lengths)")("rays", po::value(&sdf.rays)->default_value(25),
-                              "sdf: rays per face (1..1000)")(
+        "mean edge lengths)")(
+        "window", po::value(&values.window)->default_value("disk"),
+        "shape index with --radius on a DEM: disk (the pixels within the radius on the ground; "
+        "costs the same whatever the radius) or ball (the vertices within the radius in 3-D)")(
+        "rays", po::value(&sdf.rays)->default_value(25), "sdf: rays per face (1..1000)")(
         "cone-angle", po::value(&values.cone_angle_degrees)->default_value(120.0),
         "sdf: opening of each face's cone of rays, degrees")(
         "no-postprocess", po::bool_switch(&values.no_postprocess),
         "sdf: no bilateral smoothing of the face values")(
         "allow-open", po::bool_switch(&sdf.allow_open),
         "sdf: compute on a mesh with holes (rays through them are lost)");
+}
+
+field::ShapeIndexWindow parse_window(const std::string& name) {
+    if (name == "disk") return field::ShapeIndexWindow::disk;
+    if (name == "ball") return field::ShapeIndexWindow::ball;
+    throw Error("options", "--window must be disk or ball, not '" + name + "'");
 }
 
 field::FieldOptions to_field_options(const FieldOptionValues& values, const po::variables_map& vm) {
@@ -36,6 +45,7 @@ field::FieldOptions to_field_options(const FieldOptionValues& values, const po::
         throw Error("options", "--rings must be between 1 and " + std::to_string(kMaxRings));
     if (!(out.shape_index.radius >= 0) || !std::isfinite(out.shape_index.radius))
         throw Error("options", "--radius must be a positive number of metres");
+    out.shape_index.window = parse_window(values.window);
     if (out.sdf.rays < 1 || out.sdf.rays > kMaxRays)
         throw Error("options", "--rays must be between 1 and " + std::to_string(kMaxRays));
     if (!(values.cone_angle_degrees > 0 && values.cone_angle_degrees < 180))

@@ -10,12 +10,13 @@ namespace terrain::cli {
 
 struct FieldOptionValues {
     std::string name = "shape-index";
+    std::string window = "disk";      // --window
     double cone_angle_degrees = 120;  // --cone-angle (the library takes radians)
     bool no_postprocess = false;
     field::FieldOptions options;
 };
 
-// Adds --field, --rings, --radius and the SDF's --rays, --cone-angle, --no-postprocess,
+// Adds --field, --rings, --radius, --window and the SDF's --rays, --cone-angle, --no-postprocess,
 // --allow-open bound to `values`.
 void add_field_options(po::options_description& options, FieldOptionValues& values);
 
@@ -23,6 +24,9 @@ void add_field_options(po::options_description& options, FieldOptionValues& valu
 constexpr int kMaxRings = 10;
 constexpr int kMaxRays = 1000;
 constexpr double kMaxRadiusEdges = 20;
+
+// The window --window names (disk or ball); throws terrain::Error for another name.
+field::ShapeIndexWindow parse_window(const std::string& name);
 
 // The library's options from the parsed values; throws UsageError for contradictions.
 field::FieldOptions to_field_options(const FieldOptionValues& values, const po::variables_map& vm);

@@ -37,6 +37,7 @@ pipeline::SegmentOptions to_pipeline_options(const FieldOptionValues& field,
     pipeline::SegmentOptions out;
     out.field = field.name;
     out.shape_index = field.options.shape_index;
+    out.shape_index.window = parse_window(field.window);
     out.rays = field.options.sdf.rays;
     out.cone_angle_degrees = field.cone_angle_degrees;
     out.postprocess = !field.no_postprocess;

@@ -387,6 +387,17 @@ PYBIND11_MODULE(_terrain, m) {
         .def_property(
             "radius", [](const pipeline::SegmentOptions& o) { return o.shape_index.radius; },
             [](pipeline::SegmentOptions& o, double v) { o.shape_index.radius = v; })
+        .def_property(
+            "window",
+            [](const pipeline::SegmentOptions& o) {
+                return o.shape_index.window == field::ShapeIndexWindow::disk ? "disk" : "ball";
+            },
+            [](pipeline::SegmentOptions& o, const std::string& v) {
+                if (v != "disk" && v != "ball")
+                    throw Error("options", "window must be disk or ball, not '" + v + "'");
+                o.shape_index.window =
+                    v == "disk" ? field::ShapeIndexWindow::disk : field::ShapeIndexWindow::ball;
+            })
         .def_readwrite("rays", &pipeline::SegmentOptions::rays)
         .def_readwrite("cone_angle", &pipeline::SegmentOptions::cone_angle_degrees)
         .def_readwrite("postprocess", &pipeline::SegmentOptions::postprocess)

@@ -39,7 +39,7 @@ __all__ = [
 
 # The options of `terrain segment` (docs/cli.md), as keyword arguments.
 _SEGMENT_OPTIONS = (
-    "field", "rings", "radius", "rays", "cone_angle", "postprocess", "allow_open",
+    "field", "rings", "radius", "window", "rays", "cone_angle", "postprocess", "allow_open",
     "persistence", "area_ratio", "min_area", "cost", "saddle_penalty", "absorbed",
     "format",
 )
@@ -213,7 +213,7 @@ def segment(dem, geotransform=None, crs=None, *, progress=None, **options):
         elevations in metres (NaN = NoData) with its GDAL `geotransform` (6 numbers or an
         affine.Affine) and `crs` (WKT, "EPSG:32611", "IAU_2015:30100", or a CRS object).
     options (keywords, the command line's defaults): field="shape-index" (or "sdf",
-        "height"), rings=2, radius=0, rays=25, cone_angle=120, postprocess=True,
+        "height"), rings=2, radius=0, window="disk" (or "ball"; docs/field.md), rays=25, cone_angle=120, postprocess=True,
         allow_open=False, persistence=10, area_ratio=0.5 (percent) or min_area (an area on
         the body: m^2 as a number, or "5km2", "2000m2", "3ha"; an arc is cancelled when its
         area is below it, whatever the tile's extent), cost="auto" ("graph",
@@ -296,12 +296,13 @@ def sweep(dem, geotransform=None, crs=None, *, area_ratios=None, min_areas=None,
     return SweepResult(native, native_options, _input_path(source))
 
 
-def shape_index(dem, geotransform=None, crs=None, *, rings=2, radius=0.0, progress=None,
-                **read):
+def shape_index(dem, geotransform=None, crs=None, *, rings=2, radius=0.0, window="disk",
+                progress=None, **read):
     """The shape index x100 (0 cup, 50 saddle or plane, 100 cap) of each DEM pixel, a 2-D
     float32 array (NaN = NoData), fitted over the vertices within `rings` mesh edges or
-    `radius` metres; per vertex (1-D) for a mesh file."""
-    options = {"field": "shape-index", "radius": radius, **read}
+    `radius` metres (window "disk": on the ground, or "ball": in 3-D); per vertex (1-D)
+    for a mesh file."""
+    options = {"field": "shape-index", "radius": radius, "window": window, **read}
     if not radius:
         options["rings"] = rings
     native_options, read = _split_options(options, _SEGMENT_OPTIONS)

@@ -204,3 +204,18 @@ def test_min_area_is_the_cli_and_an_area_ratio(cli, moon, tmp_path):
     assert np.array_equal(sweep.scales[0].labels, terrain.segment(moon, min_area="50km2").labels)
     graph = terrain.reeb_graph(moon, min_area="150km2")
     assert graph.critical_before > len(graph.nodes["node"])
+
+
+def test_window_is_the_cli_and_disk_by_default(cli, moon, tmp_path):
+    # --radius of about 4 pixels of the 7.6 km crop.
+    disk = terrain.shape_index(moon, radius=30000)
+    assert np.array_equal(disk, terrain.shape_index(moon, radius=30000, window="disk"))
+    ball = terrain.shape_index(moon, radius=30000, window="ball")
+    assert not np.array_equal(disk, ball)
+    out = tmp_path / "ball.tif"
+    assert cli("field", moon, "--radius", "30000", "--window", "ball", "-o", out,
+               "-q").returncode == 0
+    ds = gdal.Open(str(out))
+    assert np.array_equal(ball, ds.ReadAsArray(), equal_nan=True)
+    with pytest.raises(terrain.Error, match="window must be disk or ball"):
+        terrain.shape_index(moon, radius=30000, window="cube")

@@ -281,3 +281,54 @@ TEST_CASE("terrain field --field sdf: a mesh file round trip, open DEM tiles ref
     }
     CHECK(*std::max_element(values.begin(), values.end()) == 100);
 }
+
+TEST_CASE("terrain field and segment --window: disk by default with --radius, ball on request",
+          "[cli][field]") {
+    const auto dir = terrain::test::scratch_dir("cli_window");
+    terrain::test::RasterSpec spec;
+    spec.width = spec.height = 48;
+    spec.crs = "EPSG:32611";
+    spec.geotransform = {400000, 30, 0, 3800000, 0, -30};
+    for (int r = 0; r < 48; ++r)
+        for (int c = 0; c < 48; ++c)
+            spec.values.push_back(200 * std::sin(c * 0.21) * std::cos(r * 0.17) + 40 * c);
+    const auto dem = terrain::test::write_raster(dir / "dem.tif", spec);
+    GDALAllRegister();
+    const auto read = [](const std::string& path) {
+        std::unique_ptr<GDALDataset> ds(GDALDataset::Open(path.c_str(), GDAL_OF_RASTER));
+        REQUIRE(ds);
+        std::vector<float> values(48 * 48);
+        REQUIRE(ds->GetRasterBand(1)->RasterIO(GF_Read, 0, 0, 48, 48, values.data(), 48, 48,
+                                               GDT_Float32, 0, 0) == CE_None);
+        return values;
+    };
+    std::map<std::string, std::vector<float>> fields;
+    for (const std::string window : {"", "disk", "ball"}) {
+        const auto out = (dir / ("si_" + window + ".tif")).string();
+        std::vector<std::string> args{"field", dem, "--radius", "150", "-o", out, "-q"};
+        if (!window.empty()) args.insert(args.end(), {"--window", window});
+        const auto r = run_cli(args);
+        INFO(r.err);
+        REQUIRE(r.status == 0);
+        fields[window] = read(out);
+        for (float v : fields[window]) CHECK((v >= 0 && v <= 100));
+    }
+    CHECK(fields[""] == fields["disk"]);  // the default
+    CHECK(fields["disk"] != fields["ball"]);
+    // segment records the window it took in run.json.
+    for (const std::string window : {"disk", "ball"}) {
+        const auto out = (dir / ("seg_" + window)).string();
+        const auto r =
+            run_cli({"segment", dem, "--radius", "150", "--window", window, "-o", out, "-q"});
+        INFO(r.err);
+        REQUIRE(r.status == 0);
+        CPLJSONDocument run;
+        REQUIRE(run.Load(out + "/run.json"));
+        CHECK(run.GetRoot().GetString("parameters/shape_index_window") == window);
+    }
+    const auto bad = run_cli(
+        {"field", dem, "--radius", "150", "--window", "cube", "-o", (dir / "bad.tif").string()});
+    CHECK(bad.status == 1);
+    CHECK_THAT(bad.err, Contains("--window must be disk or ball"));
+    CHECK_FALSE(std::filesystem::exists(dir / "bad.tif"));
+}

@@ -313,9 +313,11 @@ std::vector<std::string> write_segment_directory(SegmentResult& result,
     out.preview_caption.field = options.field;
     auto& caption = out.preview_caption.parameters;
     if (options.field == "shape-index")
-        caption.push_back(options.shape_index.radius > 0
-                              ? "radius " + JsonWriter::number(options.shape_index.radius) + " m"
-                              : std::to_string(options.shape_index.rings) + " rings");
+        caption.push_back(
+            options.shape_index.radius > 0
+                ? "radius " + JsonWriter::number(options.shape_index.radius) + " m (" +
+                      field::shape_index_window(result.input.mesh, options.shape_index) + ")"
+                : std::to_string(options.shape_index.rings) + " rings");
     caption.push_back("persistence " + JsonWriter::number(options.simplify.persistence));
     caption.push_back(
         "area ratio " + JsonWriter::number(result.area_ratio_percent) + " %" +
@@ -380,7 +382,9 @@ void write_run_json(const SegmentResult& result, const std::string& input_path,
         .field("frame", to_string(result.input.mesh.frame));
     if (options.field == "shape-index")
         j.field("shape_index_method",
-                field::shape_index_method(result.input.mesh, options.shape_index));
+                field::shape_index_method(result.input.mesh, options.shape_index))
+            .field("shape_index_window",
+                   field::shape_index_window(result.input.mesh, options.shape_index));
     if (options.field == "sdf")
         j.field("rays", options.rays)
             .field("cone_angle_degrees", options.cone_angle_degrees)
