@@ -1,12 +1,15 @@
 #include "terrain/mesh/triangle_mesh.hpp"
 #include "../core/disjoint_sets.hpp"
 #include "../core/release.hpp"
+#include "terrain/core/error.hpp"
 
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <numeric>
+#include <string>
 
 namespace terrain {
 
@@ -57,6 +60,17 @@ void set_positions(TriangleMesh& mesh, const std::vector<std::array<double, 3>>&
             mesh.positions[v][k] = static_cast<float>(points[v][k] - mesh.origin[k]);
 }
 
+namespace {
+
+// Refuses a mesh whose per-corner lists would pass the 32-bit offsets that index them.
+void check_adjacency_size(std::uint64_t entries, const char* what) {
+    if (entries > std::uint64_t{UINT32_MAX})
+        throw Error("mesh", "the mesh has " + std::to_string(entries) + " " + what +
+                                ", more than 32-bit offsets can index: too large");
+}
+
+}  // namespace
+
 void finish_mesh(TriangleMesh& mesh) {
     const std::size_t n = mesh.positions.size();
     // Vertex areas: one third of each incident triangle (serial: the same sums every run).
@@ -68,13 +82,16 @@ void finish_mesh(TriangleMesh& mesh) {
     mesh.vertex_areas.assign(area.begin(), area.end());
     detail::release(area);
 
-    // CSR adjacency from the triangles' edges, each list sorted and without repeats.
-    std::vector<std::int32_t> offsets(n + 1, 0);
+    // CSR adjacency from the triangles' edges, each list sorted and without repeats. Before
+    // the repeats go there are two entries per triangle corner (12 per vertex of a grid,
+    // past 2^31 at 179 M vertices): 32-bit unsigned offsets, checked.
+    check_adjacency_size(6 * std::uint64_t{mesh.triangles.size()}, "triangle corners");
+    std::vector<std::uint32_t> offsets(n + 1, 0);
     for (const auto& t : mesh.triangles)
         for (int k = 0; k < 3; ++k) offsets[t[k] + 1] += 2;
     std::partial_sum(offsets.begin(), offsets.end(), offsets.begin());
     std::vector<std::int32_t> all(offsets.back());
-    std::vector<std::int32_t> fill(offsets.begin(), offsets.end() - 1);
+    std::vector<std::uint32_t> fill(offsets.begin(), offsets.end() - 1);
     for (const auto& t : mesh.triangles)
         for (int k = 0; k < 3; ++k) {
             all[fill[t[k]]++] = t[(k + 1) % 3];
@@ -88,6 +105,9 @@ void finish_mesh(TriangleMesh& mesh) {
         std::sort(begin, end);
         end = std::unique(begin, end);
         for (auto it = begin; it != end; ++it) all[write++] = *it;
+        if (write > std::size_t{INT32_MAX})
+            throw Error("mesh", "the mesh has more than 2^31 vertex neighbours (" +
+                                    std::to_string(n) + " vertices): too large");
         mesh.neighbor_offsets[v + 1] = static_cast<std::int32_t>(write);
     }
     all.resize(write);
@@ -154,13 +174,14 @@ MeshTopology mesh_topology(const TriangleMesh& mesh) {
 // of v. Returns the number of vertices split.
 std::size_t split_pinched_vertices(TriangleMesh& mesh, std::int32_t* first_pinched) {
     const std::size_t n = mesh.positions.size();
-    std::vector<std::int32_t> offsets(n + 1, 0);
+    check_adjacency_size(3 * std::uint64_t{mesh.triangles.size()}, "triangle corners");
+    std::vector<std::uint32_t> offsets(n + 1, 0);
     for (const auto& t : mesh.triangles)
         for (auto v : t) ++offsets[v + 1];
     for (std::size_t v = 0; v < n; ++v) offsets[v + 1] += offsets[v];
     std::vector<std::int32_t> incident(offsets.back());
     {
-        std::vector<std::int32_t> fill(offsets.begin(), offsets.end() - 1);
+        std::vector<std::uint32_t> fill(offsets.begin(), offsets.end() - 1);
         for (std::size_t t = 0; t < mesh.triangles.size(); ++t)
             for (auto v : mesh.triangles[t]) incident[fill[v]++] = std::int32_t(t);
     }
@@ -170,8 +191,8 @@ std::size_t split_pinched_vertices(TriangleMesh& mesh, std::int32_t* first_pinch
     std::vector<std::int32_t> size;
     constexpr std::int32_t kPairwise = 16;
     for (std::size_t v = 0; v < n; ++v) {
-        const auto begin = offsets[v], end = offsets[v + 1];
-        const auto k = end - begin;
+        const std::size_t begin = offsets[v];
+        const auto k = static_cast<std::int32_t>(offsets[v + 1] - offsets[v]);  // a fan's size
         if (k < 2) continue;
         fans_of.reset(static_cast<std::size_t>(k));
         auto find = [&](std::int32_t x) { return fans_of.find(x); };
