@@ -35,6 +35,7 @@ from . import backend
 
 FIELDS = ["shape-index", "sdf", "height"]
 COSTS = ["auto", "graph", "standard"]
+WINDOWS = ["disk", "ball"]
 
 
 def region_colours(regions_path, layer=None):
@@ -299,7 +300,9 @@ class ShapeIndexAlgorithm(_Base):
     def shortHelpString(self):  # noqa: N802
         return ("The shape index x100 of each pixel (0 cup, 25 rut, 50 saddle or plane, "
                 "75 ridge, 100 cap), fitted on the DEM's mesh over the vertices within RINGS "
-                "mesh edges, or within RADIUS metres when RADIUS > 0 (terrain field).")
+                "mesh edges, or within RADIUS metres when RADIUS > 0 (terrain field): on the "
+                "ground (WINDOW disk, any radius at about the cost of 2 rings) or in 3-D "
+                "(WINDOW ball).")
 
     def initAlgorithm(self, config=None):  # noqa: N802
         self.add_input()
@@ -308,6 +311,8 @@ class ShapeIndexAlgorithm(_Base):
         self.addParameter(QgsProcessingParameterNumber(
             "RADIUS", "Radius in metres (0: use rings)", QgsProcessingParameterNumber.Double, 0,
             minValue=0))
+        self.addParameter(QgsProcessingParameterEnum(
+            "WINDOW", "Window of the radius", WINDOWS, defaultValue=0))
         self.addParameter(QgsProcessingParameterRasterDestination("OUTPUT", "Shape index"))
 
     def processAlgorithm(self, parameters, context, feedback):  # noqa: N802
@@ -315,6 +320,7 @@ class ShapeIndexAlgorithm(_Base):
         band = self.parameterAsInt(parameters, "BAND", context) or 1
         rings = self.parameterAsInt(parameters, "RINGS", context)
         radius = self.parameterAsDouble(parameters, "RADIUS", context)
+        window = WINDOWS[self.parameterAsEnum(parameters, "WINDOW", context)]
         out = self.parameterAsOutputLayer(parameters, "OUTPUT", context)
         terrain = backend.module()
         if terrain is not None:
@@ -322,6 +328,7 @@ class ShapeIndexAlgorithm(_Base):
 
             try:
                 si = terrain.shape_index(path, band=band, rings=rings, radius=radius,
+                                         window=window,
                                          progress=backend.progress_callback(feedback, 0, 95))
             except terrain.Error as e:
                 raise backend.library_error(e)
@@ -338,7 +345,8 @@ class ShapeIndexAlgorithm(_Base):
             b.WriteArray(si)
             ds = None
         else:
-            shape = ["--radius", str(radius)] if radius > 0 else ["--rings", str(rings)]
+            shape = (["--radius", str(radius), "--window", window] if radius > 0
+                     else ["--rings", str(rings)])
             backend.run_cli(["field", path, "--field", "shape-index", "-o", out, "--overwrite",
                              "--band", str(band), *shape], feedback)
         self.load(context, out, "shape index", "OUTPUT", ShapeIndexStyle())

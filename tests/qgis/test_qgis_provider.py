@@ -120,3 +120,28 @@ def test_sweep_and_shape_index(qgis, tmp_path):
     assert done.returncode == 0, done.stdout + done.stderr
     si2 = gdal.Open(str(tmp_path / "si2.tif")).ReadAsArray()
     assert np.allclose(si2[valid], si[valid], atol=1e-4)
+
+
+def test_shape_index_window(qgis, tmp_path):
+    # RADIUS on the ground (WINDOW 0, disk, the default) or in 3-D (WINDOW 1, ball); the
+    # module and the command line give the same values for each.
+    values = {}
+    for window in (0, 1):
+        for backend in ("module", "cli"):
+            out = tmp_path / f"si_{window}_{backend}.tif"
+            done, _ = qgis("terrain:shapeindex", backend=backend, INPUT=MOON, RADIUS=30000,
+                           WINDOW=window, OUTPUT=out)
+            assert done.returncode == 0, done.stdout + done.stderr
+            ds = gdal.Open(str(out))
+            values[window, backend] = ds.ReadAsArray()
+    cli = subprocess.run([os.environ["TERRAIN_CLI"], "field", str(MOON), "--radius", "30000",
+                          "-o", str(tmp_path / "disk.tif"), "-q"], capture_output=True, text=True)
+    assert cli.returncode == 0, cli.stderr
+    ds = gdal.Open(str(tmp_path / "disk.tif"))
+    default = ds.ReadAsArray()
+    valid = np.isfinite(default)
+    for window in (0, 1):
+        assert np.allclose(values[window, "module"][valid], values[window, "cli"][valid],
+                           atol=1e-4)
+    assert np.allclose(values[0, "cli"][valid], default[valid], atol=1e-4)
+    assert not np.allclose(values[1, "cli"][valid], default[valid], atol=1e-4)
