@@ -1,8 +1,10 @@
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <set>
+#include <string_view>
 
 #include "support/test_meshes.hpp"
 #include "support/test_support.hpp"
@@ -288,4 +290,28 @@ TEST_CASE("Simplification refuses a graph whose lists hold arc ends or shared no
     auto shared = g;
     shared.arc_nodes[shared.arc_offsets[listed[1]]] = g.arc_nodes[g.arc_offsets[listed[0]]];
     CHECK_THROWS_WITH(reeb::simplify(mesh, shared, {}), Catch::Contains("not valid"));
+}
+
+TEST_CASE("The simplification's progress never goes back and ends at 1", "[simplify]") {
+    // Reported on a clock (at least every quarter second while it runs): the fraction of the
+    // work known, cancellations made over those made plus the candidates queued, which new
+    // candidates can lower; it is held where it was instead.
+    auto dem = io::read_dem(test::sample("moon_ldem1_global.tif"));
+    const auto mesh = mesh::dem_to_mesh(dem);
+    const auto si = field::shape_index_field(mesh);
+    const auto g = reeb::build_reeb_graph(mesh, si);
+    std::vector<double> seen;
+    const auto r = reeb::simplify(mesh, g, {}, [&](double fraction, std::string_view message) {
+        CHECK(message == "simplify");
+        seen.push_back(fraction);
+        return true;
+    });
+    REQUIRE_FALSE(seen.empty());
+    CHECK(std::is_sorted(seen.begin(), seen.end()));
+    CHECK(seen.front() >= 0);
+    CHECK(seen.back() == 1.0);
+    // A callback that cancels stops it with an error.
+    CHECK_THROWS_AS(reeb::simplify(mesh, g, {}, [](double, std::string_view) { return false; }),
+                    Error);
+    CHECK(r.graph.node_count() > 0);
 }

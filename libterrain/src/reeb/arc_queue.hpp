@@ -64,6 +64,8 @@ class ArcQueue {
         return next_ + ahead < sorted_.size() ? sorted_[next_ + ahead] : kEmpty;
     }
     void skip_sorted() { ++next_; }
+    // Entries still queued (sorted ones to come and the heap's), stale ones included.
+    std::size_t pending() const { return sorted_.size() - next_ + heap_.size(); }
     std::uint64_t top() const { return heap_.empty() ? kEmpty : heap_.front(); }
     // Queues arc `key & 0xffffffff` with this key, or moves it there.
     void set(std::uint64_t key) {

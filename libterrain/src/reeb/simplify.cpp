@@ -26,6 +26,7 @@
 #include "terrain/reeb/simplify.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 
@@ -46,8 +47,13 @@ void Simplifier::run(const ProgressFn& progress, SimplifyResult& result) {
         ++pushed_;
     }
     queue_.seal();
-    const std::size_t initial = pushed_;
     std::size_t done = 0;
+    // Progress on a clock: a noisy closed surface can spend minutes in cancellations of a
+    // high-degree node, thousands of times slower than the first ones. Every 64 cancellations
+    // the clock is read; at least every quarter second the fraction done of the work known
+    // (cancellations made, plus the candidates queued) is reported, never going back.
+    auto reported_at = std::chrono::steady_clock::now();
+    double reported = 0;
     // Lowest persistence first, until no candidate is left.
     for (std::uint64_t key; (key = take()) != ArcQueue::kEmpty;) {
         const i32 a = ArcQueue::arc_of(key);
@@ -64,9 +70,15 @@ void Simplifier::run(const ProgressFn& progress, SimplifyResult& result) {
         }
         cancel(b, result);
         prefetch_ends(next);
-        if ((++done & 0xfff) == 0 && initial > 0)
-            report_progress(progress, std::min(0.9, 0.9 * done / static_cast<double>(initial)),
-                            "simplify");
+        if ((++done & 63) == 0) {
+            const auto now = std::chrono::steady_clock::now();
+            if (now - reported_at >= std::chrono::milliseconds(250)) {
+                reported_at = now;
+                const double known = static_cast<double>(done + queue_.pending());
+                reported = std::max(reported, 0.9 * static_cast<double>(done) / known);
+                report_progress(progress, reported, "simplify");
+            }
+        }
     }
     result.working_bytes = working_bytes() + queue_.bytes();
     queue_.release();  // the output is the peak of memory: the queue is done
