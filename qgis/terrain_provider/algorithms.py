@@ -137,6 +137,11 @@ class _Base(QgsProcessingAlgorithm):
             "RINGS", "Shape index: rings (mesh edges)", QgsProcessingParameterNumber.Integer, 2,
             minValue=1))
         self.addParameter(QgsProcessingParameterNumber(
+            "RADIUS", "Shape index: radius in metres (0: use rings)",
+            QgsProcessingParameterNumber.Double, 0, minValue=0))
+        self.addParameter(QgsProcessingParameterEnum(
+            "WINDOW", "Shape index: window of the radius", WINDOWS, defaultValue=0))
+        self.addParameter(QgsProcessingParameterNumber(
             "PERSISTENCE", "Persistence (field units)", QgsProcessingParameterNumber.Double, 10,
             minValue=0))
         if area_ratio:
@@ -157,6 +162,11 @@ class _Base(QgsProcessingAlgorithm):
             "cost": COSTS[self.parameterAsEnum(parameters, "COST", context)],
             "saddle_penalty": self.parameterAsDouble(parameters, "SADDLE_PENALTY", context),
         }
+        radius = self.parameterAsDouble(parameters, "RADIUS", context)
+        if radius > 0:  # instead of rings (giving both is refused)
+            del options["rings"]
+            options["radius"] = radius
+            options["window"] = WINDOWS[self.parameterAsEnum(parameters, "WINDOW", context)]
         if area_ratio:
             options["area_ratio"] = self.parameterAsDouble(parameters, "AREA_RATIO", context)
         return options

@@ -98,6 +98,21 @@ def test_segment_parameters_reach_terrain(qgis, tmp_path):
     assert int(labels.max()) == results["REGION_COUNT"]
 
 
+def test_segment_at_a_radius(qgis, tmp_path):
+    # RADIUS and WINDOW reach the library from both back ends, which give the same labels.
+    labels = {}
+    for backend in ("module", "cli"):
+        out = tmp_path / backend
+        done, _ = qgis("terrain:segment", backend=backend, INPUT=MOON, OUTPUT=out, RADIUS=30000,
+                       WINDOW=1)
+        assert done.returncode == 0, done.stdout + done.stderr
+        parameters = json.loads((out / "run.json").read_text())["parameters"]
+        assert parameters["radius"] == 30000 and parameters["shape_index_window"] == "ball"
+        ds = gdal.Open(str(out / "labels.tif"))
+        labels[backend] = ds.ReadAsArray()
+    assert np.array_equal(labels["module"], labels["cli"])
+
+
 def test_library_errors_reach_qgis(qgis, tmp_path):
     done, _ = qgis("terrain:sweep", INPUT=MOON, OUTPUT=tmp_path / "s", AREA_RATIOS="0.5,200")
     assert done.returncode != 0
