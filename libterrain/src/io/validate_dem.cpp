@@ -1,4 +1,5 @@
 #include "validate_dem.hpp"
+#include "../core/significant.hpp"
 
 #include <cpl_vsi.h>
 #include <gdal_priv.h>
@@ -18,9 +19,7 @@ namespace terrain::io {
 namespace {
 
 std::string number(double v) {
-    char text[64];
-    std::snprintf(text, sizeof text, "%.6g", v);
-    return text;
+    return terrain::detail::significant(v, 6);
 }
 
 }  // namespace

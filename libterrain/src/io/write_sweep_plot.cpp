@@ -6,11 +6,11 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstdio>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "../core/significant.hpp"
 #include "image_module.hpp"
 #include "map_canvas.hpp"
 #include "terrain/core/error.hpp"
@@ -22,9 +22,7 @@ namespace terrain::io {
 namespace {
 
 std::string short_number(double v) {
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%.4g", v);
-    return buf;
+    return terrain::detail::significant(v, 4);
 }
 
 // The smallest 4 * (1, 2, 2.5 or 5 times a power of ten) at least `v`: an axis's top whose

@@ -1,6 +1,5 @@
 #include "terrain/synth/vesta_crs.hpp"
-
-#include <cstdio>
+#include "../core/significant.hpp"
 
 #include "terrain/synth/crater_field.hpp"
 
@@ -9,9 +8,7 @@ namespace {
 
 // A number as OGR writes it in WKT: 15 significant digits, no trailing zeros.
 std::string wkt_number(double v) {
-    char text[32];
-    std::snprintf(text, sizeof text, "%.15g", v);
-    return text;
+    return terrain::detail::significant(v, 15);
 }
 
 }  // namespace
