@@ -70,17 +70,14 @@ GridLayout grid_layout(const TriangleMesh& mesh) {
     if (mesh.frame == MeshFrame::body) {
         double spacing = 0, radius = 0;
         const int row_step = std::max(1, g.height / 64), col_step = std::max(1, g.width / 64);
-        const auto at = [&](int c, int r) {
-            return g.pixel_vertex[std::size_t(r) * std::size_t(g.width) + std::size_t(c)];
-        };
         for (int r = 0; r + 1 < g.height; r += row_step)
             for (int c = 0; c + 1 < g.width; c += col_step) {
-                const auto v = at(c, r);
+                const auto v = g.vertex_at(c, r);
                 if (v < 0) continue;
                 const auto& p = mesh.positions[std::size_t(v)];
                 const Vec3 q{mesh.origin[0] + p[0], mesh.origin[1] + p[1], mesh.origin[2] + p[2]};
                 radius = std::max(radius, std::sqrt(dot(q, q)));
-                for (const auto w : {at(c + 1, r), at(c, r + 1)})
+                for (const auto w : {g.vertex_at(c + 1, r), g.vertex_at(c, r + 1)})
                     if (w >= 0) {
                         const Vec3 d = sub(mesh.positions[std::size_t(w)], p);
                         spacing = std::max(spacing, std::sqrt(dot(d, d)));
@@ -273,12 +270,7 @@ constexpr int moment_index(int x, int y, int z) {
     return -1;
 }
 
-// Moving moments by a translation s along one axis is a Taylor shift of each chain of
-// moments that differ only in that axis's exponent: M[e] += s M[e - 1] for j = 1..n, e = n
-// down to j. The steps (axis, target, source) in order, 3 x 35 of them.
-struct ShiftStep {
-    std::uint8_t axis, target, source;
-};
+// The Taylor shift of the 35 moments along x, y and z (ShiftStep), 3 x 35 steps.
 constexpr int kShiftSteps = 105;
 constexpr std::array<ShiftStep, kShiftSteps> kShift = [] {
     std::array<ShiftStep, kShiftSteps> steps{};
@@ -397,8 +389,7 @@ NormalEquations equations_from_moments(const double* m, const Vec3& normal) {
 void fit_from_moments(double* moments, const Vec3& centre, const Vec3& ref, const Vec3& normal,
                       std::int32_t v, const VertexFn& body) {
     const Vec3 t{centre[0] - ref[0], centre[1] - ref[1], centre[2] - ref[2]};
-#pragma GCC unroll 105
-    for (const auto& step : kShift) moments[step.target] -= t[step.axis] * moments[step.source];
+    apply_shift(kShift, t.data(), moments);
     PrincipalCurvatures k;
     const auto equations = equations_from_moments(moments, normal);
     const bool fitted = solve_curvatures(equations, k);
@@ -411,16 +402,8 @@ void grid_tile(const TriangleMesh& mesh, const GridLayout& g, const std::vector<
                std::size_t& mesh_fallbacks, const VertexFn& body) {
     const int W = g.width, H = g.height;
     const int r1 = std::min(H, r0 + kTile), c1 = std::min(W, c0 + kTile);
-    const auto vertex_at = [&](int col, int row) {
-        return g.pixel_vertex[std::size_t(row) * std::size_t(W) + std::size_t(col)];
-    };
     const auto fallback = [&](std::int32_t v) {
-        PrincipalCurvatures k;
-        double scale = 0;
-        const bool ok =
-            mesh_fit(mesh, v, normals[std::size_t(v)], options, nullptr, s.mesh, k, scale);
-        body(v, ok, k, scale);
-        ++mesh_fallbacks;
+        tile_fallback(mesh, v, normals[std::size_t(v)], options, nullptr, s, mesh_fallbacks, body);
     };
     // How far (in pixels) the ball can reach: from the short end of the tile's distances
     // between neighbouring pixels, with a margin; a window reaching the margin takes the
@@ -429,7 +412,7 @@ void grid_tile(const TriangleMesh& mesh, const GridLayout& g, const std::vector<
         s.spacing.clear();
         for (int row = r0; row + dr < r1; ++row)
             for (int col = c0; col + dc < c1; ++col) {
-                const auto a = vertex_at(col, row), b = vertex_at(col + dc, row + dr);
+                const auto a = g.vertex_at(col, row), b = g.vertex_at(col + dc, row + dr);
                 if (a < 0 || b < 0) continue;
                 const Vec3 d = sub(mesh.positions[std::size_t(a)], mesh.positions[std::size_t(b)]);
                 s.spacing.push_back(std::sqrt(dot(d, d)));
@@ -446,12 +429,8 @@ void grid_tile(const TriangleMesh& mesh, const GridLayout& g, const std::vector<
     const auto status =
         region_sums<kMoments>(mesh, g, r0, r1, c0, c1, mx, my, true, s, region, monomials);
     if (status == RegionStatus::empty) return;
-    if (status == RegionStatus::mesh_path) {
-        for (int row = r0; row < r1; ++row)
-            for (int col = c0; col < c1; ++col)
-                if (const auto v = vertex_at(col, row); v >= 0) fallback(v);
-        return;
-    }
+    if (status == RegionStatus::mesh_path)
+        return g.for_each_vertex(r0, r1, c0, c1, [&](std::int32_t v, int, int) { fallback(v); });
     const int rr0 = region.rr0, cc0 = region.cc0, rows = region.rows, cols = region.cols;
     const Vec3 ref = region.ref;
     const double r2 = options.radius * options.radius;
@@ -462,7 +441,7 @@ void grid_tile(const TriangleMesh& mesh, const GridLayout& g, const std::vector<
         bool warm = false;  // the spans hold the previous pixel's window
         const int lr = row - rr0;
         for (int col = c0; col < c1; ++col) {
-            const auto v = vertex_at(col, row);
+            const auto v = g.vertex_at(col, row);
             if (v < 0) {
                 warm = false;
                 continue;

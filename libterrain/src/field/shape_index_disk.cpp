@@ -60,9 +60,8 @@ DiskWindow ellipse_window(double a, double b, double c) {
 }
 
 // The ground (horizontal: across `up`) offsets between pixel centres along columns and rows
-// at vertex v; each from
-// the vertices of the pixels on both sides (or one), or square to the other when neither has
-// one.
+// at vertex v; each from the vertices of the pixels on both sides (or one), or square to the
+// other when neither has one.
 struct GroundSpacing {
     Vec3 up{0, 0, 1}, col{0, 0, 0}, row{0, 0, 0};
     bool ok = false;
@@ -74,14 +73,6 @@ GroundSpacing ground_spacing(const TriangleMesh& mesh, const GridLayout& g, std:
     const int col = pixel % g.width, row = pixel / g.width;
     GroundSpacing out;
     out.up = up;
-    const auto at = [&](int c, int r) -> std::int32_t {
-        if (r < 0 || r >= g.height) return -1;
-        if (c < 0 || c >= g.width) {
-            if (!g.seam) return -1;
-            c = (c + g.width) % g.width;
-        }
-        return g.pixel_vertex[std::size_t(r) * std::size_t(g.width) + std::size_t(c)];
-    };
     const auto horizontal = [&](std::int32_t to, std::int32_t from, double share) {
         const Vec3 d = sub(mesh.positions[std::size_t(to)], mesh.positions[std::size_t(from)]);
         const double along = dot(d, up);
@@ -89,7 +80,8 @@ GroundSpacing ground_spacing(const TriangleMesh& mesh, const GridLayout& g, std:
                     (d[2] - along * up[2]) * share};
     };
     const auto spacing = [&](int dc, int dr, Vec3& out_spacing) {
-        const auto before = at(col - dc, row - dr), after = at(col + dc, row + dr);
+        const auto before = g.vertex_near(col - dc, row - dr),
+                   after = g.vertex_near(col + dc, row + dr);
         if (before >= 0 && after >= 0)
             out_spacing = horizontal(after, before, 0.5);
         else if (after >= 0)
@@ -118,21 +110,14 @@ DiskWindow vertex_disk(const TriangleMesh& mesh, const GridLayout& g, std::int32
     if (!s.ok) return {};
     const auto pixel = mesh.vertex_pixel[std::size_t(v)];
     const int col = pixel % g.width, row = pixel / g.width;
-    const auto at = [&](int c, int r) -> std::int32_t {
-        if (r < 0 || r >= g.height) return -1;
-        if (c < 0 || c >= g.width) {
-            if (!g.seam) return -1;
-            c = ((c % g.width) + g.width) % g.width;
-        }
-        return g.pixel_vertex[std::size_t(r) * std::size_t(g.width) + std::size_t(c)];
-    };
     // The rise along the ground offset `step` (pixels dc, dr) over the window's half-width.
     const auto rise = [&](const Vec3& spacing, int dc, int dr) -> std::optional<double> {
         const double length = std::sqrt(dot(spacing, spacing));
         if (!(length > 0)) return std::nullopt;
         const int k = int(std::clamp(0.5 * radius / length + 0.5, 1.0, 64.0));
         for (int j = k; j >= 1; --j) {
-            const auto a = at(col - j * dc, row - j * dr), b = at(col + j * dc, row + j * dr);
+            const auto a = g.vertex_near(col - j * dc, row - j * dr),
+                       b = g.vertex_near(col + j * dc, row + j * dr);
             if (a < 0 || b < 0) continue;
             const Vec3 d = sub(mesh.positions[std::size_t(b)], mesh.positions[std::size_t(a)]);
             return dot(d, s.up) / (2.0 * j);
@@ -204,9 +189,7 @@ MongeFrame tile_frame(const TriangleMesh& mesh, const GridLayout& g, int col, in
     const int r1 = std::min(g.height, r0 + t), c1 = std::min(g.width, c0 + t);
     for (int r = r0; r < r1; ++r)
         for (int c = c0; c < c1; ++c)
-            if (const auto v =
-                    g.pixel_vertex[std::size_t(r) * std::size_t(g.width) + std::size_t(c)];
-                v >= 0) {
+            if (const auto v = g.vertex_at(c, r); v >= 0) {
                 const auto& p = mesh.positions[std::size_t(v)];
                 f.up = normalized(
                     {mesh.origin[0] + p[0], mesh.origin[1] + p[1], mesh.origin[2] + p[2]});
@@ -231,16 +214,12 @@ void monge_monomials(const MongeFrame& f, const Vec3& d, double* out) {
     out[kHH] = h * h;
 }
 
-// Moving the moments by (u0, v0) is a Taylor shift of each chain of moments that differ only
-// in the u (or v) exponent: M[e] -= u0 M[e - 1] for step = 1..n, e = n down to step. The
-// steps (axis, target, source) in order: u then v, for the 15 sum u^i v^j (n = 4 - the other
-// exponent) and the 6 sum h u^i v^j (n = 2 - the other exponent), 48 in all.
-struct MongeStep {
-    std::uint8_t axis, target, source;
-};
+// The Taylor shift of the moments by (u0, v0) (ShiftStep): u then v, for the 15 sum u^i v^j
+// (n = 4 - the other exponent) and the 6 sum h u^i v^j (n = 2 - the other exponent), 48
+// steps in all.
 constexpr int kMongeSteps = 48;
-constexpr std::array<MongeStep, kMongeSteps> kMongeShift = [] {
-    std::array<MongeStep, kMongeSteps> steps{};
+constexpr std::array<ShiftStep, kMongeSteps> kMongeShift = [] {
+    std::array<ShiftStep, kMongeSteps> steps{};
     int k = 0;
     for (int axis = 0; axis < 2; ++axis)
         for (int group = 0; group < 2; ++group) {
@@ -264,8 +243,7 @@ constexpr std::array<MongeStep, kMongeSteps> kMongeShift = [] {
 // h0) from it.
 void monge_shift(double* m, double u0, double v0, double h0) {
     const double t[2] = {u0, v0};
-#pragma GCC unroll 48
-    for (const auto& step : kMongeShift) m[step.target] -= t[step.axis] * m[step.source];
+    apply_shift(kMongeShift, t, m);
     // sum (h - h0)^2 and sum (h - h0) u^i v^j.
     m[kHH] += h0 * (h0 * m[uv_index(0, 0)] - 2 * m[huv_index(0, 0)]);
 #pragma GCC unroll 6
@@ -325,15 +303,8 @@ void disk_tile(const TriangleMesh& mesh, const GridLayout& g, const std::vector<
     const int W = g.width, H = g.height;
     const int tile = g.disk_tile;
     const int r1 = std::min(H, r0 + tile), c1 = std::min(W, c0 + tile);
-    const auto vertex_at = [&](int col, int row) {
-        return g.pixel_vertex[std::size_t(row) * std::size_t(W) + std::size_t(col)];
-    };
     const auto fallback = [&](std::int32_t v) {
-        PrincipalCurvatures k;
-        double scale = 0;
-        const bool ok = mesh_fit(mesh, v, normals[std::size_t(v)], options, &g, s.mesh, k, scale);
-        body(v, ok, k, scale);
-        ++mesh_fallbacks;
+        tile_fallback(mesh, v, normals[std::size_t(v)], options, &g, s, mesh_fallbacks, body);
     };
     const auto frame = tile_frame(mesh, g, c0, r0);
     // Each vertex's window, and the margins the windows the tables can hold need.
@@ -342,25 +313,19 @@ void disk_tile(const TriangleMesh& mesh, const GridLayout& g, const std::vector<
         return s.disks[std::size_t(row - r0) * std::size_t(tile) + std::size_t(col - c0)];
     };
     int mx = 0, my = 0;
-    for (int row = r0; row < r1; ++row)
-        for (int col = c0; col < c1; ++col)
-            if (const auto v = vertex_at(col, row); v >= 0) {
-                const auto& d = disk_of(col, row) =
-                    vertex_disk(mesh, g, v, normals[std::size_t(v)], frame.up, options.radius);
-                if (d.reach_x <= kMaxReach && d.reach_y <= kMaxReach)
-                    mx = std::max(mx, d.reach_x), my = std::max(my, d.reach_y);
-            }
+    g.for_each_vertex(r0, r1, c0, c1, [&](std::int32_t v, int col, int row) {
+        const auto& d = disk_of(col, row) =
+            vertex_disk(mesh, g, v, normals[std::size_t(v)], frame.up, options.radius);
+        if (d.reach_x <= kMaxReach && d.reach_y <= kMaxReach)
+            mx = std::max(mx, d.reach_x), my = std::max(my, d.reach_y);
+    });
     Region region;
     const auto status =
         region_sums<kMonge>(mesh, g, r0, r1, c0, c1, mx, my, false, s, region,
                             [&](const Vec3& d, double* out) { monge_monomials(frame, d, out); });
     if (status == RegionStatus::empty) return;
-    if (status == RegionStatus::mesh_path) {
-        for (int row = r0; row < r1; ++row)
-            for (int col = c0; col < c1; ++col)
-                if (const auto v = vertex_at(col, row); v >= 0) fallback(v);
-        return;
-    }
+    if (status == RegionStatus::mesh_path)
+        return g.for_each_vertex(r0, r1, c0, c1, [&](std::int32_t v, int, int) { fallback(v); });
     const int rows = region.rows, cols = region.cols;
     const std::size_t stride = std::size_t(cols + 1) * kMonge;
     for (int lr = 1; lr < rows; ++lr) {
@@ -383,30 +348,24 @@ void disk_tile(const TriangleMesh& mesh, const GridLayout& g, const std::vector<
         const double* a1 = &s.prefix[std::size_t(ra - 1) * stride + std::size_t(cb + 1) * kMonge];
         for (int k = 0; k < kMonge; ++k) moments[k] += (b1[k] - b0[k]) - (a1[k] - a0[k]);
     };
-    for (int row = r0; row < r1; ++row)
-        for (int col = c0; col < c1; ++col) {
-            const auto v = vertex_at(col, row);
-            if (v < 0) continue;
-            const DiskWindow& d = disk_of(col, row);
-            // Beyond the margins (a window wider than kMaxReach): the mesh path.
-            if (d.reach_x > mx || d.reach_y > my) {
-                fallback(v);
-                continue;
-            }
-            const int lr = row - region.rr0, lc = col - region.cc0;
-            double moments[kMonge] = {};
-            for (int k = 0; k < d.bands; ++k) {
-                const auto& b = d.band[std::size_t(k)];
-                add_rectangle(moments, lr + b.row_lo, lr + b.row_hi, lc + b.col_lo, lc + b.col_hi);
-            }
-            const auto& p = mesh.positions[std::size_t(v)];
-            const Vec3 t{p[0] - region.ref[0], p[1] - region.ref[1], p[2] - region.ref[2]};
-            monge_shift(moments, dot(t, frame.e1), dot(t, frame.e2), dot(t, frame.up));
-            PrincipalCurvatures k;
-            const auto equations = monge_equations(moments);
-            const bool fitted = solve_curvatures(equations, k);
-            body(v, fitted, k, equations.scale);
+    g.for_each_vertex(r0, r1, c0, c1, [&](std::int32_t v, int col, int row) {
+        const DiskWindow& d = disk_of(col, row);
+        // Beyond the margins (a window wider than kMaxReach): the mesh path.
+        if (d.reach_x > mx || d.reach_y > my) return fallback(v);
+        const int lr = row - region.rr0, lc = col - region.cc0;
+        double moments[kMonge] = {};
+        for (int k = 0; k < d.bands; ++k) {
+            const auto& b = d.band[std::size_t(k)];
+            add_rectangle(moments, lr + b.row_lo, lr + b.row_hi, lc + b.col_lo, lc + b.col_hi);
         }
+        const auto& p = mesh.positions[std::size_t(v)];
+        const Vec3 t{p[0] - region.ref[0], p[1] - region.ref[1], p[2] - region.ref[2]};
+        monge_shift(moments, dot(t, frame.e1), dot(t, frame.e2), dot(t, frame.up));
+        PrincipalCurvatures k;
+        const auto equations = monge_equations(moments);
+        const bool fitted = solve_curvatures(equations, k);
+        body(v, fitted, k, equations.scale);
+    });
 }
 
 }  // namespace terrain::field::detail

@@ -72,6 +72,28 @@ struct GridLayout {
     bool seam = false;
     std::vector<std::int32_t> pixel_vertex;  // the vertex a pixel owns, or -1
     int disk_tile = 64;                      // pixels per side of the disk window's tiles
+
+    // The vertex pixel (col, row) of the grid owns, or -1.
+    std::int32_t vertex_at(int col, int row) const {
+        return pixel_vertex[std::size_t(row) * std::size_t(width) + std::size_t(col)];
+    }
+    // The same for any (col, row): -1 off the grid's rows, and off its columns unless it is
+    // a global grid, whose columns wrap across the seam.
+    std::int32_t vertex_near(int col, int row) const {
+        if (row < 0 || row >= height) return -1;
+        if (col < 0 || col >= width) {
+            if (!seam) return -1;
+            col = ((col % width) + width) % width;
+        }
+        return vertex_at(col, row);
+    }
+    // f(v, col, row) for each vertex the pixels [c0, c1) x [r0, r1) own, row by row.
+    template <class F>
+    void for_each_vertex(int r0, int r1, int c0, int c1, F&& f) const {
+        for (int row = r0; row < r1; ++row)
+            for (int col = c0; col < c1; ++col)
+                if (const auto v = vertex_at(col, row); v >= 0) f(v, col, row);
+    }
 };
 
 // The disk window's tiles span at most this angle on the body: its fit is made in one frame
@@ -143,6 +165,32 @@ struct GridScratch {
 
 using VertexFn = std::function<void(std::int32_t, bool, const PrincipalCurvatures&, double)>;
 
+// The mesh path for vertex v of a tile whose sums could not hold its window: mesh_fit, its
+// result through `body`, counted in `fallbacks`.
+inline void tile_fallback(const TriangleMesh& mesh, std::int32_t v, const Vec3& normal,
+                          const ShapeIndexOptions& options, const GridLayout* disk_grid,
+                          GridScratch& s, std::size_t& fallbacks, const VertexFn& body) {
+    PrincipalCurvatures k;
+    double scale = 0;
+    const bool ok = mesh_fit(mesh, v, normal, options, disk_grid, s.mesh, k, scale);
+    body(v, ok, k, scale);
+    ++fallbacks;
+}
+
+// One step of a Taylor shift of moments: moments[target] -= t[axis] * moments[source].
+// Moving sums of monomials of offsets by a translation t is a run of such steps over each
+// chain of moments that differ only in one axis's exponent (M[e] -= t M[e - 1] for
+// j = 1..n, e = n down to j).
+struct ShiftStep {
+    std::uint8_t axis, target, source;
+};
+
+template <std::size_t N>
+void apply_shift(const std::array<ShiftStep, N>& steps, const double* t, double* moments) {
+#pragma GCC unroll 105
+    for (const auto& step : steps) moments[step.target] -= t[step.axis] * moments[step.source];
+}
+
 // What a tile of pixels [c0, c1) x [r0, r1) works on: the tile and margins of mx columns
 // and my rows (rows clipped to the grid; columns clipped, or wrapped across the seam of a
 // global grid), its reference point (the tile's first vertex), and per region row the
@@ -160,9 +208,6 @@ RegionStatus region_sums(const TriangleMesh& mesh, const GridLayout& g, int r0, 
                          const Fill& fill) {
     const int W = g.width, H = g.height;
     if (mx > kMaxReach || my > kMaxReach) return RegionStatus::mesh_path;
-    const auto vertex_at = [&](int col, int row) {
-        return g.pixel_vertex[std::size_t(row) * std::size_t(W) + std::size_t(col)];
-    };
     const int rr0 = std::max(0, r0 - my), rr1 = std::min(H, r1 + my);
     for (int row : mesh.pole_rows)
         if (row >= rr0 && row < rr1) return RegionStatus::mesh_path;
@@ -178,7 +223,7 @@ RegionStatus region_sums(const TriangleMesh& mesh, const GridLayout& g, int r0, 
     bool any = false;
     for (int row = r0; row < r1 && !any; ++row)
         for (int col = c0; col < c1 && !any; ++col)
-            if (const auto v = vertex_at(col, row); v >= 0) {
+            if (const auto v = g.vertex_at(col, row); v >= 0) {
                 const auto& p = mesh.positions[std::size_t(v)];
                 ref = {p[0], p[1], p[2]}, any = true;
             }
@@ -189,7 +234,7 @@ RegionStatus region_sums(const TriangleMesh& mesh, const GridLayout& g, int r0, 
         double* running = &s.prefix[std::size_t(lr) * std::size_t(cols + 1) * N];
         std::fill_n(running, N, 0.0);
         for (int lc = 0; lc < cols; ++lc) {
-            const auto v = vertex_at(region_col(cc0 + lc), rr0 + lr);
+            const auto v = g.vertex_at(region_col(cc0 + lc), rr0 + lr);
             Vec3 p{std::numeric_limits<double>::quiet_NaN(), 0, 0};
             double* next = running + N;
             if (v < 0) {
