@@ -272,47 +272,82 @@ Dem crop(const Dem& dem, int c0, int r0, int w, int h) {
     return out;
 }
 
-}  // namespace
-
-TEST_CASE("shape index by the grid method: known answers on analytic DEMs", "[shape_index]") {
+// The analytic surfaces of the grid method's tests, with their derivatives.
+using Surface =
+    std::pair<std::function<double(double, double)>, std::function<Derivatives(double, double)>>;
+std::vector<Surface> analytic_surfaces() {
     const double k = 1 / R;
-    using F = std::function<double(double, double)>;
-    using D = std::function<Derivatives(double, double)>;
-    const std::vector<std::pair<F, D>> surfaces{
-        {[&](double x, double y) { return -(x * x + y * y) * k / 2; },
-         [&](double x, double y) {
+    return {
+        {[=](double x, double y) { return -(x * x + y * y) * k / 2; },
+         [=](double x, double y) {
              return Derivatives{-x * k, -y * k, -k, 0, -k};
          }},
-        {[&](double x, double y) { return (x * x + y * y) * k / 2; },
-         [&](double x, double y) {
+        {[=](double x, double y) { return (x * x + y * y) * k / 2; },
+         [=](double x, double y) {
              return Derivatives{x * k, y * k, k, 0, k};
          }},
-        {[&](double x, double) { return -x * x * k / 2; },
-         [&](double x, double) {
+        {[=](double x, double) { return -x * x * k / 2; },
+         [=](double x, double) {
              return Derivatives{-x * k, 0, -k, 0, 0};
          }},
-        {[&](double x, double) { return x * x * k / 2; },
-         [&](double x, double) {
+        {[=](double x, double) { return x * x * k / 2; },
+         [=](double x, double) {
              return Derivatives{x * k, 0, k, 0, 0};
          }},
-        {[&](double x, double y) { return (x * x - y * y) * k / 2; },
-         [&](double x, double y) {
+        {[=](double x, double y) { return (x * x - y * y) * k / 2; },
+         [=](double x, double y) {
              return Derivatives{x * k, -y * k, k, 0, -k};
          }},
-        {[&](double x, double y) { return (x * x - 0.5 * y * y) * k / 2; },
-         [&](double x, double y) {
-             return Derivatives{x * k, -0.5 * y * k, k, 0, -0.5 * k};
+        {[=](double x, double y) { return (x * x - 0.5 * y * y) * k / 2 + 0.3 * x * y * k; },
+         [=](double x, double y) {
+             return Derivatives{x * k + 0.3 * y * k, -0.5 * y * k + 0.3 * x * k, k, 0.3 * k,
+                                -0.5 * k};
          }},
         {[](double x, double y) { return 0.3 * x - 0.2 * y + 5; },
          [](double, double) {
              return Derivatives{0.3, -0.2, 0, 0, 0};
          }},
         {[](double x, double y) { return std::sqrt(60.0 * 60.0 - x * x - y * y); },
-         [](double, double) {
-             return Derivatives{0, 0, -1, 0, -1};
+         [](double x, double y) {
+             const double z2 = 60.0 * 60.0 - x * x - y * y, z = std::sqrt(z2), z3 = z2 * z;
+             return Derivatives{-x / z, -y / z, -(60.0 * 60.0 - y * y) / z3, -x * y / z3,
+                                -(60.0 * 60.0 - x * x) / z3};
          }},
     };
-    for (const auto& [f, d] : surfaces) {
+}
+
+// A rough surface (slopes to 1.1 from a 0.4 m ripple of 2.2 m wavelength) of n x n pixels of
+// 1 m with a NoData hole, a NoData row `nodata_row` cutting part of the tile, a ragged edge
+// and a lone corner pixel.
+Dem rough_dem_with_nodata(int n, int nodata_row) {
+    Dem dem = analytic(n, 1.0, [](double x, double y) {
+        return 3 * std::sin(x * 0.31) * std::cos(y * 0.23) + 0.4 * std::sin(x * 1.7 + y * 2.3);
+    });
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    for (int r = 20; r < 27; ++r)
+        for (int c = 25; c < 33; ++c) dem.values[dem.index(c, r)] = nan;
+    for (int c = 0; c < 40; ++c) dem.values[dem.index(c, nodata_row)] = nan;
+    for (int r = 0; r < n; r += 3) dem.values[dem.index(n - 1, r)] = nan;
+    dem.values[dem.index(0, n - 1)] = nan;
+    return dem;
+}
+
+// Whether vertex v has no NoData pixel within `reach` pixels (a square around its pixel).
+bool no_nodata_within(const Dem& dem, const TriangleMesh& mesh, std::size_t v, int reach) {
+    const int c = mesh.vertex_pixel[v] % dem.width, r = mesh.vertex_pixel[v] / dem.width;
+    for (int dr = -reach; dr <= reach; ++dr)
+        for (int dc = -reach; dc <= reach; ++dc) {
+            const int cc = c + dc, rr = r + dr;
+            if (cc >= 0 && rr >= 0 && cc < dem.width && rr < dem.height && !dem.valid(cc, rr))
+                return false;
+        }
+    return true;
+}
+
+}  // namespace
+
+TEST_CASE("shape index by the grid method: known answers on analytic DEMs", "[shape_index]") {
+    for (const auto& [f, d] : analytic_surfaces()) {
         const auto dem = analytic(41, 1.0, f);
         const auto mesh = mesh::dem_to_mesh(dem);
         for (double radius : {2.9, 5.5}) {
@@ -353,33 +388,13 @@ TEST_CASE("shape index methods: which applies", "[shape_index]") {
 }
 
 TEST_CASE("shape index by the grid method next to NoData and borders", "[shape_index]") {
-    // A rough surface with a NoData hole, a NoData row cutting part of the tile, a lone
-    // corner pixel and a ragged edge.
-    Dem dem = analytic(60, 1.0, [](double x, double y) {
-        return 3 * std::sin(x * 0.31) * std::cos(y * 0.23) + 0.4 * std::sin(x * 1.7 + y * 2.3);
-    });
-    const double nan = std::numeric_limits<double>::quiet_NaN();
-    for (int r = 20; r < 27; ++r)
-        for (int c = 25; c < 33; ++c) dem.values[dem.index(c, r)] = nan;
-    for (int c = 0; c < 40; ++c) dem.values[dem.index(c, 45)] = nan;
-    for (int r = 0; r < 60; r += 3) dem.values[dem.index(59, r)] = nan;
-    dem.values[dem.index(0, 59)] = nan;
+    const Dem dem = rough_dem_with_nodata(60, 45);
     const auto mesh = mesh::dem_to_mesh(dem);
     for (double radius : {2.5, 4.5, 8.0}) {
         // Vertices with no NoData pixel within radius + 1 pixels: their windows are whole
         // (the tile's border clips both methods' balls alike) and must agree.
         const int reach = int(std::ceil(radius)) + 1;
-        const auto whole = [&](std::size_t v) {
-            const int c = mesh.vertex_pixel[v] % dem.width, r = mesh.vertex_pixel[v] / dem.width;
-            for (int dr = -reach; dr <= reach; ++dr)
-                for (int dc = -reach; dc <= reach; ++dc) {
-                    const int cc = c + dc, rr = r + dr;
-                    if (cc >= 0 && rr >= 0 && cc < dem.width && rr < dem.height &&
-                        !dem.valid(cc, rr))
-                        return false;
-                }
-            return true;
-        };
+        const auto whole = [&](std::size_t v) { return no_nodata_within(dem, mesh, v, reach); };
         const auto a = grid_against_mesh(mesh, radius, whole);
         const auto near = grid_against_mesh(mesh, radius, [&](std::size_t v) { return !whole(v); });
         INFO("radius " << radius << ": whole windows " << a.above_half << " above 0.5, worst "
@@ -459,54 +474,6 @@ TEST_CASE("shape index by the grid method agrees with the mesh method on real DE
 
 // ---- The disk window (the default for --radius on DEMs) ----
 
-namespace {
-
-// The analytic surfaces of the grid method's tests, with their derivatives.
-using Surface =
-    std::pair<std::function<double(double, double)>, std::function<Derivatives(double, double)>>;
-std::vector<Surface> analytic_surfaces() {
-    const double k = 1 / R;
-    return {
-        {[=](double x, double y) { return -(x * x + y * y) * k / 2; },
-         [=](double x, double y) {
-             return Derivatives{-x * k, -y * k, -k, 0, -k};
-         }},
-        {[=](double x, double y) { return (x * x + y * y) * k / 2; },
-         [=](double x, double y) {
-             return Derivatives{x * k, y * k, k, 0, k};
-         }},
-        {[=](double x, double) { return -x * x * k / 2; },
-         [=](double x, double) {
-             return Derivatives{-x * k, 0, -k, 0, 0};
-         }},
-        {[=](double x, double) { return x * x * k / 2; },
-         [=](double x, double) {
-             return Derivatives{x * k, 0, k, 0, 0};
-         }},
-        {[=](double x, double y) { return (x * x - y * y) * k / 2; },
-         [=](double x, double y) {
-             return Derivatives{x * k, -y * k, k, 0, -k};
-         }},
-        {[=](double x, double y) { return (x * x - 0.5 * y * y) * k / 2 + 0.3 * x * y * k; },
-         [=](double x, double y) {
-             return Derivatives{x * k + 0.3 * y * k, -0.5 * y * k + 0.3 * x * k, k, 0.3 * k,
-                                -0.5 * k};
-         }},
-        {[](double x, double y) { return 0.3 * x - 0.2 * y + 5; },
-         [](double, double) {
-             return Derivatives{0.3, -0.2, 0, 0, 0};
-         }},
-        {[](double x, double y) { return std::sqrt(60.0 * 60.0 - x * x - y * y); },
-         [](double x, double y) {
-             const double z2 = 60.0 * 60.0 - x * x - y * y, z = std::sqrt(z2), z3 = z2 * z;
-             return Derivatives{-x / z, -y / z, -(60.0 * 60.0 - y * y) / z3, -x * y / z3,
-                                -(60.0 * 60.0 - x * x) / z3};
-         }},
-    };
-}
-
-}  // namespace
-
 TEST_CASE("shape index with the disk window: known answers on analytic DEMs", "[shape_index]") {
     // A DEM is a graph over its grid: the disk window's Monge fit of a quadric graph is exact,
     // whatever the window's size, its slope or the vertex's place; on a sphere cap it is a fit.
@@ -547,33 +514,14 @@ TEST_CASE("shape index with the disk window: known answers on analytic DEMs", "[
 TEST_CASE("shape index with the disk window: the grid method sums what the mesh gathers",
           "[shape_index]") {
     // The summed-area tables against the same window gathered vertex by vertex on the mesh,
-    // on a rough surface (slopes to 1.1) with a NoData hole, a NoData row, a ragged edge and
-    // a lone corner pixel.
-    Dem dem = analytic(150, 1.0, [](double x, double y) {
-        return 3 * std::sin(x * 0.31) * std::cos(y * 0.23) + 0.4 * std::sin(x * 1.7 + y * 2.3);
-    });
-    const double nan = std::numeric_limits<double>::quiet_NaN();
-    for (int r = 20; r < 27; ++r)
-        for (int c = 25; c < 33; ++c) dem.values[dem.index(c, r)] = nan;
-    for (int c = 0; c < 40; ++c) dem.values[dem.index(c, 100)] = nan;
-    for (int r = 0; r < 150; r += 3) dem.values[dem.index(149, r)] = nan;
-    dem.values[dem.index(0, 149)] = nan;
+    // on a rough surface with NoData (rough_dem_with_nodata).
+    const Dem dem = rough_dem_with_nodata(150, 100);
     const auto mesh = mesh::dem_to_mesh(dem);
     for (double radius : {2.5, 6.0, 14.0}) {
         // The mesh gathers through the window's vertices: across NoData it may not reach
         // pixels the tables hold. Vertices without NoData within the window agree exactly.
         const int reach = int(std::ceil(radius * 1.6)) + 1;
-        const auto whole = [&](std::size_t v) {
-            const int c = mesh.vertex_pixel[v] % dem.width, r = mesh.vertex_pixel[v] / dem.width;
-            for (int dr = -reach; dr <= reach; ++dr)
-                for (int dc = -reach; dc <= reach; ++dc) {
-                    const int cc = c + dc, rr = r + dr;
-                    if (cc >= 0 && rr >= 0 && cc < dem.width && rr < dem.height &&
-                        !dem.valid(cc, rr))
-                        return false;
-                }
-            return true;
-        };
+        const auto whole = [&](std::size_t v) { return no_nodata_within(dem, mesh, v, reach); };
         const auto a = grid_against_mesh(mesh, radius, whole, field::ShapeIndexWindow::disk);
         INFO("radius " << radius << ": worst " << a.worst << " over " << a.vertices);
         REQUIRE(a.vertices > 5000);
