@@ -21,6 +21,7 @@ namespace terrain::reeb::internal {
 // value range join keep, and the ends swap if the other end is now on the wrong side.
 void Simplifier::fit_arc(i32 b, i32 keep) {
     Arc& arc = arcs_[idx(b)];
+    ends(b);  // live ends
     const float fk = critical_[idx(keep)].value;
     if (arc.end[1] == keep) {
         while (arc.tail != kNone && value(arc.tail) > fk) {
@@ -60,6 +61,7 @@ void Simplifier::fit_arc(i32 b, i32 keep) {
         }
     }
     if (arc.head == kNone) arc.area = 0;
+    refresh_ends(b);
 }
 
 // A critical node left with one arc below and one above becomes regular: its arcs merge
@@ -69,7 +71,8 @@ bool Simplifier::regularize(i32 n, std::vector<i32>& out) {
     if (degree(n) != 2 || down(n) != 1) return false;
     arcs_at(n, all_);
     i32 lower = all_[0], upper = all_[1];
-    if (arcs_[idx(lower)].end[1] != n) std::swap(lower, upper);
+    ends(upper);
+    if (ends(lower)[1] != n) std::swap(lower, upper);
     Arc& L = arcs_[idx(lower)];
     Arc& U = arcs_[idx(upper)];
     if (L.end[0] == U.end[1]) return false;
@@ -94,12 +97,13 @@ bool Simplifier::regularize(i32 n, std::vector<i32>& out) {
     U.set = kNone;
     unlink(upper, q);
     link(lower, q);
+    refresh_ends(lower);  // its far end and nearest node changed at its lower end
     // The arcs parallel to the merged one, found at its end with fewer arcs (the one
     // has_parallel_arc() will look at too).
     out.push_back(lower);
     const i32 m = degree(L.end[0]) <= degree(L.end[1]) ? L.end[0] : L.end[1];
     for_each_arc(m, [&](i32 b) {
-        const auto& e = arcs_[idx(b)].end;
+        const auto& e = ends(b);
         if (b != lower && e[0] == L.end[0] && e[1] == L.end[1]) out.push_back(b);
     });
     return true;
@@ -111,16 +115,16 @@ bool Simplifier::regularize(i32 n, std::vector<i32>& out) {
 // extremum to the farther value would cut across the closer saddle's branches (the
 // rewritten field would then disagree with the graph).
 i32 Simplifier::redirect(i32 a) const {
-    const Arc& arc = arcs_[idx(a)];
-    const i32 lo = arc.end[0], hi = arc.end[1];
+    const auto [lo, hi] = ends(a);
     const bool lo_ext = down(lo) == 0, hi_ext = up(hi) == 0;
     if (lo_ext == hi_ext) return a;  // two extrema: their own rules
     const i32 ext = lo_ext ? lo : hi;
     if (degree(ext) < 2) return a;
+    if (big(ext)) return redirect_big(a, ext);
     i32 best = a;
     float best_gap = persistence(a);
     for_each_arc(ext, [&](i32 b) {
-        const auto& e = arcs_[idx(b)].end;
+        const auto& e = ends(b);
         const i32 other = e[0] == ext ? e[1] : e[0];
         const float gap = persistence(b);
         if (gap < best_gap && !extremum(other) && !has_parallel_arc(b)) {
@@ -138,8 +142,7 @@ i32 Simplifier::redirect(i32 a) const {
 // value, as a saddle would. The midpoint there would move the degenerate extremum and turn
 // its other arcs around, and the rewritten field would no longer match the graph.
 Simplifier::Pairing Simplifier::pairing(i32 a) const {
-    const Arc& arc = arcs_[idx(a)];
-    const i32 lo = arc.end[0], hi = arc.end[1];
+    const auto [lo, hi] = ends(a);
     const bool lo_ext = down(lo) == 0, hi_ext = up(hi) == 0;
     Pairing p;
     p.both = lo_ext && hi_ext;
@@ -165,9 +168,13 @@ bool Simplifier::would_turn_a_loop(i32 a) const {
     // when its far end is then on the other side of that value than the arc says.
     const auto check = [&](i32 n) {
         if (turns || (n == p.keep && !p.midpoint)) return;  // keep's arcs stay as they are
+        if (big(n)) {
+            turns = turns_a_loop_at_big(n, a, p.value);
+            return;
+        }
         for_each_arc(n, [&](i32 b) {
             if (turns || b == a) return;
-            const auto& e = arcs_[idx(b)].end;
+            const auto& e = ends(b);
             const bool n_upper = e[1] == n;
             const float far = value(n_upper ? e[0] : e[1]);
             if ((n_upper ? far > p.value : far < p.value) && has_parallel_arc(b)) turns = true;
@@ -181,7 +188,7 @@ bool Simplifier::would_turn_a_loop(i32 a) const {
 void Simplifier::cancel(i32 a, SimplifyResult& result) {
     turned_.clear();
     Arc& arc = arcs_[idx(a)];
-    const i32 lo = arc.end[0], hi = arc.end[1];
+    const auto [lo, hi] = ends(a);
     const Pairing p = pairing(a);
     const i32 keep = p.keep, gone = p.gone;
     const bool midpoint = p.midpoint, both = p.both;
@@ -198,29 +205,43 @@ void Simplifier::cancel(i32 a, SimplifyResult& result) {
     arc.set = kNone;
     absorb(gone, keep);
     std::vector<i32>& touched = touched_;
-    arcs_at(gone, touched);
-    critical_[idx(gone)].size = 0;
-    release_run(critical_[idx(gone)]);
-    critical_[idx(gone)].down = 0;
-    for (const i32 b : touched) {
-        Arc& other = arcs_[idx(b)];
-        link(b, keep);
-        for (auto& e : other.end)
-            if (e == gone) e = keep;
-        k.down += other.end[1] == keep;
-    }
-    if (midpoint) {
-        arcs_at(keep, all_);
-        for (const i32 b : all_) fit_arc(b, keep);
+    touched.clear();
+    // keep_full: every arc of a big keep may have a new key or candidacy; keep_clear: they are
+    // all looked at again (their waits end).
+    bool keep_full = false, keep_clear = false;
+    const bool handed_over = big(gone) && (!big(keep) || degree(gone) > degree(keep));
+    if (handed_over) {
+        hand_over(keep, gone, midpoint);
+        keep_full = true;
     } else {
-        for (const i32 b : touched) fit_arc(b, keep);
+        arcs_at(gone, touched);
+        critical_[idx(gone)].size = 0;
+        release_run(critical_[idx(gone)]);
+        critical_[idx(gone)].down = 0;
+        for (const i32 b : touched) {
+            const auto& e = ends(b);  // gone's ends now name keep
+            link(b, keep);
+            k.down += e[1] == keep;
+        }
+        if (midpoint) {
+            arcs_at(keep, all_);
+            for (const i32 b : all_) fit_arc(b, keep);
+        } else {
+            for (const i32 b : touched) fit_arc(b, keep);
+        }
     }
     // keep's other arcs need a new look only if they may have become candidates: its
     // value moved, it became an extremum, or its area share per arc went down. Arcs that
     // stopped being candidates are dropped when they reach the top of the heap.
     const double share_after = degree(keep) == 0 ? 0.0 : k.area / static_cast<double>(degree(keep));
-    if (midpoint || extremum(keep) != ext_before || share_after < share_before)
-        arcs_at(keep, touched);
+    if (midpoint || extremum(keep) != ext_before || share_after < share_before) {
+        if (big(keep)) {
+            keep_full = keep_clear = true;
+            touched.clear();
+        } else {
+            arcs_at(keep, touched);
+        }
+    }
 
     merged_.clear();
     if (regularize(keep, merged_)) {
@@ -238,10 +259,24 @@ void Simplifier::cancel(i32 a, SimplifyResult& result) {
             ++result.turned_made_regular;
         } else {
             result.turned_made_extremum += extremum(n);
-            for_each_arc(n, [&](i32 b) { touched.push_back(b); });
+            if (big(n)) {
+                clear_waits(n);
+                mark_full(n);
+            } else {
+                for_each_arc(n, [&](i32 b) { touched.push_back(b); });
+            }
         }
     }
+    promote_pending();
     for (const i32 b : touched) consider(b);
+    if (big(keep)) {
+        if (keep_clear) clear_waits(keep);
+        if (keep_full)
+            mark_full(keep);
+        else
+            rescan(keep);  // its candidate may have been the arc just cancelled
+    }
+    update_reps();
 }
 
 }  // namespace terrain::reeb::internal

@@ -29,6 +29,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <string>
 
 #include "../core/release.hpp"
 #include "simplifier.hpp"
@@ -39,14 +40,22 @@ namespace terrain::reeb {
 namespace internal {
 
 void Simplifier::run(const ProgressFn& progress, SimplifyResult& result) {
-    // The candidates of the input graph.
+    // Nodes with many arcs from the start (a pole's many-armed saddle) are big.
+    promote_pending(true);
+    // The candidates of the input graph; an arc with a big end is queued through it.
     for (std::size_t a = 0; a < arcs_.size(); ++a) {
         if (a + kAhead < arcs_.size()) prefetch_ends(a + kAhead);
-        if (!candidate(static_cast<i32>(a))) continue;
-        queue_.seed(mark_queued(static_cast<i32>(a)));
+        const i32 arc = static_cast<i32>(a);
+        if (managed(arc)) {
+            if (!candidate(arc)) set_waiting(arc);
+            continue;
+        }
+        if (!candidate(arc)) continue;
+        queue_.seed(mark_queued(arc));
         ++pushed_;
     }
     queue_.seal();
+    update_reps();
     std::size_t done = 0;
     // Progress on a clock: a noisy closed surface can spend minutes in cancellations of a
     // high-degree node, thousands of times slower than the first ones. Every 64 cancellations
@@ -62,13 +71,25 @@ void Simplifier::run(const ProgressFn& progress, SimplifyResult& result) {
         const std::size_t next = top == ArcQueue::kEmpty ? idx(a) : idx(ArcQueue::arc_of(top));
         __builtin_prefetch(&arcs_[next]);  // its ends are fetched once a is cancelled
         arcs_[idx(a)].queued = kNotQueued;
-        if (!candidate(a)) continue;  // no longer one since it was queued
+        popped(a);
+        if (!candidate(a)) {  // no longer one since it was queued
+            update_reps();
+            continue;
+        }
         const i32 b = redirect(a);
         if (would_turn_a_loop(b)) {  // it waits (cancellation.cpp)
             ++result.loop_waits;
+            update_reps();
             continue;
         }
         cancel(b, result);
+        if (check_steps_ && check_failure_.empty()) {  // (tests) the nodes just changed
+            check_failure_ = check_big_nodes(done % 1024 == 0 ? nullptr : &updated_);
+            if (!check_failure_.empty())
+                check_failure_ =
+                    "after cancellation " + std::to_string(done) + ": " + check_failure_;
+            updated_.clear();
+        }
         prefetch_ends(next);
         if ((++done & 63) == 0) {
             const auto now = std::chrono::steady_clock::now();
@@ -80,6 +101,7 @@ void Simplifier::run(const ProgressFn& progress, SimplifyResult& result) {
             }
         }
     }
+    if (check_steps_ && check_failure_.empty()) check_failure_ = check_big_nodes();
     result.working_bytes = working_bytes() + queue_.bytes();
     queue_.release();  // the output is the peak of memory: the queue is done
     write_result(result);

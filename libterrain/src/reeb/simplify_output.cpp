@@ -97,10 +97,12 @@ void WorkingGraph::write_result(SimplifyResult& result) {
         result.field[v] = out.node_values[idx(out.vertex_nodes[v])];
     const auto new_id = [&](i32 i) { return -2 - code[idx(i)]; };
     out.arc_offsets.assign(1, 0);
-    for (const Arc& arc : arcs_) {
+    for (std::size_t a = 0; a < arcs_.size(); ++a) {
+        const Arc& arc = arcs_[a];
         if (arc.set == kNone) continue;
         const i32 id = static_cast<i32>(out.arcs.size());
-        out.arcs.push_back({new_id(arc.end[0]), new_id(arc.end[1])});
+        const auto& e = ends(static_cast<i32>(a));
+        out.arcs.push_back({new_id(e[0]), new_id(e[1])});
         for (i32 r = arc.head; r != kNone; r = next(r)) {
             const i32 nid = new_id(r);
             out.arc_nodes.push_back(nid);

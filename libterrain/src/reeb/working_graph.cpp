@@ -28,9 +28,91 @@ i32 WorkingGraph::take_run(std::uint8_t shift) {
     return static_cast<i32>(offset);
 }
 
+void WorkingGraph::make_big(i32 n) {
+    CriticalNode& c = critical_[idx(n)];
+    std::vector<i32> arcs;
+    arcs_at(n, arcs);
+    std::reverse(arcs.begin(), arcs.end());
+    release_run(c);
+    i32 slot;
+    if (!free_big_.empty()) {
+        slot = free_big_.back();
+        free_big_.pop_back();
+    } else {
+        slot = static_cast<i32>(big_.size());
+        big_.emplace_back();
+    }
+    c.offset = slot;
+    c.flags = static_cast<std::uint8_t>((c.flags | kBig) & ~kPending);
+    for (const i32 b : arcs) big_insert(n, b);
+}
+
+void WorkingGraph::release_big(CriticalNode& c) {
+    BigNode& b = big_[idx(c.offset)];
+    b = BigNode{};
+    free_big_.push_back(c.offset);
+    c.flags = static_cast<std::uint8_t>(c.flags & ~(kBig | kPending));
+    c.offset = 0;
+}
+
+WorkingGraph::BigNode::Keys WorkingGraph::keys_of(i32 b, i32 n) const {
+    const auto& e = ends(b);
+    const Arc& arc = arcs_[idx(b)];
+    BigNode::Keys k;
+    k.side = e[1] == n ? 0 : 1;  // 0: n is the upper end, the arc is below it
+    const i32 far = k.side == 0 ? e[0] : e[1];
+    k.far = value(far);
+    const i32 nearest = k.side == 0 ? arc.tail : arc.head;
+    k.near = nearest == kNone ? k.far : value(nearest);
+    k.ext = extremum(far);
+    return k;
+}
+
+void WorkingGraph::big_insert(i32 n, i32 b) {
+    BigNode& big_node = big_of(n);
+    const BigNode::Keys k = keys_of(b, n);
+    if (!big_node.keys.emplace(b, k).second)
+        throw Error("simplify", "internal: arc " + std::to_string(b) + " joined a node twice");
+    const float sign = k.side == 0 ? -1.0f : 1.0f;
+    big_node.far[k.side].emplace(sign * k.far, b);
+    big_node.near[k.side].emplace(sign * k.near, b);
+    if (k.ext) big_node.ext[k.side].emplace(sign * k.far, b);
+    const i32 other = other_end(b, n);
+    if (big(other)) {
+        big_node.bb.insert(b);
+        big_of(other).bb.insert(b);
+    }
+}
+
+void WorkingGraph::big_erase(i32 n, i32 b) {
+    BigNode& big_node = big_of(n);
+    const auto it = big_node.keys.find(b);
+    if (it == big_node.keys.end()) return;
+    const BigNode::Keys k = it->second;
+    const float sign = k.side == 0 ? -1.0f : 1.0f;
+    big_node.far[k.side].erase({sign * k.far, b});
+    big_node.near[k.side].erase({sign * k.near, b});
+    if (k.ext) big_node.ext[k.side].erase({sign * k.far, b});
+    big_node.keys.erase(it);
+    big_node.bb.erase(b);
+}
+
+bool WorkingGraph::refresh(i32 n, i32 b) {
+    if (!big(n)) return false;
+    BigNode& big_node = big_of(n);
+    const auto it = big_node.keys.find(b);
+    if (it == big_node.keys.end()) return false;
+    if (keys_of(b, n) == it->second) return false;
+    big_erase(n, b);
+    big_insert(n, b);
+    return true;
+}
+
 std::size_t WorkingGraph::working_bytes() const {
     std::size_t freed = 0;
     for (const auto& f : free_runs_) freed += f.capacity() * sizeof(i32);
+    // A big node's arc: three set entries and a map entry, about 48 bytes each.
+    for (const BigNode& b : big_) freed += b.keys.size() * 4 * 48 + b.bb.size() * 48;
     return critical_.capacity() * sizeof(CriticalNode) + regular_.capacity() * sizeof(RegularNode) +
            arcs_.capacity() * sizeof(Arc) + arena_.capacity() * sizeof(i32) + freed +
            (set_parent_.capacity() + set_fate_.capacity() + node_map_.capacity()) * sizeof(i32);
@@ -57,7 +139,8 @@ double node_area(const TriangleMesh& mesh, const ReebGraph& g, std::size_t n,
 
 }  // namespace
 
-WorkingGraph::WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g) : g_(g) {
+WorkingGraph::WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big_degree)
+    : g_(g), big_degree_(big_degree) {
     const std::size_t nn = g.node_count(), na = g.arc_count(), nl = g.arc_nodes.size();
     // node_map_[n]: arc ends marked, the other regular nodes of the lists by their position in
     // arc_nodes (`placed` says which positions hold their node); then the new numbers.

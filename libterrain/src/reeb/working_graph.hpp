@@ -8,11 +8,21 @@
 // one per arc, sorted by value. A list absorbed whole is never walked: its area moves at once
 // and its nodes learn where they went in the output, through union-find sets of lists (see
 // Arc). The cancellation rules are in cancellation.cpp, the result in simplify_output.cpp.
+//
+// A node with many arcs is "big" (kBig; the degenerate extrema of noisy closed surfaces
+// reach tens of thousands of arcs and move from node to node): its arcs sit in ordered sets
+// (BigNode) instead of a run, by their far end's value and by the value nearest to the node
+// along the arc, so that a cancellation touches only the arcs it changes. A big node
+// absorbed by a node with fewer arcs hands over its whole set; the arcs it held keep naming
+// it as their end, and ends() follows the absorbed node's `forward` to the live one.
 
 #include <algorithm>
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <set>
+#include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include "../core/indices.hpp"
@@ -29,10 +39,16 @@ using detail::kNone;
 // ahead.
 inline constexpr std::size_t kAhead = 16;
 
+// Nodes with at least this many arcs become big (see above): below it a node's arcs are
+// scanned, above it they are looked up.
+inline constexpr i32 kBigDegree = 48;
+
 class WorkingGraph {
   public:
     // Throws terrain::Error when an arc's list holds an arc end or a node of another list.
-    WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g);
+    // Nodes reaching big_degree arcs become big (kBigDegree; tests lower it to exercise big
+    // nodes on small graphs and raise it to turn them off).
+    WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big_degree = kBigDegree);
 
     // The simplified graph and the rewritten field (simplify_output.cpp).
     void write_result(SimplifyResult& result);
@@ -46,7 +62,7 @@ class WorkingGraph {
     struct alignas(64) CriticalNode {
         double area = 0;  // its vertices' and its absorbed nodes' area
         float value = 0;
-        i32 forward = kNone;  // the node that absorbed it
+        mutable i32 forward = kNone;  // the node that absorbed it (live() shortens the path)
         i32 size = 0;
         i32 down = 0;            // its arcs whose upper end it is
         i32 offset = 0;          // its run in arena_ when shift > 0
@@ -79,6 +95,33 @@ class WorkingGraph {
     };
     static_assert(sizeof(Arc) == 32);
     static constexpr std::uint8_t kCritical = 1, kModified = 2;
+    // kBig: its arcs are in big_[offset]; kPending: it has reached big_degree_ arcs and is
+    // made big at the next safe point (Simplifier::promote_pending); kDirty: it waits in
+    // Simplifier's list of big nodes whose candidate needs a new look.
+    static constexpr std::uint8_t kBig = 4, kPending = 8, kDirty = 16;
+
+    // The arcs of a big node. Side 0 holds the arcs below it (it is their upper end), keyed
+    // by minus a value, side 1 the arcs above, keyed by the value: either way the nearest
+    // come first. `far` keys by the far end's value, `near` by the value next to the node
+    // along the arc (the list's nearest regular node, else the far end), `ext` holds the arcs
+    // of `far` whose far end is an extremum. Keys are refreshed (refresh()) wherever an arc's
+    // list, ends or ends' values change.
+    struct BigNode {
+        using Set = std::set<std::pair<float, i32>>;
+        struct Keys {
+            float far = 0, near = 0;
+            std::uint8_t side = 0;
+            bool ext = false;
+            bool operator==(const Keys&) const = default;
+        };
+        std::array<Set, 2> far, near, ext;
+        std::unordered_map<i32, Keys> keys;
+        std::set<i32> bb;          // arcs here whose other end was big too (may hold stale ones)
+        std::vector<i32> waiting;  // arcs here set waiting (may hold stale ones)
+        std::vector<i32> changed;  // arcs here changed since its candidate was last chosen
+        i32 rep = kNone;           // its candidate in the queue (Simplifier)
+        bool full = false;         // everything changed: its candidate is looked for anew
+    };
     // Any node's fields (a critical node's list neighbours are used once it is regular).
     double& area(i32 n) {
         return n < critical_count_ ? critical_[idx(n)].area
@@ -101,14 +144,53 @@ class WorkingGraph {
                                    : regular_[idx(n - critical_count_)].next;
     }
 
+    // The live node that node n's vertices went to (n itself while it lives): absorbed
+    // critical nodes name the node that took them in `forward`.
+    i32 live(i32 n) const {
+        // (each step halves the path: a node handed over many times is found in a few steps)
+        while (critical_[idx(n)].forward >= 0) {
+            const i32 f = critical_[idx(n)].forward;
+            const i32 ff = critical_[idx(f)].forward;
+            if (ff >= 0) critical_[idx(n)].forward = ff;
+            n = f;
+        }
+        return n;
+    }
+    // Arc b's {lower, upper} ends, live: ends naming an absorbed node (arcs handed over in a
+    // big node's set, see above) are set to the node that took it.
+    const std::array<i32, 2>& ends(i32 b) const {
+        auto& e = arcs_[idx(b)].end;
+        for (i32& n : e)
+            if (critical_[idx(n)].forward >= 0) n = live(n);
+        return e;
+    }
+    i32 other_end(i32 b, i32 n) const {
+        const auto& e = ends(b);
+        return e[0] == n ? e[1] : e[0];
+    }
+    bool big(i32 n) const { return (critical_[idx(n)].flags & kBig) != 0; }
+    BigNode& big_of(i32 n) { return big_[idx(critical_[idx(n)].offset)]; }
+    const BigNode& big_of(i32 n) const { return big_[idx(critical_[idx(n)].offset)]; }
+    // Whether arc b is queued through a big end's candidate rather than on its own.
+    bool managed(i32 b) const {
+        const auto& e = ends(b);
+        return big(e[0]) || big(e[1]);
+    }
+
     // A critical node's arcs, the newest last: in its record while they fit, else in the arena.
     i32* arc_run(CriticalNode& c) { return c.shift == 0 ? c.own.data() : arena_.data() + c.offset; }
     const i32* arc_run(const CriticalNode& c) const {
         return c.shift == 0 ? c.own.data() : arena_.data() + c.offset;
     }
-    // The arcs at a critical node, newest first.
+    // The arcs at a critical node, newest first (a big node's: below it, then above it,
+    // nearest first).
     template <class F>
     void for_each_arc(i32 n, F&& f) const {
+        if (big(n)) {
+            for (const auto& side : big_of(n).far)
+                for (const auto& entry : side) f(entry.second);
+            return;
+        }
         const CriticalNode& c = critical_[idx(n)];
         const i32* r = arc_run(c);
         for (i32 i = c.size - 1; i >= 0; --i) f(r[i]);
@@ -124,7 +206,17 @@ class WorkingGraph {
     // arcs to a new node at every cancellation, as the degenerate extrema of noisy closed
     // surfaces do, once grew it without bound (past 2^31 entries on a 66 M pixel global grid).
     void link(i32 a, i32 n) {
+        ++moves_;
         CriticalNode& c = critical_[idx(n)];
+        if (c.flags & kBig) {
+            big_insert(n, a);
+            ++c.size;
+            return;
+        }
+        if (c.size + 1 >= big_degree_ && !(c.flags & kPending)) {
+            c.flags |= kPending;
+            pending_big_.push_back(n);
+        }
         if (c.size == kInline << c.shift) {
             const std::uint8_t shift = static_cast<std::uint8_t>(c.shift + 1);
             const i32 offset = take_run(shift);
@@ -138,6 +230,11 @@ class WorkingGraph {
     // Arc a leaves node n (the newest of its entries there, for an arc with both ends at n).
     void unlink(i32 a, i32 n) {
         CriticalNode& c = critical_[idx(n)];
+        if (c.flags & kBig) {
+            big_erase(n, a);
+            --c.size;
+            return;
+        }
         if (c.size == 1) {  // its only arc
             c.size = 0;
             release_run(c);
@@ -152,12 +249,32 @@ class WorkingGraph {
     // A node left with no arcs gives its run back (its arcs go in its record again, and its
     // record may hold its list neighbours).
     void release_run(CriticalNode& c) {
+        if (c.flags & kBig) {
+            release_big(c);
+            return;
+        }
         if (c.shift == 0) return;
         free_runs_[c.shift].push_back(c.offset);
         c.shift = 0;
     }
     // A run with room for kInline << shift arcs: a freed one, or a new one at the arena's end.
     i32 take_run(std::uint8_t shift);
+
+    // Big nodes (working_graph.cpp). make_big moves node n's run into a new BigNode;
+    // release_big gives a node's BigNode back (emptied) once the node is gone.
+    void make_big(i32 n);
+    void release_big(CriticalNode& c);
+    // Arc b's keys at big node n, as they are now.
+    BigNode::Keys keys_of(i32 b, i32 n) const;
+    void big_insert(i32 n, i32 b);
+    void big_erase(i32 n, i32 b);
+    // Arc b's keys at its big ends made current; returns whether they changed at n.
+    bool refresh(i32 n, i32 b);
+    void refresh_ends(i32 b) {
+        const auto e = ends(b);
+        if (big(e[0])) refresh(e[0], b);
+        if (e[1] != e[0] && big(e[1])) refresh(e[1], b);
+    }
 
     // Arcs below and above a critical node: its arcs ending there as the upper / lower end
     // (`down` is updated wherever an arc end moves or an arc turns around).
@@ -167,27 +284,26 @@ class WorkingGraph {
     bool extremum(i32 n) const { return down(n) == 0 || up(n) == 0; }
     // The measures of arc a (arc_measures.hpp).
     float persistence(i32 a) const {
-        const Arc& arc = arcs_[idx(a)];
-        return internal::persistence(value(arc.end[0]), value(arc.end[1]));
+        const auto& e = ends(a);
+        return internal::persistence(value(e[0]), value(e[1]));
     }
     double area_ratio(i32 a) const {
         const Arc& arc = arcs_[idx(a)];
-        const i32 lo = arc.end[0], hi = arc.end[1];
+        const auto [lo, hi] = ends(a);
         const auto add_list_area = [&](double sum) { return sum + arc.area; };
         return internal::area_ratio(critical_[idx(lo)].area, degree(lo), critical_[idx(hi)].area,
                                     degree(hi), add_list_area, total_area_);
     }
     // Whether another arc joins the same two nodes as arc a (a loop of the graph).
     bool has_parallel_arc(i32 a) const {
-        const Arc& arc = arcs_[idx(a)];
-        const i32 n = degree(arc.end[0]) <= degree(arc.end[1]) ? arc.end[0] : arc.end[1];
+        const auto end = ends(a);
+        const i32 n = degree(end[0]) <= degree(end[1]) ? end[0] : end[1];
         if (degree(n) == 1) return false;  // a is its only arc
         bool found = false;
         for_each_arc(n, [&](i32 b) {
-            if (b == a) return;
-            const auto& e = arcs_[idx(b)].end;
-            found |= (e[0] == arc.end[0] && e[1] == arc.end[1]) ||
-                     (e[0] == arc.end[1] && e[1] == arc.end[0]);
+            if (b == a || found) return;
+            const auto& e = ends(b);
+            found |= (e[0] == end[0] && e[1] == end[1]) || (e[0] == end[1] && e[1] == end[0]);
         });
         return found;
     }
@@ -222,9 +338,14 @@ class WorkingGraph {
     std::array<std::vector<i32>, 32> free_runs_;  // freed runs by shift
     std::size_t arena_peak_ = 0;                  // the arena's largest size, entries
     double total_area_ = 0;
-    std::vector<i32> set_parent_;  // of each set, kNone for a root (an arc's current set)
-    std::vector<i32> set_fate_;    // of each root set: the node that absorbed it, or kNone
-    std::vector<Arc> arcs_;
+    std::vector<i32> set_parent_;    // of each set, kNone for a root (an arc's current set)
+    std::vector<i32> set_fate_;      // of each root set: the node that absorbed it, or kNone
+    mutable std::vector<Arc> arcs_;  // (ends() sets live ends as it reads them)
+    i32 big_degree_ = kBigDegree;
+    std::vector<BigNode> big_;      // the big nodes' arcs (a node's BigNode at its offset)
+    std::vector<i32> free_big_;     // BigNodes given back, for reuse
+    std::vector<i32> pending_big_;  // nodes flagged kPending
+    std::size_t moves_ = 0;         // link() calls
 };
 
 }  // namespace terrain::reeb::internal
