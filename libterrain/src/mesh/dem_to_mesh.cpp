@@ -262,10 +262,12 @@ TriangleMesh dem_to_mesh(const Dem& dem, const DemToMeshOptions& options,
 
     // Leave out valid pixels in no triangle (isolated, or only in degenerate blocks).
     mesh.isolated_vertices = remove_unreferenced_vertices(mesh);
+    report_progress(progress, 0.75, "mesh");
     mesh.pinched_vertices = split_pinched_vertices(mesh);
     mesh.positions.shrink_to_fit();
     mesh.vertex_pixel.shrink_to_fit();
-    finish_mesh(mesh);
+    report_progress(progress, 0.8, "mesh");
+    finish_mesh(mesh, scaled_progress(progress, 0.8, 1));
     report_progress(progress, 1.0, "mesh");
     return mesh;
 }

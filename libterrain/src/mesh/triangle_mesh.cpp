@@ -71,7 +71,7 @@ void check_adjacency_size(std::uint64_t entries, const char* what) {
 
 }  // namespace
 
-void finish_mesh(TriangleMesh& mesh) {
+void finish_mesh(TriangleMesh& mesh, const ProgressFn& progress) {
     const std::size_t n = mesh.positions.size();
     // Vertex areas: one third of each incident triangle (serial: the same sums every run).
     std::vector<double> area(n, 0.0);
@@ -81,6 +81,7 @@ void finish_mesh(TriangleMesh& mesh) {
     }
     mesh.vertex_areas.assign(area.begin(), area.end());
     detail::release(area);
+    report_progress(progress, 0.25, "mesh");
 
     // CSR adjacency from the triangles' edges, each list sorted and without repeats. Before
     // the repeats go there are two entries per triangle corner (12 per vertex of a grid,
@@ -98,6 +99,7 @@ void finish_mesh(TriangleMesh& mesh) {
             all[fill[t[k]]++] = t[(k + 2) % 3];
         }
     detail::release(fill);
+    report_progress(progress, 0.5, "mesh");
     mesh.neighbor_offsets.assign(n + 1, 0);
     std::size_t write = 0;
     for (std::size_t v = 0; v < n; ++v) {
@@ -109,6 +111,8 @@ void finish_mesh(TriangleMesh& mesh) {
             throw Error("mesh", "the mesh has more than 2^31 vertex neighbours (" +
                                     std::to_string(n) + " vertices): too large");
         mesh.neighbor_offsets[v + 1] = static_cast<std::int32_t>(write);
+        if ((v & 0xfffff) == 0xfffff)
+            report_progress(progress, 0.5 + 0.5 * double(v) / double(n), "mesh");
     }
     all.resize(write);
     all.shrink_to_fit();

@@ -223,10 +223,13 @@ ScaleResult grow_scale(const Input& input, const std::vector<float>& field,
     segment::GrowOptions grow;
     grow.saddle_penalty = options.saddle_penalty;
     grow.cost = grow_cost(options, input.dem.has_value());
-    out.segmentation = segment::grow_regions(input.mesh, simplified.graph, grow, progress);
-    if (parse_absorbed(options.absorbed) == Absorbed::divide)
-        out.divided = segment::divide_absorbed(input.mesh, simplified.graph, field,
-                                               simplified.absorbed, out.segmentation, finer);
+    const bool divide = parse_absorbed(options.absorbed) == Absorbed::divide;
+    out.segmentation = segment::grow_regions(input.mesh, simplified.graph, grow,
+                                             scaled_progress(progress, 0, divide ? 0.5 : 1));
+    if (divide)
+        out.divided =
+            segment::divide_absorbed(input.mesh, simplified.graph, field, simplified.absorbed,
+                                     out.segmentation, finer, scaled_progress(progress, 0.5, 1));
     out.grow_seconds = since(t0);
     return out;
 }
@@ -257,27 +260,29 @@ SegmentResult segment(Input input, const SegmentOptions& options, const Progress
     result.input = std::move(input);
     result.timings.push_back({"read", result.input.read_seconds});
     if (result.input.dem) result.timings.push_back({"mesh", result.input.mesh_seconds});
-    // The slices of the command line's bar (field 0.15-0.45, reeb -0.6, segment -0.7).
-    compute_field(result, options, scaled_progress(progress, 0, 30.0 / 55));
-    auto graph = compute_reeb(result, scaled_progress(progress, 30.0 / 55, 45.0 / 55));
+    // Slices of the progress by the stages' measured cost on global grids of 1 to 66 M
+    // pixels (docs/performance.md): field 0.2, Reeb graph 0.2, simplification 0.2, growing
+    // and dividing 0.3, region graph 0.1.
+    compute_field(result, options, scaled_progress(progress, 0, 0.2));
+    auto graph = compute_reeb(result, scaled_progress(progress, 0.2, 0.4));
     // One scale only: the simplification takes the graph and frees what it no longer needs,
     // which lowers the peak memory.
     const auto t0 = clock::now();
     const auto thresholds = simplify_options(options, result.input.mesh);
     result.area_ratio_percent = thresholds.area_ratio;
     const auto simplified = reeb::simplify(result.input.mesh, std::move(graph), thresholds,
-                                           scaled_progress(progress, 45.0 / 55, 48.0 / 55));
+                                           scaled_progress(progress, 0.4, 0.6));
     const double seconds = since(t0);
     auto scale = grow_scale(result.input, result.field, options, simplified, seconds,
-                            scaled_progress(progress, 48.0 / 55, 1));
+                            scaled_progress(progress, 0.6, 0.9));
     result.segmentation = std::move(scale.segmentation);
     result.after = scale.after;
     result.divided = scale.divided;
     result.add_time("simplify", scale.simplify_seconds);
     const auto t1 = clock::now();
-    result.regions =
-        segment::region_graph(result.input.mesh, result.field, result.segmentation.labels,
-                              result.segmentation.region_count, result.dem());
+    result.regions = segment::region_graph(
+        result.input.mesh, result.field, result.segmentation.labels,
+        result.segmentation.region_count, result.dem(), scaled_progress(progress, 0.9, 1));
     // On a DEM, with the regions of valid pixels in no triangle (segment::label_pixels).
     result.segmentation.region_count = static_cast<std::uint32_t>(result.regions.regions.size());
     result.add_time("grow", scale.grow_seconds + since(t1));

@@ -62,7 +62,8 @@ void Simplifier::run(const ProgressFn& progress, SimplifyResult& result) {
     // the clock is read; at least every quarter second the fraction done of the work known
     // (cancellations made, plus the candidates queued) is reported, never going back.
     auto reported_at = std::chrono::steady_clock::now();
-    double reported = 0;
+    double reported = 0.02;  // the copy and the first candidates
+    report_progress(progress, reported, "simplify");
     // Lowest persistence first, until no candidate is left.
     for (std::uint64_t key; (key = take()) != ArcQueue::kEmpty;) {
         const i32 a = ArcQueue::arc_of(key);
@@ -104,6 +105,7 @@ void Simplifier::run(const ProgressFn& progress, SimplifyResult& result) {
     if (check_steps_ && check_failure_.empty()) check_failure_ = check_big_nodes();
     result.working_bytes = working_bytes() + queue_.bytes();
     queue_.release();  // the output is the peak of memory: the queue is done
+    report_progress(progress, 0.9, "simplify");
     write_result(result);
     report_progress(progress, 1.0, "simplify");
 }

@@ -102,7 +102,7 @@ double mean_edge_length(const TriangleMesh& mesh) {
 DivideCounts divide_absorbed(const TriangleMesh& mesh, const reeb::ReebGraph& graph,
                              const std::vector<float>& field,
                              const std::vector<std::uint8_t>& absorbed, Segmentation& segmentation,
-                             const std::vector<std::uint32_t>* finer) {
+                             const std::vector<std::uint32_t>* finer, const ProgressFn& progress) {
     const std::size_t n = mesh.vertex_count();
     if (finer && finer->size() != n)
         throw Error("segment", "divide_absorbed: the finer labels do not match the mesh");
@@ -117,7 +117,10 @@ DivideCounts divide_absorbed(const TriangleMesh& mesh, const reeb::ReebGraph& gr
             labels[v] = 0;
             ++counts.absorbed;
         }
-    if (counts.absorbed == 0) return counts;
+    if (counts.absorbed == 0) {
+        report_progress(progress, 1, "divide");
+        return counts;
+    }
     // 1b. With a finer scale's labels: absorbed vertices first go with their finer region.
     if (finer) {
         const auto here = finer_to_here(*finer, labels);
@@ -156,6 +159,7 @@ DivideCounts divide_absorbed(const TriangleMesh& mesh, const reeb::ReebGraph& gr
             labels[v] = 0;
             ++counts.detached;
         }
+    report_progress(progress, 0.2, "divide");
     // 3. Flooding from the regions' edges: the shortest paths in the metric where a step
     // into u for region r costs |field(u) - mean(r)| plus a constant per mean edge length.
     const float step = kStepShare * field_spread(field);
@@ -199,6 +203,10 @@ DivideCounts divide_absorbed(const TriangleMesh& mesh, const reeb::ReebGraph& gr
             neighbours(w, [&](std::size_t u) { edge |= labels[u] == 0; });
             if (edge) push_around(w);
         }
+    // (the vertices to label: the absorbed ones and those detached, less those kept)
+    std::size_t to_label = 0, labelled = 0;
+    for (std::size_t v = 0; v < n; ++v) to_label += labels[v] == 0;
+    report_progress(progress, 0.3, "divide");
     while (!heap.empty()) {
         const Step s = heap.top();
         heap.pop();
@@ -207,7 +215,10 @@ DivideCounts divide_absorbed(const TriangleMesh& mesh, const reeb::ReebGraph& gr
         labels[u] = s.label;
         cost[u] = s.cost;
         push_around(u);
+        if ((++labelled & 0xffff) == 0)
+            report_progress(progress, 0.3 + 0.7 * double(labelled) / double(to_label), "divide");
     }
+    report_progress(progress, 1, "divide");
     for (std::size_t v = 0; v < n; ++v) {
         if (labels[v] == 0)
             throw Error("segment", "divide_absorbed: vertex " + std::to_string(v) +

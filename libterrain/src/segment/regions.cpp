@@ -302,8 +302,9 @@ std::vector<std::uint32_t> label_pixels(const TriangleMesh& mesh, const Dem& dem
 
 RegionGraph region_graph(const TriangleMesh& mesh, const std::vector<float>& field,
                          const std::vector<std::uint32_t>& labels, std::uint32_t region_count,
-                         const Dem* dem) {
+                         const Dem* dem, const ProgressFn& progress) {
     check_inputs(mesh, field, labels, region_count, dem);
+    report_progress(progress, 0, "regions");
     // On a DEM, the regions of valid pixels in no triangle come after the vertices' regions.
     std::vector<std::uint32_t> pixels;
     std::uint32_t total = region_count;
@@ -311,6 +312,7 @@ RegionGraph region_graph(const TriangleMesh& mesh, const std::vector<float>& fie
         pixels = label_pixels(mesh, *dem, labels);
         for (const auto l : pixels) total = std::max(total, l);
     }
+    report_progress(progress, 0.2, "regions");
     RegionGraph graph;
     graph.regions.resize(total);
     std::vector<double> weighted(region_count, 0.0), plain(region_count, 0.0);
@@ -340,6 +342,7 @@ RegionGraph region_graph(const TriangleMesh& mesh, const std::vector<float>& fie
         r.area_m2 = r.surface_area_m2;
     }
 
+    report_progress(progress, 0.4, "regions");
     // Regions of pixels only: no vertex, no field (NaN), no mesh area.
     for (std::uint32_t i = region_count; i < total; ++i) {
         auto& r = graph.regions[i];
@@ -361,11 +364,13 @@ RegionGraph region_graph(const TriangleMesh& mesh, const std::vector<float>& fie
             }
     }
 
+    report_progress(progress, 0.5, "regions");
     const auto best = representative_vertices(mesh, labels, region_count);
     for (std::uint32_t i = 0; i < region_count; ++i)
         graph.regions[i].representative_vertex = best[i];
     set_points(graph, mesh, dem, first_pixel);
 
+    report_progress(progress, 0.7, "regions");
     const auto sums = boundary_sums(mesh, labels);
     graph.edges.reserve(sums.size());
     for (const auto& [key, s] : sums) {
@@ -385,6 +390,7 @@ RegionGraph region_graph(const TriangleMesh& mesh, const std::vector<float>& fie
         ++graph.regions[e.a - 1].neighbor_count;
         ++graph.regions[e.b - 1].neighbor_count;
     }
+    report_progress(progress, 1, "regions");
     return graph;
 }
 

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "terrain/core/body.hpp"
+#include "terrain/core/progress.hpp"
 
 namespace terrain {
 
@@ -75,7 +76,7 @@ struct MeshTopology {
 void set_positions(TriangleMesh& mesh, const std::vector<std::array<double, 3>>& points);
 
 // Fills vertex_areas and the CSR adjacency from positions and triangles.
-void finish_mesh(TriangleMesh& mesh);
+void finish_mesh(TriangleMesh& mesh, const ProgressFn& progress = {});
 
 MeshTopology mesh_topology(const TriangleMesh& mesh);
 

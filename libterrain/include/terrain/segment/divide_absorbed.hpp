@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "terrain/core/progress.hpp"
 #include "terrain/mesh/triangle_mesh.hpp"
 #include "terrain/reeb/reeb_graph.hpp"
 #include "terrain/segment/grow_regions.hpp"
@@ -39,6 +40,7 @@ struct DivideCounts {
 DivideCounts divide_absorbed(const TriangleMesh& mesh, const reeb::ReebGraph& graph,
                              const std::vector<float>& field,
                              const std::vector<std::uint8_t>& absorbed, Segmentation& segmentation,
-                             const std::vector<std::uint32_t>* finer = nullptr);
+                             const std::vector<std::uint32_t>* finer = nullptr,
+                             const ProgressFn& progress = {});
 
 }  // namespace terrain::segment

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "terrain/core/dem.hpp"
+#include "terrain/core/progress.hpp"
 #include "terrain/mesh/triangle_mesh.hpp"
 
 namespace terrain::segment {
@@ -88,9 +89,10 @@ struct RegionGraph {
 // label_pixels gives a region. `dem` is the DEM the mesh was made from, or nullptr for a mesh
 // read from a file. Throws terrain::Error (stage "segment") on sizes that do not match,
 // labels out of range or unused ids.
+// Progress goes to `progress` between its passes over the grid.
 RegionGraph region_graph(const TriangleMesh& mesh, const std::vector<float>& field,
                          const std::vector<std::uint32_t>& labels, std::uint32_t region_count,
-                         const Dem* dem);
+                         const Dem* dem, const ProgressFn& progress = {});
 
 // The label of each DEM pixel (row-major), 0 where the DEM has NoData; the pixels of a
 // collapsed pole row take the pole vertex's label. Every valid pixel has a label: a pixel in
