@@ -25,14 +25,7 @@ void Simplifier::promote_pending(bool initial) {
             (void)keys;
             // An arc that was queued on its own is now queued through n (and through its other
             // end if that is big already, in which case nothing changes for it).
-            if (initial || big(other_end(arc, n))) continue;
-            if (arcs_[idx(arc)].queued != kNotQueued) {
-                queue_.erase(arc);
-                arcs_[idx(arc)].queued = kNotQueued;
-                waiting_[idx(arc)] = 0;
-            } else {
-                waiting_[idx(arc)] = 1;
-            }
+            if (!initial && !big(other_end(arc, n))) queue_through_big_end(arc);
         }
         // (its waiting list in arc order, for the same result whatever the hash)
         std::vector<i32> waits;
@@ -43,6 +36,17 @@ void Simplifier::promote_pending(bool initial) {
         rescan(n);
     }
     pending_big_.clear();
+}
+
+// Arc b, queued on its own until now, is queued through its new big end: its own entry goes,
+// and being out of the queue becomes its waiting flag.
+void Simplifier::queue_through_big_end(i32 b) {
+    const bool queued = arcs_[idx(b)].queued != kNotQueued;
+    if (queued) {
+        queue_.erase(b);
+        arcs_[idx(b)].queued = kNotQueued;
+    }
+    waiting_[idx(b)] = queued ? 0 : 1;
 }
 
 void Simplifier::mark_dirty(i32 n) {
@@ -254,15 +258,7 @@ void Simplifier::hand_over(i32 keep, i32 gone, bool midpoint) {
     for (const i32 b : own_) {
         const i32 other = other_end(b, keep);
         link(b, keep);
-        if (!keep_was_big && !big(other)) {  // it was queued on its own: now through keep
-            if (arcs_[idx(b)].queued != kNotQueued) {
-                queue_.erase(b);
-                arcs_[idx(b)].queued = kNotQueued;
-                waiting_[idx(b)] = 0;
-            } else {
-                waiting_[idx(b)] = 1;
-            }
-        }
+        if (!keep_was_big && !big(other)) queue_through_big_end(b);
         if (waiting_[idx(b)]) big_of(keep).waiting.push_back(b);
     }
     // The arcs to fit: all of them at a midpoint, else those whose nearest value is now on

@@ -105,6 +105,7 @@ class Simplifier : WorkingGraph {
     // Big nodes (big_nodes.cpp).
     void promote_pending(bool initial = false);  // nodes flagged kPending become big
     void consider_managed(i32 a);                // consider() for an arc with a big end
+    void queue_through_big_end(i32 b);           // arc b just got its first big end
     void mark_changed(i32 n, i32 b);             // arc b at big node n changed
     void mark_full(i32 n);                       // everything at big node n may have changed
     void rescan(i32 n);                          // big node n's candidate is looked for anew
