@@ -25,12 +25,19 @@ namespace terrain::reeb::internal {
 
 class Simplifier : WorkingGraph {
   public:
+    // The copy into the working graph reports through `progress` as 0 to 1 of the whole
+    // simplification's first quarter (run() reports the rest).
     Simplifier(const TriangleMesh& mesh, const ReebGraph& g, const SimplifyOptions& options,
-               i32 big_degree = kBigDegree)
-        : WorkingGraph(mesh, g, big_degree), options_(options) {
+               i32 big_degree = kBigDegree, const ProgressFn& progress = {})
+        : WorkingGraph(mesh, g, big_degree, scaled_progress(progress, 0, kCopyEnd)),
+          options_(options) {
         queue_.init(arcs_.size());
         waiting_.assign(arcs_.size(), 0);
     }
+
+    // Slices of the simplification's progress, by their measured cost on global grids: the
+    // copy into the working graph, the cancellations, the output.
+    static constexpr double kCopyEnd = 0.25, kOutputStart = 0.75;
 
     // Cancels candidates until none is left, then writes the result (simplify.cpp).
     void run(const ProgressFn& progress, SimplifyResult& result);

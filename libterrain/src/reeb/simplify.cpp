@@ -62,7 +62,7 @@ void Simplifier::run(const ProgressFn& progress, SimplifyResult& result) {
     // the clock is read; at least every quarter second the fraction done of the work known
     // (cancellations made, plus the candidates queued) is reported, never going back.
     auto reported_at = std::chrono::steady_clock::now();
-    double reported = 0.02;  // the copy and the first candidates
+    double reported = kCopyEnd;  // the copy and the first candidates
     report_progress(progress, reported, "simplify");
     // Lowest persistence first, until no candidate is left.
     for (std::uint64_t key; (key = take()) != ArcQueue::kEmpty;) {
@@ -97,7 +97,8 @@ void Simplifier::run(const ProgressFn& progress, SimplifyResult& result) {
             if (now - reported_at >= std::chrono::milliseconds(250)) {
                 reported_at = now;
                 const double known = static_cast<double>(done + queue_.pending());
-                reported = std::max(reported, 0.9 * static_cast<double>(done) / known);
+                reported = std::max(reported, kCopyEnd + (kOutputStart - kCopyEnd) *
+                                                             static_cast<double>(done) / known);
                 report_progress(progress, reported, "simplify");
             }
         }
@@ -105,8 +106,8 @@ void Simplifier::run(const ProgressFn& progress, SimplifyResult& result) {
     if (check_steps_ && check_failure_.empty()) check_failure_ = check_big_nodes();
     result.working_bytes = working_bytes() + queue_.bytes();
     queue_.release();  // the output is the peak of memory: the queue is done
-    report_progress(progress, 0.9, "simplify");
-    write_result(result);
+    report_progress(progress, kOutputStart, "simplify");
+    write_result(result, scaled_progress(progress, kOutputStart, 1));
     report_progress(progress, 1.0, "simplify");
 }
 
@@ -132,7 +133,8 @@ SimplifyResult simplify(const TriangleMesh& mesh, const ReebGraph& graph,
     if (graph.vertex_nodes.size() != mesh.vertex_count())
         throw Error("simplify", "the graph was not built on this mesh");
     SimplifyResult result;
-    internal::Simplifier(mesh, graph, options).run(progress, result);
+    internal::Simplifier(mesh, graph, options, internal::kBigDegree, progress)
+        .run(progress, result);
     return result;
 }
 
@@ -142,7 +144,7 @@ SimplifyResult simplify(const TriangleMesh& mesh, ReebGraph&& graph, const Simpl
     if (graph.vertex_nodes.size() != mesh.vertex_count())
         throw Error("simplify", "the graph was not built on this mesh");
     SimplifyResult result;
-    internal::Simplifier simplifier(mesh, graph, options);
+    internal::Simplifier simplifier(mesh, graph, options, internal::kBigDegree, progress);
     // The working copy holds the arcs now; the output reads only the vertex lists and links.
     detail::release(graph.arcs);
     detail::release(graph.arc_offsets);

@@ -8,14 +8,20 @@
 #include <array>
 
 #include "../core/disjoint_sets.hpp"
+#include "../core/pass_progress.hpp"
 #include "working_graph.hpp"
 
 namespace terrain::reeb::internal {
 
 using detail::find_root;
 
-void WorkingGraph::write_result(SimplifyResult& result) {
+void WorkingGraph::write_result(SimplifyResult& result, const ProgressFn& progress) {
     const std::size_t nn = g_.node_count(), nl = regular_.size();
+    // Its passes: the fates (0 to 0.2), the new numbers (to 0.4), the vertices (to 0.8), the
+    // arcs (to 1).
+    using detail::PassProgress;
+    const PassProgress fates(progress, 0, 0.2, "simplify"), numbers(progress, 0.2, 0.4, "simplify"),
+        vertices(progress, 0.4, 0.8, "simplify"), arcs(progress, 0.8, 1, "simplify");
     // code[i]: for an absorbed node, the critical node that finally took it (nodes are
     // only absorbed into critical nodes); for a remaining node, -2 - its new id.
     // A listed node's forward: the fate of its set's root (kNone for a list still there).
@@ -27,6 +33,7 @@ void WorkingGraph::write_result(SimplifyResult& result) {
     for (std::size_t k = 0; k < idx(critical_count_); ++k)
         if (code[k] != kNone) code[k] = find_root(code, code[k]);
     for (std::size_t p = 0; p < nl; ++p) {
+        fates.at(p, nl);
         const i32 f = fate(regular_[p].forward);
         code[idx(critical_count_) + p] = f == kNone || code[idx(f)] == kNone ? f : code[idx(f)];
     }
@@ -35,6 +42,7 @@ void WorkingGraph::write_result(SimplifyResult& result) {
     std::vector<std::array<i32, 2>> kept;   // {old node, internal index} by new id
     std::vector<std::uint8_t> gone(nn, 0);  // old nodes absorbed by another
     for (std::size_t n = 0; n < nn; ++n) {
+        numbers.at(n, nn);
         if (n + kAhead < nn) __builtin_prefetch(&code[idx(node_map_[n + kAhead])]);
         i32& c = code[idx(node_map_[n])];
         if (c != kNone) {
@@ -79,6 +87,7 @@ void WorkingGraph::write_result(SimplifyResult& result) {
     out.vertex_nodes.resize(g_.vertex_nodes.size());
     result.absorbed.assign(g_.vertex_nodes.size(), 0);
     for (std::size_t n = 0; n < nn; ++n) {
+        vertices.at(n, nn);
         if (n + kAhead < nn) {
             const i32 i = g_.node_vertex_offsets[n + kAhead];
             if (i < g_.node_vertex_offsets[n + kAhead + 1])
@@ -98,6 +107,7 @@ void WorkingGraph::write_result(SimplifyResult& result) {
     const auto new_id = [&](i32 i) { return -2 - code[idx(i)]; };
     out.arc_offsets.assign(1, 0);
     for (std::size_t a = 0; a < arcs_.size(); ++a) {
+        arcs.at(a, arcs_.size());
         const Arc& arc = arcs_[a];
         if (arc.set == kNone) continue;
         const i32 id = static_cast<i32>(out.arcs.size());

@@ -8,6 +8,7 @@
 #include <limits>
 #include <string>
 
+#include "../core/pass_progress.hpp"
 #include "terrain/core/error.hpp"
 
 namespace terrain::reeb::internal {
@@ -139,8 +140,13 @@ double node_area(const TriangleMesh& mesh, const ReebGraph& g, std::size_t n,
 
 }  // namespace
 
-WorkingGraph::WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big_degree)
+WorkingGraph::WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big_degree,
+                           const ProgressFn& progress)
     : g_(g), big_degree_(big_degree) {
+    // Its three passes: the lists (0 to 0.1), the nodes (to 0.6), the arcs (to 1).
+    using detail::PassProgress;
+    const PassProgress lists(progress, 0, 0.1, "simplify"), nodes(progress, 0.1, 0.6, "simplify"),
+        arcs(progress, 0.6, 1, "simplify");
     const std::size_t nn = g.node_count(), na = g.arc_count(), nl = g.arc_nodes.size();
     // node_map_[n]: arc ends marked, the other regular nodes of the lists by their position in
     // arc_nodes (`placed` says which positions hold their node); then the new numbers.
@@ -149,6 +155,7 @@ WorkingGraph::WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big
     for (const auto& e : g.arcs) node_map_[idx(e[0])] = node_map_[idx(e[1])] = kEnd;
     std::vector<char> placed(nl, 0);
     for (std::size_t p = 0; p < nl; ++p) {
+        lists.at(p, nl);
         const i32 r = g.arc_nodes[p];
         // (A critical node in a list keeps its neighbours in its record, which an arc end
         // needs for its arcs.)
@@ -167,6 +174,7 @@ WorkingGraph::WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big
     std::vector<i32> scratch;
     i32 k = 0;
     for (std::size_t n = 0; n < nn; ++n) {
+        nodes.at(n, nn);
         if (n + kAhead < nn) {
             const std::size_t m = n + kAhead;
             const i32 i = g.node_vertex_offsets[m];
@@ -193,6 +201,7 @@ WorkingGraph::WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big
     set_parent_.assign(na, kNone);
     set_fate_.assign(na, kNone);
     for (std::size_t a = 0; a < na; ++a) {
+        arcs.at(a, na);
         Arc& arc = arcs_[a];
         if (a + kAhead < na)
             for (const i32 e : g.arcs[a + kAhead]) __builtin_prefetch(&node_map_[idx(e)]);

@@ -27,6 +27,7 @@
 
 #include "../core/indices.hpp"
 #include "arc_measures.hpp"
+#include "terrain/core/progress.hpp"
 #include "terrain/reeb/simplify.hpp"
 
 namespace terrain::reeb::internal {
@@ -47,11 +48,13 @@ class WorkingGraph {
   public:
     // Throws terrain::Error when an arc's list holds an arc end or a node of another list.
     // Nodes reaching big_degree arcs become big (kBigDegree; tests lower it to exercise big
-    // nodes on small graphs and raise it to turn them off).
-    WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big_degree = kBigDegree);
+    // nodes on small graphs and raise it to turn them off). The copy reports its progress
+    // (0 to 1), as the output does: each is a pass over every node, vertex and arc.
+    WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big_degree = kBigDegree,
+                 const ProgressFn& progress = {});
 
     // The simplified graph and the rewritten field (simplify_output.cpp).
-    void write_result(SimplifyResult& result);
+    void write_result(SimplifyResult& result, const ProgressFn& progress = {});
     // The bytes it holds now: records, arc runs (freed ones included), list sets.
     std::size_t working_bytes() const;
 
