@@ -1,12 +1,16 @@
 // Benchmark: the region graph and every segment output of a 1000x1000 DEM cut into about
 // 2000 jagged regions (jittered-grid Voronoi cells).
 //   build/tests/bench/bench_outputs [size] [regions]
+#include <malloc.h>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <functional>
+#include <string>
 
 #include "bench_dem.hpp"
 #include "terrain/field/vertex_field.hpp"
@@ -26,6 +30,32 @@ double seconds(const std::function<void()>& f) {
     const auto t0 = std::chrono::steady_clock::now();
     f();
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// kB of the process's resident set ("VmRSS") or of its peak ("VmHWM").
+double status_kb(const char* key) {
+    std::ifstream in("/proc/self/status");
+    std::string k;
+    double value = 0;
+    while (in >> k) {
+        if (k == std::string(key) + ":") {
+            in >> value;
+            return value;
+        }
+        std::getline(in, k);
+    }
+    return 0;
+}
+
+// Seconds of f, and the bytes its peak resident set rose above the set before it (the peak
+// is reset first, through /proc/self/clear_refs, and the heap's free pages given back, so
+// that what f allocates shows).
+std::array<double, 2> seconds_and_peak(const std::function<void()>& f) {
+    malloc_trim(0);
+    std::ofstream("/proc/self/clear_refs") << "5";
+    const double before = status_kb("VmRSS");
+    const double s = seconds(f);
+    return {s, (status_kb("VmHWM") - before) * 1024.0};
 }
 
 // A small deterministic hash in [0,1).
@@ -94,14 +124,18 @@ int main(int argc, char** argv) {
     std::printf("labels.tif           %.3f s\n", seconds([&] {
                     io::write_label_raster(dem, pixels, graph, path("labels.tif"), true);
                 }));
-    std::printf("regions.geojson      %.3f s\n", seconds([&] {
-                    io::write_region_polygons(dem, pixels, graph, path("regions.geojson"), true);
-                }));
+    // The polygons' memory: their peak above what was held before, per pixel.
+    const double px = double(dem.width) * double(dem.height);
+    const auto geojson = seconds_and_peak(
+        [&] { io::write_region_polygons(dem, pixels, graph, path("regions.geojson"), true); });
+    std::printf("regions.geojson      %.3f s  %.2f M pixels/s  peak +%.1f MB  %.2f bytes/pixel\n",
+                geojson[0], px / geojson[0] / 1e6, geojson[1] / 1e6, geojson[1] / px);
     io::RegionPolygonOptions gpkg;
     gpkg.driver = "GPKG";
-    std::printf("regions.gpkg         %.3f s\n", seconds([&] {
-                    io::write_region_polygons(dem, pixels, graph, path("regions.gpkg"), true, gpkg);
-                }));
+    const auto geopackage = seconds_and_peak(
+        [&] { io::write_region_polygons(dem, pixels, graph, path("regions.gpkg"), true, gpkg); });
+    std::printf("regions.gpkg         %.3f s  %.2f M pixels/s  peak +%.1f MB  %.2f bytes/pixel\n",
+                geopackage[0], px / geopackage[0] / 1e6, geopackage[1] / 1e6, geopackage[1] / px);
     std::printf("adjacency.json       %.3f s\n",
                 seconds([&] { io::write_adjacency_json(graph, path("adjacency.json"), true); }));
     std::printf("adjacency.graphml    %.3f s\n", seconds([&] {

@@ -5,9 +5,11 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <memory>
 #include <sstream>
+#include <thread>
 
 #include "support/segment_support.hpp"
 #include "support/test_support.hpp"
@@ -250,6 +252,43 @@ TEST_CASE("regions.geojson without CRS is in the DEM's map coordinates",
         sum += area;
     }
     CHECK(sum == Approx(70 * 120 * 1.01 * 1.01).epsilon(1e-9));
+}
+
+TEST_CASE("Region polygons wait in an unlinked temporary file and are read back region by region",
+          "[write_region_polygons]") {
+    // The outlines are never all in memory: GDALPolygonize's pieces go to a temporary file
+    // beside the output, unlinked from the start, so nothing is left behind.
+    const Dem mars = io::read_dem(test::sample("mars_hirise_crop.tif"));
+    const auto t = test::segment_tile(mars, designed_labels(mars));
+    const auto dir = test::scratch_dir("write_region_polygons_spill");
+    const auto path = (dir / "regions.geojson").string();
+    io::write_region_polygons(t.dem, t.pixels, t.graph, path, false);
+    std::vector<std::string> names;
+    for (const auto& e : std::filesystem::directory_iterator(dir))
+        names.push_back(e.path().filename().string());
+    CHECK(names == std::vector<std::string>{"regions.geojson"});
+    // Polygons made once are read by several writers at once (terrain sweep): the same
+    // features as the direct writer, from each of four threads.
+    const auto made = io::polygonize_regions(t.dem, t.pixels, t.graph.regions.size(), dir.string());
+    CHECK(made.region_count() == t.graph.regions.size());
+    std::vector<std::thread> writers;
+    for (int k = 0; k < 4; ++k)
+        writers.emplace_back([&, k] {
+            io::write_region_polygons(t.dem, made, t.graph,
+                                      (dir / ("copy" + std::to_string(k) + ".geojson")).string(),
+                                      false);
+        });
+    for (auto& w : writers) w.join();
+    for (int k = 0; k < 4; ++k)
+        CHECK(test::file_bytes((dir / ("copy" + std::to_string(k) + ".geojson")).string()) ==
+              test::file_bytes(path));
+    check_features(read_features((dir / "copy3.geojson").string()), t, [](double x, double y) {
+        return std::array<double, 2>{x, y};
+    });
+    // A temporary directory that cannot take the pieces: one line naming it.
+    CHECK_THROWS_WITH(
+        io::polygonize_regions(t.dem, t.pixels, t.graph.regions.size(), (dir / "missing").string()),
+        Catch::Contains("cannot create a temporary file in") && Catch::Contains("missing"));
 }
 
 TEST_CASE("regions.gpkg keeps the DEM's full CRS, the same bytes every run",

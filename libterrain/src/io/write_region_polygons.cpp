@@ -2,7 +2,15 @@
 #include <gdal_priv.h>
 #include <ogrsf_frmts.h>
 
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
 #include <filesystem>
+#include <functional>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <ostream>
@@ -25,44 +33,76 @@ namespace {
 
 using Geometry = std::unique_ptr<OGRGeometry>;
 
-// The region polygons in the DEM's map coordinates, indexed by id - 1: GDALPolygonize
-// (4-connected pixels, label 0 masked out) gives one polygon per connected piece; the pieces
-// of a region touch at most at corners, so collecting them is their union (valid
-// MultiPolygon).
-std::vector<Geometry> polygonize(const Dem& dem, const std::vector<std::uint32_t>& pixels,
-                                 std::size_t region_count, const GdalErrorCapture& errors) {
-    GDALDriver* mem = GetGDALDriverManager()->GetDriverByName("MEM");
-    std::unique_ptr<GDALDataset> raster(
-        mem->Create("", dem.width, dem.height, 1, GDT_UInt32, nullptr));
-    GDALDriver* memory = GetGDALDriverManager()->GetDriverByName("Memory");
-    std::unique_ptr<GDALDataset> vector(memory ? memory->Create("", 0, 0, 0, GDT_Unknown, nullptr)
-                                               : nullptr);
-    if (!raster || !vector) throw Error("write", "GDAL's in-memory drivers are missing");
-    GeoTransform t = dem.transform;
-    raster->SetGeoTransform(t.data());
-    GDALRasterBand* band = raster->GetRasterBand(1);
-    if (band->RasterIO(GF_Write, 0, 0, dem.width, dem.height,
-                       const_cast<std::uint32_t*>(pixels.data()), dem.width, dem.height, GDT_UInt32,
-                       0, 0) != CE_None)
-        throw Error("write", "cannot fill the label raster to polygonize" + errors.suffix());
-    OGRLayer* layer = vector->CreateLayer("regions", nullptr, wkbPolygon, nullptr);
-    OGRFieldDefn id("id", OFTInteger);
-    if (!layer || layer->CreateField(&id) != OGRERR_NONE)
-        throw Error("write", "cannot create the polygon layer" + errors.suffix());
-    if (GDALPolygonize(band, band, layer, 0, nullptr, nullptr, nullptr) != CE_None)
-        throw Error("write", "GDALPolygonize failed" + errors.suffix());
+// GDALPolygonize's pieces (one polygon per 4-connected piece of a region, label 0 masked
+// out), spilled as WKB to an unlinked temporary file as they come, then read back region by
+// region: the outlines are never all in memory (on a 265 M pixel global grid they are
+// hundreds of MB). Only 16 bytes a piece stay. The pieces of a region touch at most at
+// corners, so collecting them is their union (a valid MultiPolygon); they are collected in
+// the order GDALPolygonize gave them.
+class PieceFile {
+  public:
+    explicit PieceFile(std::filesystem::path dir) {
+        if (dir.empty()) dir = std::filesystem::temp_directory_path();
+        dir_ = dir.string();
+        std::string name = (dir / ".terrain-polygons-XXXXXX").string();
+        fd_ = ::mkstemp(name.data());
+        if (fd_ < 0)
+            throw Error("write", "cannot create a temporary file in '" + dir_ +
+                                     "': " + std::strerror(errno));
+        ::unlink(name.c_str());  // gone with the descriptor, whatever happens
+    }
+    ~PieceFile() {
+        if (fd_ >= 0) ::close(fd_);
+    }
+    PieceFile(const PieceFile&) = delete;
+    PieceFile& operator=(const PieceFile&) = delete;
 
-    std::vector<Geometry> out(region_count);
-    layer->ResetReading();
-    for (std::unique_ptr<OGRFeature> f(layer->GetNextFeature()); f;
-         f.reset(layer->GetNextFeature())) {
-        const auto label = static_cast<std::size_t>(f->GetFieldAsInteger(0));
-        if (label == 0 || label > region_count) continue;
-        Geometry piece(f->StealGeometry());
-        auto& g = out[label - 1];
-        if (!g) {
-            g = std::move(piece);
-        } else {
+    void add(std::uint32_t label, const OGRGeometry& g) {
+        const std::size_t bytes = g.WkbSize();
+        if (bytes > std::numeric_limits<std::uint32_t>::max())
+            throw Error("write", "a region's polygon piece is larger than 4 GB");
+        const std::size_t at = buffer_.size();
+        buffer_.resize(at + bytes);
+        if (g.exportToWkb(wkbNDR, buffer_.data() + at) != OGRERR_NONE)
+            throw Error("write", "cannot encode a region's polygon");
+        pieces_.push_back({size_, static_cast<std::uint32_t>(bytes), label});
+        size_ += bytes;
+        if (buffer_.size() >= kBuffer) flush();
+    }
+
+    // After the last piece: flushed, and the pieces grouped by label (1..region_count).
+    void finish(std::size_t region_count) {
+        flush();
+        std::vector<unsigned char>().swap(buffer_);
+        first_.assign(region_count + 1, 0);
+        for (const Piece& p : pieces_) ++first_[p.label];
+        for (std::size_t i = 1; i < first_.size(); ++i) first_[i] += first_[i - 1];
+        std::vector<std::uint64_t> at(first_.begin(), first_.end() - 1);
+        order_.resize(pieces_.size());
+        for (std::size_t k = 0; k < pieces_.size(); ++k)
+            order_[at[pieces_[k].label - 1]++] = static_cast<std::uint32_t>(k);
+    }
+    std::size_t region_count() const { return first_.empty() ? 0 : first_.size() - 1; }
+
+    // The polygon of region index i (id i + 1): a Polygon, a MultiPolygon, or null when the
+    // region has no pixel. Safe to call from several threads at once.
+    Geometry region(std::size_t i) const {
+        Geometry g;
+        std::vector<unsigned char> wkb;
+        for (std::uint64_t k = first_[i]; k < first_[i + 1]; ++k) {
+            const Piece& p = pieces_[order_[k]];
+            wkb.resize(p.bytes);
+            read_at(p.offset, wkb.data(), p.bytes);
+            OGRGeometry* raw = nullptr;
+            if (OGRGeometryFactory::createFromWkb(wkb.data(), nullptr, &raw, p.bytes) !=
+                    OGRERR_NONE ||
+                !raw)
+                throw Error("write", "cannot read back a region's polygon from '" + dir_ + "'");
+            Geometry piece(raw);
+            if (!g) {
+                g = std::move(piece);
+                continue;
+            }
             if (wkbFlatten(g->getGeometryType()) == wkbPolygon) {
                 auto multi = std::make_unique<OGRMultiPolygon>();
                 multi->addGeometryDirectly(g.release());
@@ -70,8 +110,120 @@ std::vector<Geometry> polygonize(const Dem& dem, const std::vector<std::uint32_t
             }
             g->toMultiPolygon()->addGeometryDirectly(piece.release());
         }
+        return g;
     }
-    return out;
+
+  private:
+    static constexpr std::size_t kBuffer = std::size_t{4} << 20;
+    struct Piece {
+        std::uint64_t offset;
+        std::uint32_t bytes;
+        std::uint32_t label;
+    };
+    void flush() {
+        const unsigned char* data = buffer_.data();
+        std::size_t left = buffer_.size();
+        while (left > 0) {
+            const ssize_t n = ::write(fd_, data, left);
+            if (n < 0 && errno == EINTR) continue;
+            if (n <= 0)
+                throw Error("write", "cannot write the region polygons' temporary file in '" +
+                                         dir_ + "': " + std::strerror(n < 0 ? errno : ENOSPC));
+            data += n;
+            left -= static_cast<std::size_t>(n);
+        }
+        buffer_.clear();
+    }
+    void read_at(std::uint64_t offset, unsigned char* data, std::size_t bytes) const {
+        while (bytes > 0) {
+            const ssize_t n = ::pread(fd_, data, bytes, static_cast<off_t>(offset));
+            if (n < 0 && errno == EINTR) continue;
+            if (n <= 0)
+                throw Error("write",
+                            "cannot read the region polygons' temporary file in '" + dir_ + "'");
+            data += n;
+            bytes -= static_cast<std::size_t>(n);
+            offset += static_cast<std::uint64_t>(n);
+        }
+    }
+
+    int fd_ = -1;
+    std::string dir_;
+    std::vector<unsigned char> buffer_;
+    std::uint64_t size_ = 0;
+    std::vector<Piece> pieces_;
+    std::vector<std::uint64_t> first_;  // by region index: its first entry in order_
+    std::vector<std::uint32_t> order_;  // pieces grouped by label, each group in given order
+};
+
+// The layer GDALPolygonize writes into: each feature goes to the piece file.
+class PieceLayer final : public OGRLayer {
+  public:
+    PieceLayer(PieceFile& file, std::size_t region_count)
+        : file_(file), region_count_(region_count), defn_(new OGRFeatureDefn("regions")) {
+        defn_->Reference();
+        defn_->SetGeomType(wkbPolygon);
+        OGRFieldDefn id("id", OFTInteger);
+        defn_->AddFieldDefn(&id);
+    }
+    ~PieceLayer() override { defn_->Release(); }
+    OGRFeatureDefn* GetLayerDefn() override { return defn_; }
+    void ResetReading() override {}
+    OGRFeature* GetNextFeature() override { return nullptr; }
+    int TestCapability(const char* capability) override {
+        return EQUAL(capability, OLCSequentialWrite);
+    }
+    const std::string& failure() const { return failure_; }
+
+  protected:
+    OGRErr ICreateFeature(OGRFeature* feature) override {
+        const auto label = static_cast<std::size_t>(feature->GetFieldAsInteger(0));
+        const OGRGeometry* g = feature->GetGeometryRef();
+        if (label == 0 || label > region_count_ || !g) return OGRERR_NONE;
+        try {
+            file_.add(static_cast<std::uint32_t>(label), *g);
+        } catch (const Error& e) {
+            failure_ = e.what();
+            return OGRERR_FAILURE;
+        }
+        return OGRERR_NONE;
+    }
+
+  private:
+    PieceFile& file_;
+    std::size_t region_count_;
+    OGRFeatureDefn* defn_;
+    std::string failure_;
+};
+
+// The pieces of every region of `pixels`, in the DEM's map coordinates, spilled to a
+// temporary file in `dir` (the system's temporary directory when empty).
+std::unique_ptr<PieceFile> polygonize(const Dem& dem, const std::vector<std::uint32_t>& pixels,
+                                      std::size_t region_count, const std::filesystem::path& dir,
+                                      const GdalErrorCapture& errors) {
+    GDALDriver* mem = GetGDALDriverManager()->GetDriverByName("MEM");
+    if (!mem) throw Error("write", "GDAL's in-memory raster driver is missing");
+    // A band over the labels themselves, not a copy (4 bytes a pixel less).
+    std::unique_ptr<GDALDataset> raster(
+        mem->Create("", dem.width, dem.height, 0, GDT_UInt32, nullptr));
+    char pointer[64];
+    std::snprintf(pointer, sizeof pointer, "%p",
+                  static_cast<void*>(const_cast<std::uint32_t*>(pixels.data())));
+    CPLStringList band_options;
+    band_options.SetNameValue("DATAPOINTER", pointer);
+    if (!raster || raster->AddBand(GDT_UInt32, band_options.List()) != CE_None)
+        throw Error("write", "cannot make the label raster to polygonize" + errors.suffix());
+    GeoTransform t = dem.transform;
+    raster->SetGeoTransform(t.data());
+    GDALRasterBand* band = raster->GetRasterBand(1);
+    auto file = std::make_unique<PieceFile>(dir);
+    PieceLayer layer(*file, region_count);
+    if (GDALPolygonize(band, band, OGRLayer::ToHandle(&layer), 0, nullptr, nullptr, nullptr) !=
+        CE_None)
+        throw Error("write", layer.failure().empty() ? "GDALPolygonize failed" + errors.suffix()
+                                                     : layer.failure());
+    file->finish(region_count);
+    return file;
 }
 
 // Every ring to lon/lat (when `frame`), through `global` for a global grid (its seam and
@@ -119,13 +271,18 @@ void write_polygon(JsonWriter& json, const GeoJsonFile& file, const OGRPolygon& 
     json.end_array();
 }
 
-void write_geojson(std::ostream& out, const std::vector<Geometry>& polygons,
+// The polygon of region index i, made when asked for: a region's outline is written and
+// freed before the next one is made.
+using RegionSource = std::function<Geometry(std::size_t)>;
+
+void write_geojson(std::ostream& out, const RegionSource& polygon,
                    const segment::RegionGraph& graph, const std::string& crs_name, int decimals) {
     GeoJsonFile file(out, "regions", crs_name, decimals);
     for (std::size_t i = 0; i < graph.regions.size(); ++i) {
         const auto& region = graph.regions[i];
+        const Geometry made = polygon(i);
         file.feature(region.id, region_attributes(graph, region), [&](JsonWriter& json) {
-            const OGRGeometry* g = polygons[i].get();
+            const OGRGeometry* g = made.get();
             if (!g) {
                 json.null();
             } else if (wkbFlatten(g->getGeometryType()) == wkbPolygon) {
@@ -338,7 +495,7 @@ void add_wkt2_definitions(GDALDataset& ds, const OGRSpatialReference* srs, const
 
 // Any other OGR driver: one layer "regions", MultiPolygon features, every attribute a field.
 std::vector<std::string> write_ogr(GDALDriver& driver, const std::string& temp,
-                                   const std::string& path, std::vector<Geometry>& polygons,
+                                   const std::string& path, const RegionSource& polygon,
                                    const segment::RegionGraph& graph,
                                    const OGRSpatialReference* srs, const GdalErrorCapture& errors,
                                    const std::string& layer_name, bool append) {
@@ -391,9 +548,8 @@ std::vector<std::string> write_ogr(GDALDriver& driver, const std::string& temp,
                 feature.SetField(k, std::get<std::string>(value).c_str());
             ++k;
         }
-        if (polygons[i])
-            feature.SetGeometryDirectly(
-                OGRGeometryFactory::forceToMultiPolygon(polygons[i].release()));
+        if (Geometry g = polygon(i))
+            feature.SetGeometryDirectly(OGRGeometryFactory::forceToMultiPolygon(g.release()));
         if (layer->CreateFeature(&feature) != OGRERR_NONE)
             throw Error("write", "cannot write region " + std::to_string(graph.regions[i].id) +
                                      " to '" + path + "'" + errors.suffix());
@@ -437,11 +593,10 @@ GDALDriver* polygon_driver(const std::string& path, bool overwrite,
     return driver;
 }
 
-// Writes the polygons (taken: their rings are changed in place).
-void write_polygons(const Dem& dem, std::vector<Geometry> polygons,
-                    const segment::RegionGraph& graph, const std::string& path, bool overwrite,
-                    const RegionPolygonOptions& options, GDALDriver* driver,
-                    const GdalErrorCapture& errors) {
+// Writes the polygons of `made` (in the DEM's map coordinates), region by region.
+void write_polygons(const Dem& dem, const RegionSource& made, const segment::RegionGraph& graph,
+                    const std::string& path, bool overwrite, const RegionPolygonOptions& options,
+                    GDALDriver* driver, const GdalErrorCapture& errors) {
     const bool geojson = driver == nullptr;
     std::optional<LonLatFrame> frame;
     if (!dem.crs_wkt.empty() && (geojson || options.lonlat)) frame.emplace(dem, "write");
@@ -452,8 +607,11 @@ void write_polygons(const Dem& dem, std::vector<Geometry> polygons,
         if (!frame) global_frame.emplace(dem, "write");
         global.emplace(dem, frame ? *frame : *global_frame);
     }
-    for (auto& g : polygons)
+    const RegionSource polygons = [&](std::size_t i) {
+        Geometry g = made(i);
         if (g) prepare_rings(*g, frame ? &*frame : nullptr, global ? &*global : nullptr);
+        return g;
+    };
 
     if (geojson) {
         // Lon/lat to 1e-9 degree (0.1 mm on Earth); metres to 1e-6.
@@ -510,7 +668,7 @@ void check_polygon_format(const Dem& dem, const std::string& driver) {
 }
 
 struct RegionPolygons::Impl {
-    std::vector<Geometry> geometries;  // by region id - 1; null for a region with no pixel
+    std::unique_ptr<PieceFile> pieces;  // read back region by region
 };
 RegionPolygons::RegionPolygons() : impl_(std::make_unique<Impl>()) {}
 RegionPolygons::RegionPolygons(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -518,16 +676,16 @@ RegionPolygons::~RegionPolygons() = default;
 RegionPolygons::RegionPolygons(RegionPolygons&&) noexcept = default;
 RegionPolygons& RegionPolygons::operator=(RegionPolygons&&) noexcept = default;
 std::size_t RegionPolygons::region_count() const {
-    return impl_->geometries.size();
+    return impl_->pieces ? impl_->pieces->region_count() : 0;
 }
 
 RegionPolygons polygonize_regions(const Dem& dem, const std::vector<std::uint32_t>& pixels,
-                                  std::size_t region_count) {
+                                  std::size_t region_count, const std::string& temp_dir) {
     check_grid_size(dem, pixels.size());
     ensure_gdal_registered();
     const GdalErrorCapture errors;
     auto impl = std::make_unique<RegionPolygons::Impl>();
-    impl->geometries = polygonize(dem, pixels, region_count, errors);
+    impl->pieces = polygonize(dem, pixels, region_count, temp_dir, errors);
     return RegionPolygons(std::move(impl));
 }
 
@@ -538,8 +696,12 @@ void write_region_polygons(const Dem& dem, const std::vector<std::uint32_t>& pix
     check_polygon_format(dem, options.driver);
     GDALDriver* driver = polygon_driver(path, overwrite, options);
     const GdalErrorCapture errors;
-    write_polygons(dem, polygonize(dem, pixels, graph.regions.size(), errors), graph, path,
-                   overwrite, options, driver, errors);
+    // The temporary pieces beside the output: on the same disk, as large as it will be.
+    const auto pieces = polygonize(dem, pixels, graph.regions.size(),
+                                   std::filesystem::absolute(path).parent_path(), errors);
+    write_polygons(
+        dem, [&](std::size_t i) { return pieces->region(i); }, graph, path, overwrite, options,
+        driver, errors);
 }
 
 void write_region_polygons(const Dem& dem, const RegionPolygons& polygons,
@@ -552,10 +714,10 @@ void write_region_polygons(const Dem& dem, const RegionPolygons& polygons,
     check_polygon_format(dem, options.driver);
     GDALDriver* driver = polygon_driver(path, overwrite, options);
     const GdalErrorCapture errors;
-    std::vector<Geometry> copy;
-    copy.reserve(polygons.region_count());
-    for (const auto& g : polygons.impl().geometries) copy.emplace_back(g ? g->clone() : nullptr);
-    write_polygons(dem, std::move(copy), graph, path, overwrite, options, driver, errors);
+    const PieceFile& pieces = *polygons.impl().pieces;
+    write_polygons(
+        dem, [&](std::size_t i) { return pieces.region(i); }, graph, path, overwrite, options,
+        driver, errors);
 }
 
 }  // namespace terrain::io

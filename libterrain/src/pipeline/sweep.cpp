@@ -244,7 +244,8 @@ std::vector<std::string> write_sweep_directory(SweepResult& result, const Segmen
         // the GeoJSON files beside them.
         std::vector<io::RegionPolygons> polygons(scales.size());
         tbb::parallel_for(std::size_t{0}, scales.size(), [&](std::size_t i) {
-            polygons[i] = io::polygonize_regions(*dem, bands[i], scales[i].regions.regions.size());
+            polygons[i] =
+                io::polygonize_regions(*dem, bands[i], scales[i].regions.regions.size(), dir_path);
         });
         tbb::parallel_invoke(
             [&] {

@@ -33,7 +33,9 @@ struct RegionPolygonOptions {
 void check_polygon_format(const Dem& dem, const std::string& driver);
 
 // One feature per region (Polygon, MultiPolygon where its pixels touch only at corners; null
-// when it has no pixel) made with GDALPolygonize, with the region's properties. `pixels`:
+// when it has no pixel) made with GDALPolygonize, with the region's properties. Written
+// feature by feature: GDALPolygonize's pieces wait in an unlinked temporary file beside
+// `path`, and each region's outline is read back, written and freed in turn. `pixels`:
 // segment::label_pixels() of the DEM (row-major, 0 = no region). A DEM without CRS gives its
 // map (geotransform) coordinates.
 void write_region_polygons(const Dem& dem, const std::vector<std::uint32_t>& pixels,
@@ -42,7 +44,9 @@ void write_region_polygons(const Dem& dem, const std::vector<std::uint32_t>& pix
 
 // The region polygons of one labelling (GDALPolygonize, in the DEM's map coordinates), made
 // once to be written to several files: terrain sweep writes each scale to a GeoPackage layer
-// and to GeoJSON. Writers copy what they change, so several may read one set at once.
+// and to GeoJSON. They wait in an unlinked temporary file in `temp_dir` (the system's
+// temporary directory when empty) and are read back one region at a time, so several
+// writers may read one set at once and no writer holds every outline.
 class RegionPolygons {
   public:
     RegionPolygons();
@@ -58,10 +62,10 @@ class RegionPolygons {
     explicit RegionPolygons(std::unique_ptr<Impl> impl);
     std::unique_ptr<Impl> impl_;
     friend RegionPolygons polygonize_regions(const Dem&, const std::vector<std::uint32_t>&,
-                                             std::size_t);
+                                             std::size_t, const std::string&);
 };
 RegionPolygons polygonize_regions(const Dem& dem, const std::vector<std::uint32_t>& pixels,
-                                  std::size_t region_count);
+                                  std::size_t region_count, const std::string& temp_dir = "");
 // write_region_polygons from polygons made before (for the labelling the graph describes).
 void write_region_polygons(const Dem& dem, const RegionPolygons& polygons,
                            const segment::RegionGraph& graph, const std::string& path,
