@@ -6,6 +6,10 @@
 #include <numeric>
 #include <random>
 #include <set>
+#include <string_view>
+#include <thread>
+
+#include <tbb/task_arena.h>
 
 #include "support/test_meshes.hpp"
 #include "support/test_support.hpp"
@@ -304,5 +308,41 @@ TEST_CASE("The contour tree and the sweep give the same graph on disks and spher
             return out;
         };
         CHECK(arcs(a) == arcs(b));
+    }
+}
+
+TEST_CASE("The Reeb graph's progress is monotone, on the caller's thread, whatever the threads",
+          "[reeb]") {
+    // The join and split sweeps run side by side; with one thread they run one after the
+    // other, in either order. Reports come from the caller's thread only, from the events both
+    // have passed, so the fraction never goes back.
+    const auto mesh = test::plate_mesh(640, 640, 0);  // 409 600 vertices: passes of 2^18
+    std::vector<float> field(mesh.vertex_count());
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<float> noise(0, 1);
+    for (std::size_t v = 0; v < field.size(); ++v) {
+        const auto p = mesh.position(v);
+        field[v] = static_cast<float>(std::sin(p[0] * 0.05) + std::cos(p[1] * 0.07)) + noise(rng);
+    }
+    for (const int threads : {1, 2}) {
+        tbb::task_arena arena(threads);
+        std::vector<double> seen;
+        std::size_t sweeps = 0, elsewhere = 0;
+        const auto caller = std::this_thread::get_id();
+        arena.execute([&] {
+            const auto g =
+                reeb::build_reeb_graph(mesh, field, {}, [&](double f, std::string_view message) {
+                    seen.push_back(f);
+                    sweeps += message == "reeb: join and split trees" && f > 0.3 && f < 0.6;
+                    elsewhere += std::this_thread::get_id() != caller;
+                    return true;
+                });
+            CHECK(g.node_count() == mesh.vertex_count());
+        });
+        CAPTURE(threads);
+        CHECK(std::is_sorted(seen.begin(), seen.end()));
+        CHECK(sweeps >= 1);
+        CHECK(elsewhere == 0);
+        CHECK(seen.back() == 1.0);
     }
 }

@@ -13,6 +13,7 @@
 #include <numbers>
 #include <span>
 
+#include "../core/pass_progress.hpp"
 #include "shape_index_fit.hpp"
 #include "terrain/core/error.hpp"
 
@@ -21,15 +22,26 @@ namespace detail {
 namespace {
 
 // Area-weighted vertex normals; triangles are counter-clockwise seen from outside/above.
-std::vector<Vec3> vertex_normals(const TriangleMesh& mesh) {
-    std::vector<Vec3> normals(mesh.vertex_count(), Vec3{0, 0, 0});
-    for (const auto& t : mesh.triangles) {
+std::vector<Vec3> vertex_normals(const TriangleMesh& mesh, const ProgressFn& progress = {}) {
+    const terrain::detail::PassProgress summed(progress, 0.3, 0.8, "shape index"),
+        normalised(progress, 0.8, 1, "shape index");
+    std::vector<Vec3> normals;  // made a slice at a time: the first touch of a block is slow
+    terrain::detail::assign_in_slices(
+        normals, mesh.vertex_count(), Vec3{0, 0, 0},
+        terrain::detail::PassProgress(progress, 0, 0.3, "shape index"));
+    const std::size_t nt = mesh.triangle_count();
+    for (std::size_t i = 0; i < nt; ++i) {
+        summed.at(i, nt);
+        const auto& t = mesh.triangles[i];
         const auto& p = mesh.positions;
         const Vec3 n = cross(sub(p[t[1]], p[t[0]]), sub(p[t[2]], p[t[0]]));
         for (auto v : t)
             for (int k = 0; k < 3; ++k) normals[v][k] += n[k];
     }
-    for (auto& n : normals) n = normalized(n);
+    for (std::size_t v = 0; v < normals.size(); ++v) {
+        normalised.at(v, normals.size());
+        normals[v] = normalized(normals[v]);
+    }
     return normals;
 }
 
@@ -594,12 +606,15 @@ void for_each_vertex(const TriangleMesh& mesh, const ShapeIndexOptions& options,
         throw Error("field", "--rings must be at least 1");
     if (options.radius < 0 || !std::isfinite(options.radius))
         throw Error("field", "--radius must be a positive number of metres");
-    const auto normals = vertex_normals(mesh);
+    // Normals 0 to 0.05 of the progress, the grid's layout to 0.06, the vertices to 1.
+    const auto normals = vertex_normals(mesh, scaled_progress(progress, 0, 0.05));
     const bool grid = grid_applies(mesh, options), disk = disk_applies(mesh, options);
     GridLayout layout;
     if (grid || disk) layout = grid_layout(mesh);
+    report_progress(progress, 0.06, "shape index");
     if (grid) {
-        grid_for_each_vertex(mesh, layout, options, normals, progress, body);
+        grid_for_each_vertex(mesh, layout, options, normals, scaled_progress(progress, 0.06, 1),
+                             body);
         return;
     }
     const GridLayout* disk_grid = disk ? &layout : nullptr;
@@ -617,7 +632,7 @@ void for_each_vertex(const TriangleMesh& mesh, const ShapeIndexOptions& options,
                 body(v, ok, k, scale);
             }
         });
-        report_progress(progress, double(stop) / n, "shape index");
+        report_progress(progress, 0.06 + 0.94 * double(stop) / n, "shape index");
     }
 }
 
@@ -670,7 +685,9 @@ std::vector<float> shape_index_field(const TriangleMesh& mesh, const ShapeIndexO
     for (bool changed = true; changed;) {
         changed = false;
         std::vector<std::pair<std::int32_t, float>> updates;
+        const terrain::detail::PassProgress pass(progress, 1, 1, "shape index");
         for (std::size_t v = 0; v < field.size(); ++v) {
+            pass.at(v, field.size());
             if (field[v] != kUnknown) continue;
             double sum = 0;
             int count = 0;

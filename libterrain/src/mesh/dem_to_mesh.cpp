@@ -11,6 +11,7 @@
 #include <memory>
 #include <numbers>
 
+#include "../core/pass_progress.hpp"
 #include "../core/release.hpp"
 #include "terrain/core/error.hpp"
 
@@ -44,11 +45,13 @@ namespace {
 // Returns each pixel's vertex (-1 for NoData) and fills the mesh's vertex -> pixel map and
 // pole vertices.
 std::vector<std::int32_t> number_vertices(const Dem& dem, std::array<bool, 2> pole,
-                                          TriangleMesh& mesh) {
+                                          TriangleMesh& mesh, const ProgressFn& progress) {
     const int W = dem.width, H = dem.height;
     std::vector<std::int32_t> vertex_of(dem.size(), -1);
     std::int32_t count = 0;
+    const detail::PassProgress rows(progress, 0, 1, "mesh", 5);
     for (int row = 0; row < H; ++row) {
+        rows.at(std::size_t(row), std::size_t(H));
         const int which = row == 0 && pole[0] ? 0 : (row == H - 1 && pole[1] ? 1 : -1);
         std::int32_t pole_id = -1;
         for (int col = 0; col < W; ++col) {
@@ -77,7 +80,8 @@ std::vector<std::int32_t> number_vertices(const Dem& dem, std::array<bool, 2> po
 // ellipsoid); in the map frame easting/northing and height, or a local tangent plane for a
 // lon/lat grid. Rows in parallel (the mapping keeps one PROJ transformation per thread).
 void place_vertices(const Dem& dem, const GridGeoref& geo,
-                    const std::vector<std::int32_t>& vertex_of, TriangleMesh& mesh) {
+                    const std::vector<std::int32_t>& vertex_of, TriangleMesh& mesh,
+                    const ProgressFn& progress) {
     const int W = dem.width, H = dem.height;
     const MeshFrame frame = mesh.frame;
     const bool geographic_crs = geo.kind == CrsKind::geographic;
@@ -88,7 +92,10 @@ void place_vertices(const Dem& dem, const GridGeoref& geo,
             throw Error("mesh", "cannot transform the DEM's CRS to longitude/latitude on its body");
         lonlat = geo.lonlat.get();
     }
-    std::vector<std::array<double, 3>> xyz(mesh.vertex_pixel.size());
+    // The points' memory (0 to 0.35 of the progress), then the rows (to 1).
+    std::vector<std::array<double, 3>> xyz;
+    detail::assign_in_slices(xyz, mesh.vertex_pixel.size(), {},
+                             detail::PassProgress(progress, 0, 0.35, "mesh"));
     const double a = dem.body.semi_major_axis, f = dem.body.flattening;
     const double unit = geo.linear_unit_m;
     std::unique_ptr<GeographicLib::Geocentric> earth;
@@ -100,45 +107,46 @@ void place_vertices(const Dem& dem, const GridGeoref& geo,
             std::make_unique<GeographicLib::LocalCartesian>(centre[1], centre[0], 0.0, *earth);
     }
     std::vector<std::uint8_t> failed(static_cast<std::size_t>(H), 0);
-    tbb::parallel_for(tbb::blocked_range<int>(0, H, 8), [&](const tbb::blocked_range<int>& rows) {
-        std::vector<double> lon(W), lat(W);
-        std::vector<std::uint8_t> ok(W, 1);
-        for (int row = rows.begin(); row < rows.end(); ++row) {
-            for (int col = 0; col < W; ++col) {
-                const auto xy = dem.map_xy(col + 0.5, row + 0.5);
-                lon[col] = xy[0];
-                lat[col] = xy[1];
-            }
-            if (lonlat) lonlat->to_lonlat(std::size_t(W), lon.data(), lat.data(), ok.data());
-            for (int col = 0; col < W; ++col) {
-                const auto p = dem.index(col, row);
-                const auto v = vertex_of[p];
-                if (v < 0) continue;
-                if (!ok[col] || !std::isfinite(lon[col]) || !std::isfinite(lat[col])) {
-                    failed[row] = 1;
-                    continue;
+    detail::parallel_slices(
+        H, 8, progress, 0.35, 0.9, "mesh", [&](const tbb::blocked_range<int>& rows) {
+            std::vector<double> lon(W), lat(W);
+            std::vector<std::uint8_t> ok(W, 1);
+            for (int row = rows.begin(); row < rows.end(); ++row) {
+                for (int col = 0; col < W; ++col) {
+                    const auto xy = dem.map_xy(col + 0.5, row + 0.5);
+                    lon[col] = xy[0];
+                    lat[col] = xy[1];
                 }
-                const double value = dem.values[p];
-                auto& out = xyz[v];
-                if (frame == MeshFrame::body) {
-                    if (dem.elevation == ElevationKind::radius) {
-                        // Radii are distances from the centre along the geocentric direction.
-                        const double cl = std::cos(lat[col] * kDegree);
-                        out = {value * cl * std::cos(lon[col] * kDegree),
-                               value * cl * std::sin(lon[col] * kDegree),
-                               value * std::sin(lat[col] * kDegree)};
-                    } else {
-                        earth->Forward(lat[col], lon[col], value, out[0], out[1], out[2]);
+                if (lonlat) lonlat->to_lonlat(std::size_t(W), lon.data(), lat.data(), ok.data());
+                for (int col = 0; col < W; ++col) {
+                    const auto p = dem.index(col, row);
+                    const auto v = vertex_of[p];
+                    if (v < 0) continue;
+                    if (!ok[col] || !std::isfinite(lon[col]) || !std::isfinite(lat[col])) {
+                        failed[row] = 1;
+                        continue;
                     }
-                } else if (tangent) {
-                    tangent->Forward(lat[col], lon[col], dem.height_at(col, row), out[0], out[1],
-                                     out[2]);
-                } else {
-                    out = {lon[col] * unit, lat[col] * unit, dem.height_at(col, row)};
+                    const double value = dem.values[p];
+                    auto& out = xyz[v];
+                    if (frame == MeshFrame::body) {
+                        if (dem.elevation == ElevationKind::radius) {
+                            // Radii are distances from the centre along the geocentric direction.
+                            const double cl = std::cos(lat[col] * kDegree);
+                            out = {value * cl * std::cos(lon[col] * kDegree),
+                                   value * cl * std::sin(lon[col] * kDegree),
+                                   value * std::sin(lat[col] * kDegree)};
+                        } else {
+                            earth->Forward(lat[col], lon[col], value, out[0], out[1], out[2]);
+                        }
+                    } else if (tangent) {
+                        tangent->Forward(lat[col], lon[col], dem.height_at(col, row), out[0],
+                                         out[1], out[2]);
+                    } else {
+                        out = {lon[col] * unit, lat[col] * unit, dem.height_at(col, row)};
+                    }
                 }
             }
-        }
-    });
+        });
     if (std::find(failed.begin(), failed.end(), 1) != failed.end())
         throw Error("mesh", "some pixels of '" + dem.source +
                                 "' fall outside the CRS's valid area and cannot be placed");
@@ -157,7 +165,7 @@ void place_vertices(const Dem& dem, const GridGeoref& geo,
         else
             earth->Forward(lat, 0.0, value, out[0], out[1], out[2]);
     }
-    set_positions(mesh, xyz);
+    set_positions(mesh, xyz, scaled_progress(progress, 0.9, 1));
 }
 
 // Two triangles per 2x2 block of valid pixels, split along the shorter 3-D diagonal (ties
@@ -166,14 +174,15 @@ void place_vertices(const Dem& dem, const GridGeoref& geo,
 // columns eastwards (the geotransform's determinant negative) the orders below are
 // counter-clockwise seen from above/outside; otherwise the last two corners swap.
 void triangulate_blocks(const Dem& dem, const std::vector<std::int32_t>& vertex_of,
-                        TriangleMesh& mesh) {
+                        TriangleMesh& mesh, const ProgressFn& progress) {
     const int W = dem.width, H = dem.height;
     const auto& t = dem.transform;
     const bool flip = t[1] * t[5] - t[2] * t[4] > 0;
     const int block_cols = mesh.seam_closed ? W : W - 1;
     const int block_rows = H - 1;
     std::vector<std::vector<Triangle>> per_row(static_cast<std::size_t>(block_rows));
-    tbb::parallel_for(tbb::blocked_range<int>(0, block_rows, 16), [&](const auto& rows) {
+    // Rows in parallel (0 to 0.8 of the progress), then joined in order.
+    detail::parallel_slices(block_rows, 16, progress, 0, 0.8, "mesh", [&](const auto& rows) {
         for (int row = rows.begin(); row < rows.end(); ++row) {
             auto& out = per_row[row];
             out.reserve(2 * std::size_t(block_cols));
@@ -220,7 +229,10 @@ void triangulate_blocks(const Dem& dem, const std::vector<std::int32_t>& vertex_
     std::size_t total = 0;
     for (const auto& r : per_row) total += r.size();
     mesh.triangles.reserve(total);
-    for (auto& r : per_row) {
+    const detail::PassProgress joined(progress, 0.8, 1, "mesh", 5);
+    for (std::size_t row = 0; row < per_row.size(); ++row) {
+        joined.at(row, per_row.size());
+        auto& r = per_row[row];
         mesh.triangles.insert(mesh.triangles.end(), r.begin(), r.end());
         detail::release(r);
     }
@@ -253,21 +265,20 @@ TriangleMesh dem_to_mesh(const Dem& dem, const DemToMeshOptions& options,
         pole = geo.pole_row;
     }
 
-    const auto vertex_of = number_vertices(dem, pole, mesh);
-    report_progress(progress, 0.05, "mesh");
-    place_vertices(dem, geo, vertex_of, mesh);
-    report_progress(progress, 0.4, "mesh");
-    triangulate_blocks(dem, vertex_of, mesh);
-    report_progress(progress, 0.7, "mesh");
+    // Slices of the progress by the passes' measured cost on global grids.
+    const auto vertex_of = number_vertices(dem, pole, mesh, scaled_progress(progress, 0, 0.05));
+    place_vertices(dem, geo, vertex_of, mesh, scaled_progress(progress, 0.05, 0.3));
+    triangulate_blocks(dem, vertex_of, mesh, scaled_progress(progress, 0.3, 0.5));
 
     // Leave out valid pixels in no triangle (isolated, or only in degenerate blocks).
-    mesh.isolated_vertices = remove_unreferenced_vertices(mesh);
-    report_progress(progress, 0.75, "mesh");
-    mesh.pinched_vertices = split_pinched_vertices(mesh);
+    mesh.isolated_vertices =
+        remove_unreferenced_vertices(mesh, scaled_progress(progress, 0.5, 0.6));
+    mesh.pinched_vertices =
+        split_pinched_vertices(mesh, nullptr, scaled_progress(progress, 0.6, 0.7));
     mesh.positions.shrink_to_fit();
     mesh.vertex_pixel.shrink_to_fit();
-    report_progress(progress, 0.8, "mesh");
-    finish_mesh(mesh, scaled_progress(progress, 0.8, 1));
+    report_progress(progress, 0.7, "mesh");
+    finish_mesh(mesh, scaled_progress(progress, 0.7, 1));
     report_progress(progress, 1.0, "mesh");
     return mesh;
 }

@@ -1,5 +1,6 @@
 #include "terrain/mesh/triangle_mesh.hpp"
 #include "../core/disjoint_sets.hpp"
+#include "../core/pass_progress.hpp"
 #include "../core/release.hpp"
 #include "terrain/core/error.hpp"
 
@@ -47,17 +48,26 @@ double triangle_area(const TriangleMesh& m, const std::array<std::int32_t, 3>& t
 
 }  // namespace
 
-void set_positions(TriangleMesh& mesh, const std::vector<std::array<double, 3>>& points) {
+void set_positions(TriangleMesh& mesh, const std::vector<std::array<double, 3>>& points,
+                   const ProgressFn& progress) {
+    const std::size_t n = points.size();
+    const detail::PassProgress bounds(progress, 0, 0.3, "mesh"), made(progress, 0.3, 0.6, "mesh"),
+        converted(progress, 0.6, 1, "mesh");
     std::array<double, 3> lo, hi;
     lo.fill(std::numeric_limits<double>::infinity());
     hi.fill(-std::numeric_limits<double>::infinity());
-    for (const auto& p : points)
-        for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], p[k]), hi[k] = std::max(hi[k], p[k]);
+    for (std::size_t v = 0; v < n; ++v) {
+        bounds.at(v, n);
+        for (int k = 0; k < 3; ++k)
+            lo[k] = std::min(lo[k], points[v][k]), hi[k] = std::max(hi[k], points[v][k]);
+    }
     for (int k = 0; k < 3; ++k) mesh.origin[k] = points.empty() ? 0.0 : 0.5 * (lo[k] + hi[k]);
-    mesh.positions.resize(points.size());
-    for (std::size_t v = 0; v < points.size(); ++v)
+    detail::assign_in_slices(mesh.positions, n, std::array<float, 3>{}, made);
+    for (std::size_t v = 0; v < n; ++v) {
+        converted.at(v, n);
         for (int k = 0; k < 3; ++k)
             mesh.positions[v][k] = static_cast<float>(points[v][k] - mesh.origin[k]);
+    }
 }
 
 namespace {
@@ -74,8 +84,15 @@ void check_adjacency_size(std::uint64_t entries, const char* what) {
 void finish_mesh(TriangleMesh& mesh, const ProgressFn& progress) {
     const std::size_t n = mesh.positions.size();
     // Vertex areas: one third of each incident triangle (serial: the same sums every run).
+    // Its passes: areas (0 to 0.25), the corners' lists (counted, made, filled: to 0.6),
+    // sorted (to 0.9), copied at their size (to 1).
+    const detail::PassProgress areas(progress, 0, 0.25, "mesh"),
+        counts(progress, 0.25, 0.35, "mesh"), lists(progress, 0.45, 0.6, "mesh");
+    const std::size_t nt = mesh.triangles.size();
     std::vector<double> area(n, 0.0);
-    for (const auto& t : mesh.triangles) {
+    for (std::size_t i = 0; i < nt; ++i) {
+        areas.at(i, nt);
+        const auto& t = mesh.triangles[i];
         const double third = triangle_area(mesh, t) / 3.0;
         for (int k = 0; k < 3; ++k) area[t[k]] += third;
     }
@@ -88,19 +105,27 @@ void finish_mesh(TriangleMesh& mesh, const ProgressFn& progress) {
     // past 2^31 at 179 M vertices): 32-bit unsigned offsets, checked.
     check_adjacency_size(6 * std::uint64_t{mesh.triangles.size()}, "triangle corners");
     std::vector<std::uint32_t> offsets(n + 1, 0);
-    for (const auto& t : mesh.triangles)
-        for (int k = 0; k < 3; ++k) offsets[t[k] + 1] += 2;
+    for (std::size_t i = 0; i < nt; ++i) {
+        counts.at(i, nt);
+        for (int k = 0; k < 3; ++k) offsets[mesh.triangles[i][k] + 1] += 2;
+    }
     std::partial_sum(offsets.begin(), offsets.end(), offsets.begin());
-    std::vector<std::int32_t> all(offsets.back());
+    std::vector<std::int32_t> all;
+    detail::assign_in_slices(all, offsets.back(), 0,
+                             detail::PassProgress(progress, 0.35, 0.45, "mesh"));
     std::vector<std::uint32_t> fill(offsets.begin(), offsets.end() - 1);
-    for (const auto& t : mesh.triangles)
+    for (std::size_t i = 0; i < nt; ++i) {
+        lists.at(i, nt);
+        const auto& t = mesh.triangles[i];
         for (int k = 0; k < 3; ++k) {
             all[fill[t[k]]++] = t[(k + 1) % 3];
             all[fill[t[k]]++] = t[(k + 2) % 3];
         }
+    }
     detail::release(fill);
     report_progress(progress, 0.5, "mesh");
     mesh.neighbor_offsets.assign(n + 1, 0);
+    const detail::PassProgress sorted(progress, 0.6, 0.9, "mesh");
     std::size_t write = 0;
     for (std::size_t v = 0; v < n; ++v) {
         auto begin = all.begin() + offsets[v], end = all.begin() + offsets[v + 1];
@@ -111,12 +136,10 @@ void finish_mesh(TriangleMesh& mesh, const ProgressFn& progress) {
             throw Error("mesh", "the mesh has more than 2^31 vertex neighbours (" +
                                     std::to_string(n) + " vertices): too large");
         mesh.neighbor_offsets[v + 1] = static_cast<std::int32_t>(write);
-        if ((v & 0xfffff) == 0xfffff)
-            report_progress(progress, 0.5 + 0.5 * double(v) / double(n), "mesh");
+        sorted.at(v, n);
     }
-    all.resize(write);
-    all.shrink_to_fit();
-    mesh.neighbors = std::move(all);
+    detail::copy_in_slices(mesh.neighbors, all.data(), write,
+                           detail::PassProgress(progress, 0.9, 1, "mesh"));
 }
 
 MeshTopology mesh_topology(const TriangleMesh& mesh) {
@@ -176,18 +199,28 @@ MeshTopology mesh_topology(const TriangleMesh& mesh) {
 // Fans around each vertex: triangles incident to v joined when they share an edge at v.
 // Every fan after the largest (ties: the one holding the lowest triangle index) gets a copy
 // of v. Returns the number of vertices split.
-std::size_t split_pinched_vertices(TriangleMesh& mesh, std::int32_t* first_pinched) {
+std::size_t split_pinched_vertices(TriangleMesh& mesh, std::int32_t* first_pinched,
+                                   const ProgressFn& progress) {
     const std::size_t n = mesh.positions.size();
+    // Its passes: the incident triangles (counted, made, listed: 0 to 0.5), the fans (to 1).
+    const detail::PassProgress counted(progress, 0, 0.15, "mesh"),
+        listed(progress, 0.3, 0.5, "mesh"), each_vertex(progress, 0.5, 1, "mesh");
     check_adjacency_size(3 * std::uint64_t{mesh.triangles.size()}, "triangle corners");
     std::vector<std::uint32_t> offsets(n + 1, 0);
-    for (const auto& t : mesh.triangles)
-        for (auto v : t) ++offsets[v + 1];
+    for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+        counted.at(t, mesh.triangles.size());
+        for (auto v : mesh.triangles[t]) ++offsets[v + 1];
+    }
     for (std::size_t v = 0; v < n; ++v) offsets[v + 1] += offsets[v];
-    std::vector<std::int32_t> incident(offsets.back());
+    std::vector<std::int32_t> incident;
+    detail::assign_in_slices(incident, offsets.back(), 0,
+                             detail::PassProgress(progress, 0.15, 0.3, "mesh"));
     {
         std::vector<std::uint32_t> fill(offsets.begin(), offsets.end() - 1);
-        for (std::size_t t = 0; t < mesh.triangles.size(); ++t)
+        for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+            listed.at(t, mesh.triangles.size());
             for (auto v : mesh.triangles[t]) incident[fill[v]++] = std::int32_t(t);
+        }
     }
     std::size_t split = 0;
     std::vector<std::pair<std::int32_t, std::int32_t>> others;  // (other vertex, local index)
@@ -195,6 +228,7 @@ std::size_t split_pinched_vertices(TriangleMesh& mesh, std::int32_t* first_pinch
     std::vector<std::int32_t> size;
     constexpr std::int32_t kPairwise = 16;
     for (std::size_t v = 0; v < n; ++v) {
+        each_vertex.at(v, n);
         const std::size_t begin = offsets[v];
         const auto k = static_cast<std::int32_t>(offsets[v + 1] - offsets[v]);  // a fan's size
         if (k < 2) continue;
@@ -250,13 +284,20 @@ std::size_t split_pinched_vertices(TriangleMesh& mesh, std::int32_t* first_pinch
     return split;
 }
 
-std::size_t remove_unreferenced_vertices(TriangleMesh& mesh) {
+std::size_t remove_unreferenced_vertices(TriangleMesh& mesh, const ProgressFn& progress) {
+    // Its passes: the corners (0 to 0.4), the vertices (to 0.6), the corners again (to 1).
+    const detail::PassProgress used(progress, 0, 0.4, "mesh"), kept(progress, 0.4, 0.6, "mesh"),
+        renumbered(progress, 0.6, 1, "mesh");
+    const std::size_t nt = mesh.triangles.size();
     std::vector<std::int32_t> remap(mesh.positions.size(), -1);
-    for (const auto& tri : mesh.triangles)
-        for (auto v : tri) remap[v] = 0;
+    for (std::size_t i = 0; i < nt; ++i) {
+        used.at(i, nt);
+        for (auto v : mesh.triangles[i]) remap[v] = 0;
+    }
     const bool pixels = !mesh.vertex_pixel.empty();
     std::int32_t next = 0;
     for (std::size_t v = 0; v < remap.size(); ++v) {
+        kept.at(v, remap.size());
         if (remap[v] < 0) continue;
         remap[v] = next;
         mesh.positions[next] = mesh.positions[v];
@@ -266,8 +307,10 @@ std::size_t remove_unreferenced_vertices(TriangleMesh& mesh) {
     const std::size_t removed = remap.size() - std::size_t(next);
     mesh.positions.resize(next);
     if (pixels) mesh.vertex_pixel.resize(next);
-    for (auto& tri : mesh.triangles)
-        for (auto& v : tri) v = remap[v];
+    for (std::size_t i = 0; i < nt; ++i) {
+        renumbered.at(i, nt);
+        for (auto& v : mesh.triangles[i]) v = remap[v];
+    }
     for (auto& pv : mesh.pole_vertices)
         if (pv >= 0) pv = remap[pv];
     return removed;

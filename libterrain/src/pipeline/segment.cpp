@@ -203,8 +203,9 @@ void compute_field(SegmentResult& result, const SegmentOptions& options,
 
 reeb::ReebGraph compute_reeb(SegmentResult& result, const ProgressFn& progress) {
     const auto t0 = clock::now();
-    auto graph = reeb::build_reeb_graph(result.input.mesh, result.field, {}, progress);
-    result.critical_before = reeb::summarize(graph).critical;
+    auto graph = reeb::build_reeb_graph(result.input.mesh, result.field, {},
+                                        scaled_progress(progress, 0, 0.95));
+    result.critical_before = reeb::summarize(graph, scaled_progress(progress, 0.95, 1)).critical;
     result.add_time("reeb", since(t0));
     return graph;
 }

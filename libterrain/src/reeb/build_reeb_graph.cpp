@@ -41,8 +41,7 @@ ReebGraph build_reeb_graph(const TriangleMesh& mesh, const std::vector<float>& f
         internal::contour_sweep(mesh, field, g, progress, false);
         return g;
     }
-    internal::order_events(mesh, field, g);
-    report_progress(progress, 0.2, "reeb: order");
+    internal::order_events(mesh, field, g, scaled_progress(progress, 0, 0.2));
     if (internal::contour_tree(mesh, g, progress)) {
         report_progress(progress, 1.0, "reeb");
         return g;

@@ -13,13 +13,16 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cstdint>
 #include <numeric>
+#include <thread>
 #include <utility>
 #include <vector>
 
 #include "../core/disjoint_sets.hpp"
 #include "../core/indices.hpp"
+#include "../core/pass_progress.hpp"
 #include "../core/release.hpp"
 #include "link_components.hpp"
 #include "terrain/core/error.hpp"
@@ -56,14 +59,22 @@ bool contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& prog
     g.node_upper_links.assign(nn, 1);
     std::vector<char> general;
     std::vector<LinkCounts> vertex_links;
-    const std::vector<LinkReps> reps = link_components(mesh, g, vertex_links, general);
-    report_progress(progress, 0.3, "reeb: links");
+    const std::vector<LinkReps> reps =
+        link_components(mesh, g, vertex_links, general, scaled_progress(progress, 0.2, 0.3));
 
     // Each event's parent in the join tree (below it) and in the split tree (above it).
-    std::vector<i32> join_parent(nn, kNone), split_parent(nn, kNone);
+    // (Large blocks made a slice at a time, the sweeps' own too: their first touch is slow,
+    // docs/performance.md. The sweeps' progress starts at 0.3.)
+    const auto made = [&](double from) {
+        return detail::PassProgress(progress, from, from, "reeb: join and split trees");
+    };
+    std::vector<i32> join_parent, split_parent;
+    detail::assign_in_slices(join_parent, nn, kNone, made(0.3));
+    detail::assign_in_slices(split_parent, nn, kNone, made(0.3));
     // Children in the join and split trees. The sweeps run in opposite directions, so they
     // share cache lines only where they cross.
-    std::vector<std::array<i32, 2>> children(nn);
+    std::vector<std::array<i32, 2>> children;
+    detail::assign_in_slices(children, nn, std::array<i32, 2>{}, made(0.3));
     // One union-find sweep over the components of the part swept so far (the sublevel set for
     // the join tree, the superlevel set for the split tree). A node's entry holds its parent,
     // or (at a root) minus one minus its rank, and the last event added to its component (the
@@ -75,9 +86,26 @@ bool contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& prog
     struct Entry {
         i32 up, head;
     };
+    // Progress: the events both sweeps have passed, counted together, reported (0.3 to 0.6)
+    // only from the caller's thread (the callback may not be called from another). Either
+    // sweep may run there, or both one after the other in either order: the count is what
+    // keeps the fraction from going back.
+    const auto caller = std::this_thread::get_id();
+    std::atomic<std::size_t> swept_events{0};
+    std::array<std::vector<Entry>, 2> swept_by_side;
+    for (auto& s : swept_by_side) detail::assign_in_slices(s, nn, Entry{-1, 0}, made(0.3));
     auto sweep = [&](bool ascending, std::vector<i32>& tree_parent) {
         const std::size_t side = ascending ? 0 : 1;
-        std::vector<Entry> swept(nn, Entry{-1, 0});
+        const bool reports = progress && std::this_thread::get_id() == caller;
+        const auto passed = [&](std::size_t k) {
+            constexpr std::size_t kStep = std::size_t{1} << 18;
+            if ((k & (kStep - 1)) != kStep - 1) return;
+            const std::size_t all = swept_events.fetch_add(kStep) + kStep;
+            if (reports)
+                report_progress(progress, 0.3 + 0.3 * double(all) / double(2 * nn),
+                                "reeb: join and split trees");
+        };
+        std::vector<Entry>& swept = swept_by_side[side];
         auto find = [&](i32 x) {
             i32 r = x;
             while (swept[idx(r)].up >= 0) r = swept[idx(r)].up;
@@ -123,6 +151,7 @@ bool contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& prog
         };
         std::vector<i32> roots;
         for (std::size_t k = 0; k < nn; ++k) {
+            passed(k);
             if (k + kAhead < nn) {
                 const auto& r = reps_at(k + kAhead);
                 prefetch(r[0]);
@@ -169,6 +198,7 @@ bool contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& prog
         }
     };
     tbb::parallel_invoke([&] { sweep(true, join_parent); }, [&] { sweep(false, split_parent); });
+    for (auto& s : swept_by_side) detail::release(s);
     const auto components = std::count(join_parent.begin(), join_parent.end(), kNone);
     const auto chi = static_cast<std::int64_t>(mesh.vertex_count()) -
                      static_cast<std::int64_t>(mesh.neighbors.size() / 2) +
@@ -196,10 +226,15 @@ bool contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& prog
     };
     std::vector<i32> queue, attach(nn, kNone);
     queue.reserve(nn);
-    for (std::size_t n = 0; n < nn; ++n)
+    const detail::PassProgress leaves(progress, 0.6, 0.65, "reeb: contour tree"),
+        merged(progress, 0.65, 0.75, "reeb: contour tree");
+    for (std::size_t n = 0; n < nn; ++n) {
+        leaves.at(n, nn);
         if (is_leaf(static_cast<i32>(n))) queue.push_back(static_cast<i32>(n));
+    }
     constexpr std::size_t kAhead = 16;  // as in the sweeps: fetch the next leaves' entries early
     for (std::size_t qi = 0; qi < queue.size(); ++qi) {
+        merged.at(qi, nn);  // about nn leaves in all
         if (qi + kAhead < queue.size()) {
             const i32 x = queue[qi + kAhead];
             __builtin_prefetch(&children[idx(x)]);
@@ -226,13 +261,24 @@ bool contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& prog
     report_progress(progress, 0.75, "reeb: contour tree");
 
     // Up-edges per node (CSR, in the order of the removed leaves' indices), and down degrees.
-    std::vector<i32> up_off(nn + 1, 0), up_to(nn), down_deg(nn, 0);
+    std::vector<i32> up_off, up_to, down_deg;
+    const auto arcs_made = [&](double from) {
+        return detail::PassProgress(progress, from, from, "reeb: arcs");
+    };
+    detail::assign_in_slices(up_off, nn + 1, 0, arcs_made(0.75));
+    detail::assign_in_slices(up_to, nn, 0, arcs_made(0.75));
+    detail::assign_in_slices(down_deg, nn, 0, arcs_made(0.75));
+    // Its passes over the nodes: 0.75 to 0.9, by sixths.
+    const auto pass = [&](int k) {
+        return detail::PassProgress(progress, 0.75 + 0.025 * k, 0.775 + 0.025 * k, "reeb: arcs");
+    };
+    const auto p0 = pass(0), p1 = pass(1), p2 = pass(2), p3 = pass(3), p4 = pass(4), p5 = pass(5);
     auto edge = [&](std::size_t x) {
         const i32 y = attach[x] >> 1, self = static_cast<i32>(x);
         return (attach[x] & 1) ? std::pair{self, y} : std::pair{y, self};
     };
     for (std::size_t x = 0; x < nn; ++x)
-        if (attach[x] != kNone) {
+        if (p0.at(x, nn); attach[x] != kNone) {
             const auto [lo, hi] = edge(x);
             ++up_off[idx(lo) + 1];
             ++down_deg[idx(hi)];
@@ -241,13 +287,14 @@ bool contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& prog
     {
         std::vector<i32> fill(up_off.begin(), up_off.end() - 1);
         for (std::size_t x = 0; x < nn; ++x)
-            if (attach[x] != kNone) {
+            if (p1.at(x, nn); attach[x] != kNone) {
                 const auto [lo, hi] = edge(x);
                 up_to[idx(fill[idx(lo)]++)] = hi;
             }
     }
     g.node_kinds.assign(nn, NodeKind::regular);
     for (std::size_t n = 0; n < nn; ++n) {
+        p2.at(n, nn);
         const int d = down_deg[n], u = up_off[n + 1] - up_off[n];
         if (d == 1 && u == 1) continue;  // Reeb-regular, whatever its link (links stay 1, 1)
         g.node_kinds[n] = d == 0   ? NodeKind::minimum
@@ -266,7 +313,8 @@ bool contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& prog
     auto critical = [&](i32 n) { return g.node_kinds[idx(n)] != NodeKind::regular; };
     std::vector<i32>& below = attach;  // attach is no longer needed
     g.arcs.clear();
-    for (std::size_t lo = 0; lo < nn; ++lo)
+    for (std::size_t lo = 0; lo < nn; ++lo) {
+        p3.at(lo, nn);
         for (i32 k = up_off[lo]; k < up_off[lo + 1]; ++k) {
             const i32 hi = up_to[idx(k)];
             if (critical(static_cast<i32>(lo))) {
@@ -277,9 +325,11 @@ bool contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& prog
                 below[idx(hi)] = static_cast<i32>(lo);
             }
         }
+    }
     g.node_arcs.assign(nn, kNone);
     g.arc_offsets.assign(g.arcs.size() + 1, 0);
     for (std::size_t n = 0; n < nn; ++n) {
+        p4.at(n, nn);
         if (critical(static_cast<i32>(n))) continue;
         const i32 b = below[n];
         const i32 arc = b >= 0 ? g.node_arcs[idx(b)] : -2 - b;
@@ -293,11 +343,11 @@ bool contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& prog
     {
         std::vector<i32> fill(g.arc_offsets.begin(), g.arc_offsets.end() - 1);
         for (std::size_t n = 0; n < nn; ++n)
-            if (!critical(static_cast<i32>(n)))
+            if (p5.at(n, nn); !critical(static_cast<i32>(n)))
                 g.arc_nodes[idx(fill[idx(g.node_arcs[n])]++)] = static_cast<i32>(n);
     }
     report_progress(progress, 0.9, "reeb: arcs");
-    count_general_links(mesh, g, general);
+    count_general_links(mesh, g, general, scaled_progress(progress, 0.9, 1));
     return true;
 }
 

@@ -13,6 +13,7 @@
 
 #include "../core/disjoint_sets.hpp"
 #include "../core/indices.hpp"
+#include "../core/pass_progress.hpp"
 #include "../core/release.hpp"
 
 namespace terrain::reeb::internal {
@@ -36,25 +37,48 @@ inline float key_float(std::uint32_t k) {
 
 }  // namespace
 
-void order_events(const TriangleMesh& mesh, const std::vector<float>& field, ReebGraph& g) {
+void order_events(const TriangleMesh& mesh, const std::vector<float>& field, ReebGraph& g,
+                  const ProgressFn& progress) {
     const std::size_t nv = field.size();
+    // Its passes: the keys (0 to 0.1), their counts (to 0.2), three radix passes (to 0.65),
+    // the plateaus (to 0.8), the nodes (to 1).
+    using detail::PassProgress;
+    const PassProgress keyed(progress, 0.1, 0.15, "reeb: order"),
+        counted(progress, 0.15, 0.2, "reeb: order"), plateau(progress, 0.65, 0.8, "reeb: order"),
+        noded(progress, 0.9, 1, "reeb: order");
     // Stable LSD radix sort of (value bits << 32 | vertex) on the value bits, 11 bits per
     // pass: ties keep vertex order.
-    std::vector<std::uint64_t> keys(nv), tmp(nv);
-    for (std::size_t v = 0; v < nv; ++v) keys[v] = (std::uint64_t{float_key(field[v])} << 32) | v;
+    // (Large blocks made a slice at a time: their first touch is slow, docs/performance.md.)
+    std::vector<std::uint64_t> keys, tmp;
+    detail::assign_in_slices(keys, nv, std::uint64_t{0},
+                             PassProgress(progress, 0, 0.05, "reeb: order"));
+    detail::assign_in_slices(tmp, nv, std::uint64_t{0},
+                             PassProgress(progress, 0.05, 0.1, "reeb: order"));
+    for (std::size_t v = 0; v < nv; ++v) {
+        keyed.at(v, nv);
+        keys[v] = (std::uint64_t{float_key(field[v])} << 32) | v;
+    }
     constexpr int kBits = 11;
     constexpr std::size_t kBuckets = std::size_t{1} << kBits;
     std::vector<std::uint32_t> count(3 * kBuckets, 0u);
-    for (const std::uint64_t k : keys)
+    for (std::size_t i = 0; i < nv; ++i) {
+        counted.at(i, nv);
+        const std::uint64_t k = keys[i];
         for (int p = 0; p < 3; ++p)
             ++count[idx(p) * kBuckets + ((k >> (32 + kBits * p)) & (kBuckets - 1))];
+    }
     for (int p = 0; p < 3; ++p) {
         std::uint32_t* c = count.data() + idx(p) * kBuckets;
         const int shift = 32 + kBits * p;
         if (nv == 0 || c[(keys[0] >> shift) & (kBuckets - 1)] == nv) continue;  // one bucket
         std::uint32_t sum = 0;
         for (std::size_t b = 0; b < kBuckets; ++b) sum += std::exchange(c[b], sum);
-        for (const std::uint64_t k : keys) tmp[c[(k >> shift) & (kBuckets - 1)]++] = k;
+        const PassProgress moved(progress, 0.2 + 0.15 * p, 0.35 + 0.15 * p, "reeb: order");
+        for (std::size_t i = 0; i < nv; ++i) {
+            moved.at(i, nv);
+            const std::uint64_t k = keys[i];
+            tmp[c[(k >> shift) & (kBuckets - 1)]++] = k;
+        }
         keys.swap(tmp);
     }
     detail::release(tmp);
@@ -71,6 +95,7 @@ void order_events(const TriangleMesh& mesh, const std::vector<float>& field, Ree
     // Each vertex's plateau; its representative (the root) is its lowest vertex.
     detail::DisjointSets<i32> plateaus;
     for (std::size_t v = 0; v < tied.size(); ++v) {
+        plateau.at(v, tied.size());
         if (!tied[v]) continue;
         for (auto i = mesh.neighbor_offsets[v]; i < mesh.neighbor_offsets[v + 1]; ++i) {
             const i32 w = mesh.neighbors[idx(i)];
@@ -103,8 +128,10 @@ void order_events(const TriangleMesh& mesh, const std::vector<float>& field, Ree
         return any_plateau && same_value(a, b) &&
                plateaus.parent(vertex(a)) == plateaus.parent(vertex(b));
     };
-    g.node_vertices.resize(nv);
-    g.vertex_nodes.resize(nv);
+    detail::assign_in_slices(g.node_vertices, nv, i32{0},
+                             PassProgress(progress, 0.8, 0.85, "reeb: order"));
+    detail::assign_in_slices(g.vertex_nodes, nv, i32{0},
+                             PassProgress(progress, 0.85, 0.9, "reeb: order"));
     g.node_vertex_offsets.clear();
     g.node_values.clear();
     std::size_t n_nodes = nv;
@@ -116,6 +143,7 @@ void order_events(const TriangleMesh& mesh, const std::vector<float>& field, Ree
     g.node_values.reserve(n_nodes);
     constexpr std::size_t kAhead = 16;  // vertex_nodes is written in random order
     for (std::size_t i = 0; i < nv; ++i) {
+        noded.at(i, nv);
         if (i + kAhead < nv) __builtin_prefetch(&g.vertex_nodes[idx(vertex(keys[i + kAhead]))], 1);
         const i32 v = vertex(keys[i]);
         if (i == 0 || !same_event(keys[i], keys[i - 1])) {

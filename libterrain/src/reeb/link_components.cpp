@@ -10,6 +10,8 @@
 
 #include <algorithm>
 
+#include "../core/pass_progress.hpp"
+
 namespace terrain::reeb::internal {
 
 using detail::idx;
@@ -45,8 +47,12 @@ std::pair<int, int> LinkCounter::count(const TriangleMesh& mesh, const ReebGraph
 
 std::vector<LinkReps> link_components(const TriangleMesh& mesh, const ReebGraph& g,
                                       std::vector<LinkCounts>& vertex_links,
-                                      std::vector<char>& general) {
+                                      std::vector<char>& general, const ProgressFn& progress) {
     const std::size_t nv = mesh.vertex_count(), nn = g.node_count();
+    // Its passes: the triangles (0 to 0.6), the vertices (to 1).
+    const detail::PassProgress by_triangle(progress, 0.2, 0.6, "reeb: links"),
+        by_vertex(progress, 0.65, 1, "reeb: links");
+    const std::size_t nt = mesh.triangle_count();
     const auto& node = g.vertex_nodes;
     // starts[0..1]: lower runs' first vertices, starts[2..3]: upper runs'; runs[0], runs[1]:
     // how many lower and upper runs were seen.
@@ -55,8 +61,13 @@ std::vector<LinkReps> link_components(const TriangleMesh& mesh, const ReebGraph&
         std::uint8_t triangles, lower_edges, upper_edges;
         std::array<std::uint8_t, 2> runs;
     };
-    std::vector<Star> stars(nv, Star{{kNone, kNone, kNone, kNone}, 0, 0, 0, {0, 0}});
-    for (const auto& t : mesh.triangles) {
+    // (Made a slice at a time: the first touch of a large block is slow, docs/performance.md.)
+    std::vector<Star> stars;
+    detail::assign_in_slices(stars, nv, Star{{kNone, kNone, kNone, kNone}, 0, 0, 0, {0, 0}},
+                             detail::PassProgress(progress, 0, 0.2, "reeb: links"));
+    for (std::size_t ti = 0; ti < nt; ++ti) {
+        by_triangle.at(ti, nt);
+        const auto& t = mesh.triangles[ti];
         const std::array<i32, 3> n{node[idx(t[0])], node[idx(t[1])], node[idx(t[2])]};
         for (const i32 c : t) ++stars[idx(c)].triangles;
         if (n[0] != n[1] && n[1] != n[2] && n[0] != n[2]) {
@@ -83,11 +94,14 @@ std::vector<LinkReps> link_components(const TriangleMesh& mesh, const ReebGraph&
             stars[idx(t[idx(k)])].upper_edges += (m < p) & (m < q);
         }
     }
-    std::vector<LinkReps> reps(nn);
+    std::vector<LinkReps> reps;
+    detail::assign_in_slices(reps, nn, LinkReps{},
+                             detail::PassProgress(progress, 0.6, 0.65, "reeb: links"));
     general.assign(nn, 0);
     vertex_links.resize(nv);
     constexpr std::size_t kAhead = 16;  // the nodes' entries are written in random order
     for (std::size_t v = 0; v < nv; ++v) {
+        by_vertex.at(v, nv);
         if (v + kAhead < nv) __builtin_prefetch(&reps[idx(node[v + kAhead])], 1);
         const i32 n = node[v];
         const i32 b = mesh.neighbor_offsets[v], e = mesh.neighbor_offsets[v + 1];
@@ -124,7 +138,8 @@ std::vector<LinkReps> link_components(const TriangleMesh& mesh, const ReebGraph&
 
 // The link counts of the critical nodes that link_components left (plateaus, vertices of very
 // high degree), from their stars' triangles.
-void count_general_links(const TriangleMesh& mesh, ReebGraph& g, const std::vector<char>& general) {
+void count_general_links(const TriangleMesh& mesh, ReebGraph& g, const std::vector<char>& general,
+                         const ProgressFn& progress) {
     std::vector<char> wanted;  // per vertex
     for (std::size_t n = 0; n < g.node_count(); ++n) {
         if (!general[n] || g.node_kinds[n] == NodeKind::regular) continue;
@@ -134,8 +149,9 @@ void count_general_links(const TriangleMesh& mesh, ReebGraph& g, const std::vect
     }
     if (wanted.empty()) return;
     std::vector<std::pair<i32, i32>> star;  // (node, triangle)
+    const detail::PassProgress heartbeat(progress, 0, 0, "reeb: links");
     for (std::size_t t = 0; t < mesh.triangle_count(); ++t)
-        for (const i32 c : mesh.triangles[t])
+        for (heartbeat.at(t, mesh.triangle_count()); const i32 c : mesh.triangles[t])
             if (wanted[idx(c)]) star.push_back({g.vertex_nodes[idx(c)], static_cast<i32>(t)});
     std::sort(star.begin(), star.end());
     LinkCounter counter;

@@ -10,6 +10,7 @@
 
 #include "../core/disjoint_sets.hpp"
 #include "../core/indices.hpp"
+#include "terrain/core/progress.hpp"
 #include "terrain/mesh/triangle_mesh.hpp"
 #include "terrain/reeb/reeb_graph.hpp"
 
@@ -55,10 +56,12 @@ struct LinkReps {
 using LinkCounts = std::array<std::uint8_t, 2>;
 std::vector<LinkReps> link_components(const TriangleMesh& mesh, const ReebGraph& g,
                                       std::vector<LinkCounts>& vertex_links,
-                                      std::vector<char>& general);
+                                      std::vector<char>& general, const ProgressFn& progress = {});
 
 // The link counts of the critical nodes that link_components left (plateaus, vertices of very
 // high degree), from their stars' triangles.
-void count_general_links(const TriangleMesh& mesh, ReebGraph& g, const std::vector<char>& general);
+// `progress`: heartbeats (its fraction stays where the caller's was).
+void count_general_links(const TriangleMesh& mesh, ReebGraph& g, const std::vector<char>& general,
+                         const ProgressFn& progress = {});
 
 }  // namespace terrain::reeb::internal

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "../core/disjoint_sets.hpp"
+#include "../core/pass_progress.hpp"
 #include "terrain/reeb/reeb_graph.hpp"
 
 namespace terrain::reeb {
@@ -82,14 +83,20 @@ NodeArcs node_arcs(const ReebGraph& g) {
     return out;
 }
 
-ReebSummary summarize(const ReebGraph& g) {
+ReebSummary summarize(const ReebGraph& g, const ProgressFn& progress) {
+    const detail::PassProgress by_arc(progress, 0, 0.5, "reeb: summary"),
+        by_node(progress, 0.5, 1, "reeb: summary");
     ReebSummary s;
     s.nodes = g.node_count();
     s.arcs = g.arc_count();
     // Components: the arcs join their ends' sets.
     detail::DisjointSets<std::int32_t> components(g.node_count());
-    for (const auto& a : g.arcs) components.unite(a[1], a[0]);
+    for (std::size_t a = 0; a < g.arc_count(); ++a) {
+        by_arc.at(a, g.arc_count());
+        components.unite(g.arcs[a][1], g.arcs[a][0]);
+    }
     for (std::size_t n = 0; n < g.node_count(); ++n) {
+        by_node.at(n, g.node_count());
         const NodeKind k = g.node_kinds[n];
         if (k == NodeKind::regular) continue;
         ++s.critical;

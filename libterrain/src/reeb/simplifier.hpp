@@ -29,7 +29,7 @@ class Simplifier : WorkingGraph {
     // simplification's first quarter (run() reports the rest).
     Simplifier(const TriangleMesh& mesh, const ReebGraph& g, const SimplifyOptions& options,
                i32 big_degree = kBigDegree, const ProgressFn& progress = {})
-        : WorkingGraph(mesh, g, big_degree, scaled_progress(progress, 0, kCopyEnd)),
+        : WorkingGraph(mesh, g, big_degree, scaled_progress(progress, 0, kSeedStart)),
           options_(options) {
         queue_.init(arcs_.size());
         waiting_.assign(arcs_.size(), 0);
@@ -37,7 +37,8 @@ class Simplifier : WorkingGraph {
 
     // Slices of the simplification's progress, by their measured cost on global grids: the
     // copy into the working graph, the cancellations, the output.
-    static constexpr double kCopyEnd = 0.25, kOutputStart = 0.75;
+    // The candidates are queued from kSeedStart to kCopyEnd.
+    static constexpr double kSeedStart = 0.2, kCopyEnd = 0.25, kOutputStart = 0.75;
 
     // Cancels candidates until none is left, then writes the result (simplify.cpp).
     void run(const ProgressFn& progress, SimplifyResult& result);

@@ -31,6 +31,7 @@
 #include <cstdint>
 #include <string>
 
+#include "../core/pass_progress.hpp"
 #include "../core/release.hpp"
 #include "simplifier.hpp"
 #include "terrain/core/error.hpp"
@@ -43,7 +44,9 @@ void Simplifier::run(const ProgressFn& progress, SimplifyResult& result) {
     // Nodes with many arcs from the start (a pole's many-armed saddle) are big.
     promote_pending(true);
     // The candidates of the input graph; an arc with a big end is queued through it.
+    const detail::PassProgress seeded(progress, kSeedStart, kCopyEnd, "simplify");
     for (std::size_t a = 0; a < arcs_.size(); ++a) {
+        seeded.at(a, arcs_.size());
         if (a + kAhead < arcs_.size()) prefetch_ends(a + kAhead);
         const i32 arc = static_cast<i32>(a);
         if (managed(arc)) {

@@ -28,7 +28,10 @@ void WorkingGraph::write_result(SimplifyResult& result, const ProgressFn& progre
     const auto fate = [&](i32 f) {
         return f > -2 ? f : set_fate_[idx(find_root(set_parent_, -2 - f))];
     };
-    std::vector<i32> code(idx(critical_count_) + nl);
+    // (Large blocks made a slice at a time, with heartbeats: their first touch is slow.)
+    const auto made = [&](double at) { return PassProgress(progress, at, at, "simplify"); };
+    std::vector<i32> code;
+    detail::assign_in_slices(code, idx(critical_count_) + nl, i32{0}, made(0));
     for (std::size_t k = 0; k < idx(critical_count_); ++k) code[k] = fate(critical_[k].forward);
     for (std::size_t k = 0; k < idx(critical_count_); ++k)
         if (code[k] != kNone) code[k] = find_root(code, code[k]);
@@ -39,8 +42,9 @@ void WorkingGraph::write_result(SimplifyResult& result, const ProgressFn& progre
     }
     // The remaining nodes are numbered in the order of the old ones; node_map_ takes each old
     // node's new node (first -2 - the node that took it, for the absorbed ones).
-    std::vector<std::array<i32, 2>> kept;   // {old node, internal index} by new id
-    std::vector<std::uint8_t> gone(nn, 0);  // old nodes absorbed by another
+    std::vector<std::array<i32, 2>> kept;  // {old node, internal index} by new id
+    std::vector<std::uint8_t> gone;        // old nodes absorbed by another
+    detail::assign_in_slices(gone, nn, std::uint8_t{0}, made(0.2));
     for (std::size_t n = 0; n < nn; ++n) {
         numbers.at(n, nn);
         if (n + kAhead < nn) __builtin_prefetch(&code[idx(node_map_[n + kAhead])]);
@@ -83,9 +87,9 @@ void WorkingGraph::write_result(SimplifyResult& result, const ProgressFn& progre
     // Vertices: grouped by new node, in the order of their old nodes.
     for (std::size_t i = 1; i < size.size(); ++i) size[i] += size[i - 1];
     out.node_vertex_offsets = size;
-    out.node_vertices.resize(g_.node_vertices.size());
-    out.vertex_nodes.resize(g_.vertex_nodes.size());
-    result.absorbed.assign(g_.vertex_nodes.size(), 0);
+    detail::assign_in_slices(out.node_vertices, g_.node_vertices.size(), i32{0}, made(0.4));
+    detail::assign_in_slices(out.vertex_nodes, g_.vertex_nodes.size(), i32{0}, made(0.4));
+    detail::assign_in_slices(result.absorbed, g_.vertex_nodes.size(), std::uint8_t{0}, made(0.4));
     for (std::size_t n = 0; n < nn; ++n) {
         vertices.at(n, nn);
         if (n + kAhead < nn) {
@@ -101,7 +105,7 @@ void WorkingGraph::write_result(SimplifyResult& result, const ProgressFn& progre
             result.absorbed[idx(v)] = gone[n];
         }
     }
-    result.field.resize(g_.vertex_nodes.size());
+    detail::assign_in_slices(result.field, g_.vertex_nodes.size(), 0.0f, made(0.8));
     for (std::size_t v = 0; v < result.field.size(); ++v)
         result.field[v] = out.node_values[idx(out.vertex_nodes[v])];
     const auto new_id = [&](i32 i) { return -2 - code[idx(i)]; };

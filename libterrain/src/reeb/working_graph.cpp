@@ -143,15 +143,16 @@ double node_area(const TriangleMesh& mesh, const ReebGraph& g, std::size_t n,
 WorkingGraph::WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big_degree,
                            const ProgressFn& progress)
     : g_(g), big_degree_(big_degree) {
-    // Its three passes: the lists (0 to 0.1), the nodes (to 0.6), the arcs (to 1).
+    // Its passes: the lists (0 to 0.1), the nodes (to 0.6), the arcs (to 1), each with its
+    // large blocks made a slice at a time (their first touch is slow, docs/performance.md).
     using detail::PassProgress;
-    const PassProgress lists(progress, 0, 0.1, "simplify"), nodes(progress, 0.1, 0.6, "simplify"),
-        arcs(progress, 0.6, 1, "simplify");
+    const PassProgress lists(progress, 0.03, 0.1, "simplify"),
+        nodes(progress, 0.25, 0.6, "simplify"), arcs(progress, 0.76, 1, "simplify");
     const std::size_t nn = g.node_count(), na = g.arc_count(), nl = g.arc_nodes.size();
     // node_map_[n]: arc ends marked, the other regular nodes of the lists by their position in
     // arc_nodes (`placed` says which positions hold their node); then the new numbers.
     constexpr i32 kEnd = -2;
-    node_map_.assign(nn, kNone);
+    detail::assign_in_slices(node_map_, nn, kNone, PassProgress(progress, 0, 0.03, "simplify"));
     for (const auto& e : g.arcs) node_map_[idx(e[0])] = node_map_[idx(e[1])] = kEnd;
     std::vector<char> placed(nl, 0);
     for (std::size_t p = 0; p < nl; ++p) {
@@ -168,8 +169,11 @@ WorkingGraph::WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big
     }
     critical_count_ = 0;
     for (const i32 i : node_map_) critical_count_ += i < 0;
-    critical_.resize(idx(critical_count_));
-    regular_.resize(nl);
+    // (Large blocks, made a slice at a time: their first touch is slow, docs/performance.md.)
+    detail::assign_in_slices(critical_, idx(critical_count_), CriticalNode{},
+                             PassProgress(progress, 0.1, 0.2, "simplify"));
+    detail::assign_in_slices(regular_, nl, RegularNode{},
+                             PassProgress(progress, 0.2, 0.25, "simplify"));
     total_area_ = 0;
     std::vector<i32> scratch;
     i32 k = 0;
@@ -197,9 +201,9 @@ WorkingGraph::WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big
     }
     total_area_ = mesh_area_or_one(total_area_);
     // Arc a joins its lower then its upper end, a in order.
-    arcs_.resize(na);
-    set_parent_.assign(na, kNone);
-    set_fate_.assign(na, kNone);
+    detail::assign_in_slices(arcs_, na, Arc{}, PassProgress(progress, 0.6, 0.7, "simplify"));
+    detail::assign_in_slices(set_parent_, na, kNone, PassProgress(progress, 0.7, 0.73, "simplify"));
+    detail::assign_in_slices(set_fate_, na, kNone, PassProgress(progress, 0.73, 0.76, "simplify"));
     for (std::size_t a = 0; a < na; ++a) {
         arcs.at(a, na);
         Arc& arc = arcs_[a];

@@ -22,6 +22,7 @@
 #include <string>
 
 #include "../core/indices.hpp"
+#include "../core/pass_progress.hpp"
 #include "terrain/core/error.hpp"
 
 namespace terrain::segment {
@@ -86,14 +87,16 @@ double edge_length(const TriangleMesh& mesh, std::size_t a, std::size_t b) {
                      double(p[2] - q[2]) * (p[2] - q[2]));
 }
 
-double mean_edge_length(const TriangleMesh& mesh) {
+double mean_edge_length(const TriangleMesh& mesh, const detail::PassProgress& pass) {
     double sum = 0;
     std::size_t count = 0;
-    for (std::size_t v = 0; v < mesh.vertex_count(); ++v)
+    for (std::size_t v = 0; v < mesh.vertex_count(); ++v) {
+        pass.at(v, mesh.vertex_count());
         for (i32 k = mesh.neighbor_offsets[v]; k < mesh.neighbor_offsets[v + 1]; ++k) {
             sum += edge_length(mesh, v, idx(mesh.neighbors[idx(k)]));
             ++count;
         }
+    }
     return count == 0 || sum <= 0 ? 1.0 : sum / double(count);
 }
 
@@ -163,19 +166,30 @@ DivideCounts divide_absorbed(const TriangleMesh& mesh, const reeb::ReebGraph& gr
     // 3. Flooding from the regions' edges: the shortest paths in the metric where a step
     // into u for region r costs |field(u) - mean(r)| plus a constant per mean edge length.
     const float step = kStepShare * field_spread(field);
-    const double mean_edge = mean_edge_length(mesh);
+    const double mean_edge =
+        mean_edge_length(mesh, detail::PassProgress(progress, 0.2, 0.2, "divide"));
     // cost: a labelled vertex's path cost; for the others, the best offer so far (from
     // `offer`), so that only better offers are queued (the same result as queuing every
     // one: costs grow along a path, so a vertex's first offer taken is its cheapest).
-    std::vector<float> cost(n, 0.0f);
-    std::vector<std::uint32_t> offer(n, 0);
+    // (Passes over every vertex from 0.2 to 0.3 of the progress, the large blocks made a slice
+    // at a time: their first touch is slow, docs/performance.md.)
+    const auto pass = [&](double from) {
+        return detail::PassProgress(progress, from, from + 0.015, "divide");
+    };
+    std::vector<float> cost;
+    std::vector<std::uint32_t> offer;
+    detail::assign_in_slices(cost, n, 0.0f, pass(0.2));
+    detail::assign_in_slices(offer, n, std::uint32_t{0}, pass(0.215));
+    const auto unlabelled = pass(0.23);
     for (std::size_t v = 0; v < n; ++v)
-        if (labels[v] == 0) cost[v] = std::numeric_limits<float>::infinity();
+        if (unlabelled.at(v, n); labels[v] == 0) cost[v] = std::numeric_limits<float>::infinity();
     // Each region's mean of the field over the vertices it kept (area-weighted), fixed for
     // the flooding.
     std::vector<double> sum(segmentation.seeds.size() + 1, 0.0),
         weight(segmentation.seeds.size() + 1, 0.0);
+    const auto summed = pass(0.245);
     for (std::size_t v = 0; v < n; ++v) {
+        summed.at(v, n);
         if (labels[v] == 0) continue;
         const double a = mesh.vertex_areas.empty() ? 1.0 : mesh.vertex_areas[v];
         sum[labels[v]] += a * field[v];
@@ -197,15 +211,20 @@ DivideCounts divide_absorbed(const TriangleMesh& mesh, const reeb::ReebGraph& gr
             heap.push({c, static_cast<i32>(u), labels[w]});
         });
     };
+    const auto fronts = pass(0.26);
     for (std::size_t w = 0; w < n; ++w)
-        if (labels[w] != 0) {
+        if (fronts.at(w, n); labels[w] != 0) {
             bool edge = false;
             neighbours(w, [&](std::size_t u) { edge |= labels[u] == 0; });
             if (edge) push_around(w);
         }
     // (the vertices to label: the absorbed ones and those detached, less those kept)
     std::size_t to_label = 0, labelled = 0;
-    for (std::size_t v = 0; v < n; ++v) to_label += labels[v] == 0;
+    const auto counted = pass(0.275);
+    for (std::size_t v = 0; v < n; ++v) {
+        counted.at(v, n);
+        to_label += labels[v] == 0;
+    }
     report_progress(progress, 0.3, "divide");
     while (!heap.empty()) {
         const Step s = heap.top();

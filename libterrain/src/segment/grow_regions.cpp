@@ -10,6 +10,7 @@
 #include <queue>
 
 #include "../core/indices.hpp"
+#include "../core/pass_progress.hpp"
 #include "terrain/core/error.hpp"
 
 namespace terrain::segment {
@@ -42,15 +43,20 @@ struct Candidate {
 
 class Grower {
   public:
-    Grower(const TriangleMesh& mesh, const reeb::ReebGraph& g, const GrowOptions& options)
+    // Reports its set-up as 0 to 1 of `progress` (areas, then the graph's neighbours).
+    Grower(const TriangleMesh& mesh, const reeb::ReebGraph& g, const GrowOptions& options,
+           const ProgressFn& progress)
         : mesh_(mesh), g_(g), options_(options) {
-        const std::size_t nn = g.node_count();
+        const std::size_t nn = g.node_count(), nv = g.vertex_nodes.size();
         node_region_.assign(nn, kNone);
         node_area_.assign(nn, 0.0);
-        for (std::size_t v = 0; v < g.vertex_nodes.size(); ++v)
+        const detail::PassProgress areas(progress, 0, 0.4, "grow");
+        for (std::size_t v = 0; v < nv; ++v) {
+            areas.at(v, nv);
             node_area_[idx(g.vertex_nodes[v])] +=
                 mesh.vertex_areas.empty() ? 1.0 : mesh.vertex_areas[v];
-        build_reeb_neighbours();
+        }
+        build_reeb_neighbours(scaled_progress(progress, 0.4, 1));
         unassigned_branches_.resize(nn);
         for (std::size_t n = 0; n < nn; ++n) unassigned_branches_[n] = nb_off_[n + 1] - nb_off_[n];
     }
@@ -70,7 +76,23 @@ class Grower {
         region_sum_.assign(seeds.size(), 0.0);
         region_area_.assign(seeds.size(), 0.0);
         for (std::size_t r = 0; r < seeds.size(); ++r) out.seeds.push_back(seeds[r].second);
-        for (std::size_t r = 0; r < seeds.size(); ++r) assign(seeds[r].second, static_cast<i32>(r));
+        // Progress by vertices: after the simplification a few nodes (the seeds first) hold
+        // most of them.
+        const double nv = static_cast<double>(std::max<std::size_t>(1, g_.vertex_nodes.size()));
+        std::size_t vertices_assigned = 0;
+        progress_ = &progress;
+        done_ = &vertices_assigned;
+        const auto count = [&](i32 n) {
+            const std::size_t before = vertices_assigned;
+            vertices_assigned +=
+                idx(g_.node_vertex_offsets[idx(n) + 1] - g_.node_vertex_offsets[idx(n)]);
+            if ((before >> 18) != (vertices_assigned >> 18))
+                report(static_cast<double>(vertices_assigned) / nv);
+        };
+        for (std::size_t r = 0; r < seeds.size(); ++r) {
+            assign(seeds[r].second, static_cast<i32>(r));
+            count(seeds[r].second);
+        }
         const std::size_t total = g_.node_count();
         std::size_t assigned = seeds.size();
         bool relaxed = false;
@@ -88,8 +110,8 @@ class Grower {
                 }
                 assign(c.node, c.region);
                 if (relaxed) ++out.relaxed_nodes;
-                if ((++assigned & 0xffff) == 0)
-                    report_progress(progress, static_cast<double>(assigned) / total, "grow");
+                ++assigned;
+                count(c.node);
             }
             if (assigned == total || relaxed || seeds.empty()) break;
             // Nodes the graph constraint left out: let them join under the standard cost.
@@ -111,8 +133,9 @@ class Grower {
   private:
     // Reeb-graph neighbours of every node: along its arc for a regular node, the first node
     // of each incident arc for a critical node. CSR.
-    void build_reeb_neighbours() {
+    void build_reeb_neighbours(const ProgressFn& progress) {
         const std::size_t nn = g_.node_count();
+        const detail::PassProgress along_arcs(progress, 0, 1, "grow");
         nb_off_.assign(nn + 1, 0);
         auto along = [&](std::size_t a, bool from_lower) {
             const i32 b = g_.arc_offsets[a], e = g_.arc_offsets[a + 1];
@@ -133,6 +156,7 @@ class Grower {
             nb_[idx(fill[idx(g_.arcs[a][1])]++)] = along(a, false);
             const i32 b = g_.arc_offsets[a], e = g_.arc_offsets[a + 1];
             for (i32 i = b; i < e; ++i) {
+                along_arcs.at(idx(i), g_.arc_nodes.size());
                 const i32 r = g_.arc_nodes[idx(i)];
                 nb_[idx(fill[idx(r)]++)] = i == b ? g_.arcs[a][0] : g_.arc_nodes[idx(i - 1)];
                 nb_[idx(fill[idx(r)]++)] = i + 1 == e ? g_.arcs[a][1] : g_.arc_nodes[idx(i + 1)];
@@ -158,7 +182,9 @@ class Grower {
     void push_mesh_candidates(i32 n, bool relaxed) {
         const i32 r = node_region_[idx(n)];
         i32 last = kNone;
-        for (i32 i = g_.node_vertex_offsets[idx(n)]; i < g_.node_vertex_offsets[idx(n) + 1]; ++i) {
+        const i32 first = g_.node_vertex_offsets[idx(n)];
+        for (i32 i = first; i < g_.node_vertex_offsets[idx(n) + 1]; ++i) {
+            tick(idx(i - first));
             const i32 v = g_.node_vertices[idx(i)];
             for (i32 k = mesh_.neighbor_offsets[idx(v)]; k < mesh_.neighbor_offsets[idx(v) + 1];
                  ++k) {
@@ -174,6 +200,7 @@ class Grower {
     // Candidates for node u against every region it touches on the mesh.
     void push_all_regions(i32 u) {
         for (i32 i = g_.node_vertex_offsets[idx(u)]; i < g_.node_vertex_offsets[idx(u) + 1]; ++i) {
+            tick(0);
             const i32 v = g_.node_vertices[idx(i)];
             for (i32 k = mesh_.neighbor_offsets[idx(v)]; k < mesh_.neighbor_offsets[idx(v) + 1];
                  ++k) {
@@ -207,6 +234,22 @@ class Grower {
     std::vector<i32> node_region_, nb_off_, nb_, unassigned_branches_;
     std::vector<double> node_area_, region_sum_, region_area_;
     std::priority_queue<Candidate, std::vector<Candidate>, std::greater<Candidate>> heap_;
+    // While run() runs: its progress, the vertices of the nodes assigned so far, the vertices
+    // looked at (every 2^18 a report: a node the simplification gave a large part of the
+    // surface takes seconds), and the fraction reported last.
+    const ProgressFn* progress_ = nullptr;
+    const std::size_t* done_ = nullptr;
+    std::size_t visited_ = 0;
+    double reported_ = 0;
+    void report(double fraction) {
+        reported_ = std::max(reported_, fraction);
+        report_progress(*progress_, reported_, "grow");
+    }
+    // One more vertex looked at, `partial` vertices into the node being assigned.
+    void tick(std::size_t partial) {
+        if ((++visited_ & 0x3ffff) != 0 || !progress_) return;
+        report(double(*done_ + partial) / double(std::max<std::size_t>(1, g_.vertex_nodes.size())));
+    }
 };
 
 }  // namespace
@@ -217,7 +260,8 @@ Segmentation grow_regions(const TriangleMesh& mesh, const reeb::ReebGraph& graph
         throw Error("segment", "the Reeb graph was not built on this mesh");
     if (!std::isfinite(options.saddle_penalty) || options.saddle_penalty < 0)
         throw Error("segment", "the saddle penalty must be a number >= 0");
-    return Grower(mesh, graph, options).run(progress);
+    Grower grower(mesh, graph, options, scaled_progress(progress, 0, 0.1));
+    return grower.run(scaled_progress(progress, 0.1, 1));
 }
 
 }  // namespace terrain::segment

@@ -6,6 +6,7 @@
 #include <string>
 #include <unordered_map>
 
+#include "../core/pass_progress.hpp"
 #include "pixel_areas.hpp"
 #include "terrain/core/error.hpp"
 #include "terrain/mesh/dem_to_mesh.hpp"
@@ -66,12 +67,20 @@ std::vector<std::uint8_t> mesh_boundary(const TriangleMesh& mesh) {
 // region) from the region's boundary: its cut edges and the mesh boundary. Ties: lowest index.
 std::vector<std::int32_t> representative_vertices(const TriangleMesh& mesh,
                                                   const std::vector<std::uint32_t>& labels,
-                                                  std::uint32_t region_count) {
+                                                  std::uint32_t region_count,
+                                                  const ProgressFn& progress) {
     const std::size_t n = mesh.vertex_count();
+    // Its passes: the boundary (0 to 0.2), the sources (to 0.5), the distances (to 0.9), the
+    // deepest (to 1).
+    using detail::PassProgress;
+    const PassProgress sources(progress, 0.2, 0.5, "regions"),
+        distances(progress, 0.5, 0.9, "regions"), deepest(progress, 0.9, 1, "regions");
     const auto on_boundary = mesh_boundary(mesh);
+    report_progress(progress, 0.2, "regions");
     std::vector<std::int32_t> depth(n, -1), queue;
     queue.reserve(n);
     for (std::size_t v = 0; v < n; ++v) {
+        sources.at(v, n);
         bool source = on_boundary[v];
         for (auto k = mesh.neighbor_offsets[v]; !source && k < mesh.neighbor_offsets[v + 1]; ++k)
             source = labels[static_cast<std::size_t>(mesh.neighbors[std::size_t(k)])] != labels[v];
@@ -81,6 +90,7 @@ std::vector<std::int32_t> representative_vertices(const TriangleMesh& mesh,
         }
     }
     for (std::size_t head = 0; head < queue.size(); ++head) {
+        distances.at(head, n);  // each vertex of a region's pixels once
         const auto v = static_cast<std::size_t>(queue[head]);
         for (auto k = mesh.neighbor_offsets[v]; k < mesh.neighbor_offsets[v + 1]; ++k) {
             const auto w = static_cast<std::size_t>(mesh.neighbors[std::size_t(k)]);
@@ -91,6 +101,7 @@ std::vector<std::int32_t> representative_vertices(const TriangleMesh& mesh,
     }
     std::vector<std::int32_t> best(region_count, -1);
     for (std::size_t v = 0; v < n; ++v) {
+        deepest.at(v, n);
         auto& b = best[labels[v] - 1];
         if (b < 0 || depth[v] > depth[static_cast<std::size_t>(b)])
             b = static_cast<std::int32_t>(v);
@@ -99,15 +110,22 @@ std::vector<std::int32_t> representative_vertices(const TriangleMesh& mesh,
 }
 
 // Boundary length and cut mesh edges per pair of labels (see RegionEdge).
-std::unordered_map<std::uint64_t, EdgeSums> boundary_sums(
-    const TriangleMesh& mesh, const std::vector<std::uint32_t>& labels) {
+std::unordered_map<std::uint64_t, EdgeSums> boundary_sums(const TriangleMesh& mesh,
+                                                          const std::vector<std::uint32_t>& labels,
+                                                          const ProgressFn& progress) {
+    const detail::PassProgress by_vertex(progress, 0, 0.5, "regions"),
+        by_triangle(progress, 0.5, 1, "regions");
     std::unordered_map<std::uint64_t, EdgeSums> sums;
-    for (std::size_t v = 0; v < mesh.vertex_count(); ++v)
+    for (std::size_t v = 0; v < mesh.vertex_count(); ++v) {
+        by_vertex.at(v, mesh.vertex_count());
         for (auto k = mesh.neighbor_offsets[v]; k < mesh.neighbor_offsets[v + 1]; ++k) {
             const auto w = static_cast<std::size_t>(mesh.neighbors[std::size_t(k)]);
             if (w > v && labels[w] != labels[v]) ++sums[pair_key(labels[v], labels[w])].mesh_edges;
         }
-    for (const auto& t : mesh.triangles) {
+    }
+    for (std::size_t i = 0; i < mesh.triangle_count(); ++i) {
+        by_triangle.at(i, mesh.triangle_count());
+        const auto& t = mesh.triangles[i];
         const std::uint32_t l[3] = {labels[std::size_t(t[0])], labels[std::size_t(t[1])],
                                     labels[std::size_t(t[2])]};
         if (l[0] == l[1] && l[1] == l[2]) continue;
@@ -286,16 +304,26 @@ const char* to_string(Landform landform) {
 }
 
 std::vector<std::uint32_t> label_pixels(const TriangleMesh& mesh, const Dem& dem,
-                                        const std::vector<std::uint32_t>& labels) {
+                                        const std::vector<std::uint32_t>& labels,
+                                        const ProgressFn& progress) {
     if (mesh.vertex_pixel.size() != mesh.vertex_count() || labels.size() != mesh.vertex_count() ||
         dem.width != mesh.grid_width || dem.height != mesh.grid_height)
         throw Error("segment", "labels, mesh and DEM grid do not match");
     const auto vertex = mesh::pixel_to_vertex(mesh, dem);
-    std::vector<std::uint32_t> out(vertex.size(), 0);
+    report_progress(progress, 0.2, "regions");
+    std::vector<std::uint32_t> out;  // made a slice at a time: its first touch is slow
+    detail::assign_in_slices(out, vertex.size(), std::uint32_t{0},
+                             detail::PassProgress(progress, 0.2, 0.5, "regions"));
+    const detail::PassProgress labelled(progress, 0.5, 0.8, "regions"),
+        highest(progress, 0.8, 0.9, "regions");
     for (std::size_t p = 0; p < vertex.size(); ++p)
-        if (vertex[p] >= 0) out[p] = labels[static_cast<std::size_t>(vertex[p])];
+        if (labelled.at(p, vertex.size()); vertex[p] >= 0)
+            out[p] = labels[static_cast<std::size_t>(vertex[p])];
     std::uint32_t top = 0;
-    for (const auto l : labels) top = std::max(top, l);
+    for (std::size_t v = 0; v < labels.size(); ++v) {
+        highest.at(v, labels.size());
+        top = std::max(top, labels[v]);
+    }
     label_unmeshed_pixels(dem, mesh.seam_closed, out, top + 1);
     return out;
 }
@@ -309,7 +337,7 @@ RegionGraph region_graph(const TriangleMesh& mesh, const std::vector<float>& fie
     std::vector<std::uint32_t> pixels;
     std::uint32_t total = region_count;
     if (dem) {
-        pixels = label_pixels(mesh, *dem, labels);
+        pixels = label_pixels(mesh, *dem, labels, scaled_progress(progress, 0, 0.2));
         for (const auto l : pixels) total = std::max(total, l);
     }
     report_progress(progress, 0.2, "regions");
@@ -365,13 +393,14 @@ RegionGraph region_graph(const TriangleMesh& mesh, const std::vector<float>& fie
     }
 
     report_progress(progress, 0.5, "regions");
-    const auto best = representative_vertices(mesh, labels, region_count);
+    const auto best =
+        representative_vertices(mesh, labels, region_count, scaled_progress(progress, 0.5, 0.7));
     for (std::uint32_t i = 0; i < region_count; ++i)
         graph.regions[i].representative_vertex = best[i];
     set_points(graph, mesh, dem, first_pixel);
 
     report_progress(progress, 0.7, "regions");
-    const auto sums = boundary_sums(mesh, labels);
+    const auto sums = boundary_sums(mesh, labels, scaled_progress(progress, 0.7, 0.98));
     graph.edges.reserve(sums.size());
     for (const auto& [key, s] : sums) {
         RegionEdge e;

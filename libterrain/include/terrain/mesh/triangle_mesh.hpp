@@ -73,7 +73,8 @@ struct MeshTopology {
 
 // Sets origin to the centre of the points' bounding box and positions to the points
 // relative to it, as floats.
-void set_positions(TriangleMesh& mesh, const std::vector<std::array<double, 3>>& points);
+void set_positions(TriangleMesh& mesh, const std::vector<std::array<double, 3>>& points,
+                   const ProgressFn& progress = {});
 
 // Fills vertex_areas and the CSR adjacency from positions and triangles.
 void finish_mesh(TriangleMesh& mesh, const ProgressFn& progress = {});
@@ -84,10 +85,11 @@ MeshTopology mesh_topology(const TriangleMesh& mesh);
 // largest fan (ties: the one with the lowest triangle) keeps it, each other fan gets a copy
 // appended at the end (vertex_pixel copied too). Returns the number of vertices split and
 // stores the first one in *first_pinched when given. Call before finish_mesh.
-std::size_t split_pinched_vertices(TriangleMesh& mesh, std::int32_t* first_pinched = nullptr);
+std::size_t split_pinched_vertices(TriangleMesh& mesh, std::int32_t* first_pinched = nullptr,
+                                   const ProgressFn& progress = {});
 
 // Removes vertices that are in no triangle, keeping the order of the others (and their
 // vertex_pixel). Returns the number removed.
-std::size_t remove_unreferenced_vertices(TriangleMesh& mesh);
+std::size_t remove_unreferenced_vertices(TriangleMesh& mesh, const ProgressFn& progress = {});
 
 }  // namespace terrain

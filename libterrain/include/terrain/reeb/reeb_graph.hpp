@@ -89,7 +89,7 @@ struct ReebSummary {
     // when no plateau is a critical node.
     double index_sum = 0;
 };
-ReebSummary summarize(const ReebGraph& graph);
+ReebSummary summarize(const ReebGraph& graph, const ProgressFn& progress = {});
 
 // Arcs incident to each critical node, CSR over nodes (regular nodes have none).
 struct NodeArcs {

@@ -102,6 +102,7 @@ RegionGraph region_graph(const TriangleMesh& mesh, const std::vector<float>& fie
 // mesh vertex) form regions of their own, one per 8-connected group, numbered after the
 // largest label in `labels` in row-major order of their first pixel.
 std::vector<std::uint32_t> label_pixels(const TriangleMesh& mesh, const Dem& dem,
-                                        const std::vector<std::uint32_t>& labels);
+                                        const std::vector<std::uint32_t>& labels,
+                                        const ProgressFn& progress = {});
 
 }  // namespace terrain::segment
