@@ -230,6 +230,12 @@ TEST_CASE("Simplification is deterministic and leaves no candidate", "[simplify]
     CHECK(c.graph.node_vertices == a.graph.node_vertices);
     CHECK(c.graph.node_lower_links == a.graph.node_lower_links);
     CHECK(taken.arcs.empty());
+    // ... and the rest once the result is written: nothing of it is held while regions grow.
+    CHECK(taken.node_vertices.capacity() == 0);
+    CHECK(taken.vertex_nodes.capacity() == 0);
+    CHECK(taken.node_vertex_offsets.capacity() == 0);
+    CHECK(taken.node_values.capacity() == 0);
+    CHECK(taken.node_lower_links.capacity() == 0);
     // No arc with an extremum end (and no parallel twin) is left below the thresholds.
     const auto m = reeb::arc_metrics(s.mesh, a.graph);
     const auto inc = reeb::node_arcs(a.graph);

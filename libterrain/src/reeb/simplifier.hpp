@@ -40,6 +40,8 @@ class Simplifier : WorkingGraph {
     // The candidates are queued from kSeedStart to kCopyEnd.
     static constexpr double kSeedStart = 0.2, kCopyEnd = 0.25, kOutputStart = 0.75;
 
+    using WorkingGraph::own_input;
+
     // Cancels candidates until none is left, then writes the result (simplify.cpp).
     void run(const ProgressFn& progress, SimplifyResult& result);
 

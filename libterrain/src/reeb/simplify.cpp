@@ -109,6 +109,7 @@ void Simplifier::run(const ProgressFn& progress, SimplifyResult& result) {
     if (check_steps_ && check_failure_.empty()) check_failure_ = check_big_nodes();
     result.working_bytes = working_bytes() + queue_.bytes();
     queue_.release();  // the output is the peak of memory: the queue is done
+    detail::release(waiting_);
     report_progress(progress, kOutputStart, "simplify");
     write_result(result, scaled_progress(progress, kOutputStart, 1));
     report_progress(progress, 1.0, "simplify");
@@ -148,13 +149,14 @@ SimplifyResult simplify(const TriangleMesh& mesh, ReebGraph&& graph, const Simpl
         throw Error("simplify", "the graph was not built on this mesh");
     SimplifyResult result;
     internal::Simplifier simplifier(mesh, graph, options, internal::kBigDegree, progress);
+    simplifier.own_input(graph);
     // The working copy holds the arcs now; the output reads only the vertex lists and links.
     detail::release(graph.arcs);
     detail::release(graph.arc_offsets);
     detail::release(graph.arc_nodes);
     detail::release(graph.node_arcs);
     detail::release(graph.node_kinds);
-    simplifier.run(progress, result);
+    simplifier.run(progress, result);  // (which leaves the graph empty)
     return result;
 }
 

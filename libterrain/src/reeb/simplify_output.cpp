@@ -9,6 +9,7 @@
 
 #include "../core/disjoint_sets.hpp"
 #include "../core/pass_progress.hpp"
+#include "../core/release.hpp"
 #include "working_graph.hpp"
 
 namespace terrain::reeb::internal {
@@ -17,11 +18,11 @@ using detail::find_root;
 
 void WorkingGraph::write_result(SimplifyResult& result, const ProgressFn& progress) {
     const std::size_t nn = g_.node_count(), nl = regular_.size();
-    // Its passes: the fates (0 to 0.2), the new numbers (to 0.4), the vertices (to 0.8), the
-    // arcs (to 1).
+    // Its passes: the fates (0 to 0.2), the new numbers (to 0.3), the arcs (to 0.4), the
+    // vertices (to 0.8), the field (to 1).
     using detail::PassProgress;
-    const PassProgress fates(progress, 0, 0.2, "simplify"), numbers(progress, 0.2, 0.4, "simplify"),
-        vertices(progress, 0.4, 0.8, "simplify"), arcs(progress, 0.8, 1, "simplify");
+    const PassProgress fates(progress, 0, 0.2, "simplify"), numbers(progress, 0.2, 0.3, "simplify"),
+        arcs(progress, 0.3, 0.4, "simplify"), vertices(progress, 0.4, 0.8, "simplify");
     // code[i]: for an absorbed node, the critical node that finally took it (nodes are
     // only absorbed into critical nodes); for a remaining node, -2 - its new id.
     // A listed node's forward: the fate of its set's root (kNone for a list still there).
@@ -84,30 +85,11 @@ void WorkingGraph::write_result(SimplifyResult& result, const ProgressFn& progre
         out.node_upper_links[nid] =
             unchanged ? g_.node_upper_links[idx(n)] : static_cast<std::uint8_t>(std::min(u, 255));
     }
-    // Vertices: grouped by new node, in the order of their old nodes.
-    for (std::size_t i = 1; i < size.size(); ++i) size[i] += size[i - 1];
-    out.node_vertex_offsets = size;
-    detail::assign_in_slices(out.node_vertices, g_.node_vertices.size(), i32{0}, made(0.4));
-    detail::assign_in_slices(out.vertex_nodes, g_.vertex_nodes.size(), i32{0}, made(0.4));
-    detail::assign_in_slices(result.absorbed, g_.vertex_nodes.size(), std::uint8_t{0}, made(0.4));
-    for (std::size_t n = 0; n < nn; ++n) {
-        vertices.at(n, nn);
-        if (n + kAhead < nn) {
-            const i32 i = g_.node_vertex_offsets[n + kAhead];
-            if (i < g_.node_vertex_offsets[n + kAhead + 1])
-                __builtin_prefetch(&out.vertex_nodes[idx(g_.node_vertices[idx(i)])], 1);
-        }
-        const i32 nid = node_map_[n];
-        for (i32 i = g_.node_vertex_offsets[n]; i < g_.node_vertex_offsets[n + 1]; ++i) {
-            const i32 v = g_.node_vertices[idx(i)];
-            out.node_vertices[idx(size[idx(nid)]++)] = v;
-            out.vertex_nodes[idx(v)] = nid;
-            result.absorbed[idx(v)] = gone[n];
-        }
+    if (owned_) {  // a graph handed over: what is read no more goes
+        detail::release(owned_->node_lower_links);
+        detail::release(owned_->node_upper_links);
     }
-    detail::assign_in_slices(result.field, g_.vertex_nodes.size(), 0.0f, made(0.8));
-    for (std::size_t v = 0; v < result.field.size(); ++v)
-        result.field[v] = out.node_values[idx(out.vertex_nodes[v])];
+    // The arcs that remain, with their regular nodes from the lower end up.
     const auto new_id = [&](i32 i) { return -2 - code[idx(i)]; };
     out.arc_offsets.assign(1, 0);
     for (std::size_t a = 0; a < arcs_.size(); ++a) {
@@ -123,6 +105,43 @@ void WorkingGraph::write_result(SimplifyResult& result, const ProgressFn& progre
             out.node_arcs[idx(nid)] = id;
         }
         out.arc_offsets.push_back(static_cast<i32>(out.arc_nodes.size()));
+    }
+    // The working graph is done: it goes before the arrays of every vertex are made (the
+    // peak of the simplification's memory).
+    detail::release(code);
+    detail::release(kept);
+    release_working_graph();
+    // Vertices: grouped by new node, in the order of their old nodes.
+    const std::size_t nv = g_.vertex_nodes.size();
+    for (std::size_t i = 1; i < size.size(); ++i) size[i] += size[i - 1];
+    out.node_vertex_offsets = size;
+    detail::assign_in_slices(out.node_vertices, g_.node_vertices.size(), i32{0}, made(0.4));
+    detail::assign_in_slices(out.vertex_nodes, nv, i32{0}, made(0.4));
+    detail::assign_in_slices(result.absorbed, nv, std::uint8_t{0}, made(0.4));
+    for (std::size_t n = 0; n < nn; ++n) {
+        vertices.at(n, nn);
+        if (n + kAhead < nn) {
+            const i32 i = g_.node_vertex_offsets[n + kAhead];
+            if (i < g_.node_vertex_offsets[n + kAhead + 1])
+                __builtin_prefetch(&out.vertex_nodes[idx(g_.node_vertices[idx(i)])], 1);
+        }
+        const i32 nid = node_map_[n];
+        for (i32 i = g_.node_vertex_offsets[n]; i < g_.node_vertex_offsets[n + 1]; ++i) {
+            const i32 v = g_.node_vertices[idx(i)];
+            out.node_vertices[idx(size[idx(nid)]++)] = v;
+            out.vertex_nodes[idx(v)] = nid;
+            result.absorbed[idx(v)] = gone[n];
+        }
+    }
+    detail::release(size);
+    detail::release(gone);
+    detail::release(node_map_);
+    if (owned_) *owned_ = ReebGraph{};
+    detail::assign_in_slices(result.field, nv, 0.0f, made(0.8));
+    const PassProgress field(progress, 0.9, 1, "simplify");
+    for (std::size_t v = 0; v < result.field.size(); ++v) {
+        field.at(v, nv);
+        result.field[v] = out.node_values[idx(out.vertex_nodes[v])];
     }
 }
 

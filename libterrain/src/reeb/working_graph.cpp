@@ -9,6 +9,7 @@
 #include <string>
 
 #include "../core/pass_progress.hpp"
+#include "../core/release.hpp"
 #include "terrain/core/error.hpp"
 
 namespace terrain::reeb::internal {
@@ -107,6 +108,19 @@ bool WorkingGraph::refresh(i32 n, i32 b) {
     big_erase(n, b);
     big_insert(n, b);
     return true;
+}
+
+void WorkingGraph::release_working_graph() {
+    detail::release(critical_);
+    detail::release(regular_);
+    detail::release(arena_);
+    for (auto& f : free_runs_) detail::release(f);
+    detail::release(set_parent_);
+    detail::release(set_fate_);
+    detail::release(arcs_);
+    detail::release(big_);
+    detail::release(free_big_);
+    detail::release(pending_big_);
 }
 
 std::size_t WorkingGraph::working_bytes() const {

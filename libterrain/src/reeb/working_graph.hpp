@@ -53,8 +53,12 @@ class WorkingGraph {
     WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big_degree = kBigDegree,
                  const ProgressFn& progress = {});
 
-    // The simplified graph and the rewritten field (simplify_output.cpp).
+    // The simplified graph and the rewritten field (simplify_output.cpp). The working graph is
+    // freed as it goes: nothing else may be asked of it after.
     void write_result(SimplifyResult& result, const ProgressFn& progress = {});
+    // The input graph is handed over (simplify(ReebGraph&&)): write_result frees it as it
+    // reads it for the last time, and leaves it empty.
+    void own_input(ReebGraph& g) { owned_ = &g; }
     // The bytes it holds now: records, arc runs (freed ones included), list sets.
     std::size_t working_bytes() const;
 
@@ -348,7 +352,10 @@ class WorkingGraph {
     std::vector<BigNode> big_;      // the big nodes' arcs (a node's BigNode at its offset)
     std::vector<i32> free_big_;     // BigNodes given back, for reuse
     std::vector<i32> pending_big_;  // nodes flagged kPending
-    std::size_t moves_ = 0;         // link() calls
+    ReebGraph* owned_ = nullptr;    // the input graph, when handed over (own_input)
+    // Frees the records, runs, arcs, sets and big nodes (write_result, once the arcs are out).
+    void release_working_graph();
+    std::size_t moves_ = 0;  // link() calls
 };
 
 }  // namespace terrain::reeb::internal
