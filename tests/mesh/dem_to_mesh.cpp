@@ -348,3 +348,28 @@ TEST_CASE("dem_to_mesh: the same hill on a lon/lat grid and on a UTM grid has th
     CHECK(a.first == Approx(b.first).epsilon(0.005));
     CHECK(a.first > 0.02 * 2 * std::numbers::pi * sigma * sigma);  // the hill adds real area
 }
+
+TEST_CASE("dem_to_mesh reports every pass of a large grid, never going back", "[mesh]") {
+    // 700 x 700 pixels: about a million triangles, so that every pass reports several times
+    // (every 2^18 items) and the slices of the large blocks report too; pinched pixels and
+    // NoData holes give the splitting and the removal passes work.
+    const Dem dem = grid_dem(700, 700, 10.0, [](int c, int r) {
+        if ((c / 50 + r / 50) % 7 == 3 && c % 50 < 20 && r % 50 < 20) return kNaN;
+        if (c % 97 == 5 && r % 89 == 7) return kNaN;
+        return 30 * std::sin(c * 0.05) * std::cos(r * 0.037) + 0.1 * ((c * 31 + r * 17) % 13);
+    });
+    std::vector<double> seen;
+    const auto mesh = mesh::dem_to_mesh(dem, {}, [&](double f, std::string_view message) {
+        CHECK(message == "mesh");
+        seen.push_back(f);
+        return true;
+    });
+    CHECK(mesh.triangle_count() > 900000);
+    CHECK(std::is_sorted(seen.begin(), seen.end()));
+    CHECK(seen.size() > 100);
+    CHECK(seen.back() == 1.0);
+    // No slice of the bar larger than a tenth is silent.
+    double widest = 0;
+    for (std::size_t i = 1; i < seen.size(); ++i) widest = std::max(widest, seen[i] - seen[i - 1]);
+    CHECK(widest < 0.1);
+}

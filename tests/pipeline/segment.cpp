@@ -197,3 +197,41 @@ TEST_CASE("Continuing a simplification never adds extrema (noisy fields, 20 thre
         CHECK(last < 50);
     }
 }
+
+TEST_CASE("pipeline::segment on a large grid: every stage reports, never going back",
+          "[pipeline]") {
+    // 640 x 640 pixels of noisy hills: every pass of every stage (2^18 items) and every slice
+    // of the large blocks reports, so that a grid 600 times larger is never long silent
+    // (docs/performance.md, "Progress on long runs"; tests/bench/progress_gaps.py measures it).
+    const Dem dem = test::grid_dem(640, 640, [](int c, int r) {
+        return 40 * std::sin(c * 0.03) * std::cos(r * 0.025) + ((c * 7919 + r * 104729) % 17) * 0.3;
+    });
+    std::vector<double> seen;
+    std::vector<std::string> said;
+    std::set<std::string> reported;
+    const auto progress = [&](double f, std::string_view m) {
+        seen.push_back(f);
+        said.emplace_back(m);
+        reported.insert(std::string(m));
+        return true;
+    };
+    auto input = pipeline::input_from_dem(dem, "map", scaled_progress(progress, 0, 0.2));
+    const auto result = pipeline::segment(std::move(input), {}, scaled_progress(progress, 0.2, 1));
+    CHECK(result.segmentation.region_count > 1);
+    CHECK(std::is_sorted(seen.begin(), seen.end()));
+    CHECK(seen.back() == Approx(1.0));
+    CHECK(seen.size() > 200);
+    std::size_t widest = 1;  // the call after the widest step
+    for (std::size_t i = 1; i < seen.size(); ++i)
+        if (seen[i] - seen[i - 1] > seen[widest] - seen[widest - 1]) widest = i;
+    INFO("from " << said[widest - 1] << " at " << seen[widest - 1] << " to " << said[widest]);
+    // (The cancellations report on a clock, every quarter second: on this small grid they
+    // take less, and their slice, 0.08 of the bar, passes in one step. Nothing else may.)
+    CHECK(seen[widest] - seen[widest - 1] < 0.081);
+    for (const char* stage :
+         {"mesh", "shape index", "reeb: order", "reeb: links", "reeb: join and split trees",
+          "reeb: arcs", "simplify", "grow", "divide", "regions"}) {
+        INFO(stage);
+        CHECK(reported.count(stage) == 1);
+    }
+}

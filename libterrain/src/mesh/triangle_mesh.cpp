@@ -123,7 +123,7 @@ void finish_mesh(TriangleMesh& mesh, const ProgressFn& progress) {
         }
     }
     detail::release(fill);
-    report_progress(progress, 0.5, "mesh");
+    report_progress(progress, 0.6, "mesh");
     mesh.neighbor_offsets.assign(n + 1, 0);
     const detail::PassProgress sorted(progress, 0.6, 0.9, "mesh");
     std::size_t write = 0;
