@@ -1,0 +1,55 @@
+#!/usr/bin/python3
+"""The peak resident set of each stage of `terrain segment`: runs it, samples its resident set
+every 50 ms and splits the samples by the stage times run.json reports (docs/performance.md,
+"Memory by stage"). The stages' edges are approximate by the sampling period.
+
+    /usr/bin/python3 tests/bench/stage_memory.py BUILD DEM OUTDIR [terrain segment options]
+"""
+import json
+import os
+import subprocess
+import sys
+import time
+
+
+def main():
+    build, dem, out = sys.argv[1:4]
+    command = [os.path.join(build, "tools", "terrain"), "segment", dem, "-o", out, "-q",
+               "--overwrite"] + sys.argv[4:]
+    start = time.monotonic()
+    run = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    samples = []  # (seconds, MiB)
+    while run.poll() is None:
+        try:
+            with open("/proc/%d/status" % run.pid) as status:
+                for line in status:
+                    if line.startswith("VmRSS"):
+                        samples.append((time.monotonic() - start, int(line.split()[1]) / 1024))
+        except OSError:
+            pass
+        time.sleep(0.05)
+    error = run.stderr.read().decode()
+    if run.returncode != 0 or not samples:
+        print(error.strip())
+        return 1
+    with open(os.path.join(out, "run.json")) as f:
+        report = json.load(f)
+    pixels = report["counts"]["vertices"]
+    print("stage_memory: %s, %d vertices, %d cores" % (os.path.basename(dem), pixels, os.cpu_count()))
+    print("%-9s %8s %10s %10s %8s" % ("stage", "seconds", "peak MiB", "end MiB", "B/pixel"))
+    begin = samples[0][0]
+    for name, seconds in report["timings_seconds"].items():
+        if name == "total":
+            continue
+        inside = [mib for t, mib in samples if begin <= t < begin + seconds] or [samples[-1][1]]
+        print("%-9s %8.1f %10.0f %10.0f %8.0f" % (name, seconds, max(inside), inside[-1],
+                                                 max(inside) * 2**20 / pixels))
+        begin += seconds
+    peak = max(mib for _, mib in samples)
+    print("%-9s %8.1f %10.0f %10s %8.0f" % ("all", report["timings_seconds"]["total"], peak, "",
+                                           peak * 2**20 / pixels))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
