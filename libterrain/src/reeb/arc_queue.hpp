@@ -33,7 +33,13 @@ class ArcQueue {
     }
     static i32 arc_of(std::uint64_t key) { return static_cast<i32>(key & 0xffffffffu); }
 
-    void init(std::size_t arcs) { slot_.assign(arcs, detail::kNone); }
+    // Room for every arc's first key is reserved, not touched: the pages of the keys seeded
+    // become resident as they are written, and no growth copies them (a copy was half as
+    // many keys again, at the peak of the simplification's memory).
+    void init(std::size_t arcs) {
+        slot_.assign(arcs, detail::kNone);
+        sorted_.reserve(arcs);
+    }
     std::size_t bytes() const {
         return heap_.capacity() * sizeof(std::uint64_t) + slot_.capacity() * sizeof(i32) +
                sorted_.capacity() * sizeof(std::uint64_t);
@@ -46,16 +52,28 @@ class ArcQueue {
     // The first candidates, in increasing arc order, then sorted by seal().
     void seed(std::uint64_t key) { sorted_.push_back(key); }
     void seal() {
-        // Seeded in increasing arc order: a stable sort of the high halves sorts the keys.
-        std::vector<std::uint64_t> tmp(sorted_.size());
-        for (const int shift : {32, 43, 54}) {
-            std::array<std::size_t, 2048> count{};
-            for (const std::uint64_t k : sorted_) ++count[(k >> shift) & 2047];
-            std::size_t sum = 0;
-            for (std::size_t& c : count) sum += std::exchange(c, sum);
-            for (const std::uint64_t k : sorted_) tmp[count[(k >> shift) & 2047]++] = k;
-            sorted_.swap(tmp);
-        }
+        // The keys are unique (the arc id is their low half), so sorting them whole is the
+        // stable sort of their high halves in the order seeded. In place: at the peak of the
+        // simplification's memory a second buffer is 8 bytes a candidate (about one a pixel
+        // on a noisy grid). One pass of American flag sort on the top 11 bits puts each key
+        // in its bucket by swaps, then each bucket is sorted.
+        constexpr int kShift = 53;
+        constexpr std::size_t kBuckets = std::size_t{1} << (64 - kShift);
+        std::vector<std::size_t> begin(kBuckets + 1, 0);
+        for (const std::uint64_t k : sorted_) ++begin[(k >> kShift) + 1];
+        for (std::size_t b = 0; b < kBuckets; ++b) begin[b + 1] += begin[b];
+        std::vector<std::size_t> next(begin.begin(), begin.end() - 1);
+        for (std::size_t b = 0; b < kBuckets; ++b)
+            while (next[b] < begin[b + 1]) {
+                const std::size_t home = sorted_[next[b]] >> kShift;
+                if (home == b)
+                    ++next[b];
+                else
+                    std::swap(sorted_[next[b]], sorted_[next[home]++]);
+            }
+        for (std::size_t b = 0; b < kBuckets; ++b)
+            std::sort(sorted_.begin() + static_cast<std::ptrdiff_t>(begin[b]),
+                      sorted_.begin() + static_cast<std::ptrdiff_t>(begin[b + 1]));
         next_ = 0;
     }
     // The next sorted entry (kEmpty after the last), and the one `ahead` places further.

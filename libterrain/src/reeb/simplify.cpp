@@ -148,13 +148,15 @@ SimplifyResult simplify(const TriangleMesh& mesh, ReebGraph&& graph, const Simpl
     if (graph.vertex_nodes.size() != mesh.vertex_count())
         throw Error("simplify", "the graph was not built on this mesh");
     SimplifyResult result;
+    // The copy does not read the regular nodes' arcs: they go before it (the copy's end is
+    // the peak of the simplification's memory).
+    detail::release(graph.node_arcs);
     internal::Simplifier simplifier(mesh, graph, options, internal::kBigDegree, progress);
     simplifier.own_input(graph);
     // The working copy holds the arcs now; the output reads only the vertex lists and links.
     detail::release(graph.arcs);
     detail::release(graph.arc_offsets);
     detail::release(graph.arc_nodes);
-    detail::release(graph.node_arcs);
     detail::release(graph.node_kinds);
     simplifier.run(progress, result);  // (which leaves the graph empty)
     return result;
