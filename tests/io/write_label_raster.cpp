@@ -167,3 +167,40 @@ TEST_CASE("labels.tif: same bytes again, existing files kept unless overwrite, n
     const std::vector<std::uint32_t> wrong(5, 1);
     CHECK_THROWS_AS(io::write_label_raster(t.dem, wrong, t.graph, path, true), Error);
 }
+
+TEST_CASE("labels.tif reports GDAL's progress, and a cancel leaves no file",
+          "[write_label_raster]") {
+    // On a global grid of 265 M pixels writing the tiles and overviews takes a minute: GDAL's
+    // own progress goes to the callback.
+    // The whole 512 x 512 tile: GDAL reports tile by tile (a tiny grid gets one call).
+    const Dem vesta = io::read_dem(test::sample("vesta_hamo_tile.lbl"));
+    const auto t = test::segment_tile(vesta, test::voronoi_cells(vesta, 6, 5));
+    const auto dir = test::scratch_dir("write_label_raster_progress");
+    const auto path = (dir / "labels.tif").string();
+    std::vector<double> seen;
+    io::write_label_raster(t.dem, t.pixels, t.graph, path, false,
+                           [&](double f, std::string_view message) {
+                               CHECK(message == "write");
+                               seen.push_back(f);
+                               return true;
+                           });
+    INFO(seen.size() << " calls, the last " << seen.back());
+    CHECK(seen.size() >= 3);
+    CHECK(std::is_sorted(seen.begin(), seen.end()));
+    CHECK(seen.back() == Approx(1.0));
+    const auto written = test::file_bytes(path);
+    // The same bytes as without a callback.
+    const auto again = (dir / "again.tif").string();
+    io::write_label_raster(t.dem, t.pixels, t.graph, again, false);
+    CHECK(test::file_bytes(again) == written);
+    // A callback that cancels halfway: terrain::Error, and neither the raster nor its sidecars.
+    const auto cancelled = (dir / "cancelled.tif").string();
+    CHECK_THROWS_AS(io::write_label_raster(t.dem, t.pixels, t.graph, cancelled, false,
+                                           [](double f, std::string_view) { return f < 0.5; }),
+                    Error);
+    CHECK_FALSE(std::filesystem::exists(cancelled));
+    CHECK_FALSE(std::filesystem::exists(cancelled + ".aux.xml"));
+    CHECK_FALSE(std::filesystem::exists(io::label_style_path(cancelled)));
+    for (const auto& e : std::filesystem::directory_iterator(dir))
+        CHECK(e.path().filename().string()[0] != '.');
+}

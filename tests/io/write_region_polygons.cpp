@@ -285,6 +285,31 @@ TEST_CASE("Region polygons wait in an unlinked temporary file and are read back 
     check_features(read_features((dir / "copy3.geojson").string()), t, [](double x, double y) {
         return std::array<double, 2>{x, y};
     });
+    // Progress: GDALPolygonize's rows, then each region written; a cancel leaves no file.
+    std::vector<double> seen;
+    const auto reported = (dir / "reported.geojson").string();
+    io::write_region_polygons(t.dem, t.pixels, t.graph, reported, false, {},
+                              [&](double f, std::string_view message) {
+                                  CHECK(message == "write");
+                                  seen.push_back(f);
+                                  return true;
+                              });
+    CHECK(test::file_bytes(reported) == test::file_bytes(path));
+    CHECK(seen.size() > t.graph.regions.size());
+    CHECK(std::is_sorted(seen.begin(), seen.end()));
+    CHECK(seen.back() > 0.9);
+    const auto cancelled = (dir / "cancelled.gpkg").string();
+    io::RegionPolygonOptions gpkg;
+    gpkg.driver = "GPKG";
+    for (const double at : {0.3, 0.9}) {  // in GDALPolygonize, then among the regions
+        CHECK_THROWS_AS(
+            io::write_region_polygons(t.dem, t.pixels, t.graph, cancelled, false, gpkg,
+                                      [&](double f, std::string_view) { return f < at; }),
+            Error);
+        CHECK_FALSE(std::filesystem::exists(cancelled));
+    }
+    for (const auto& e : std::filesystem::directory_iterator(dir))
+        CHECK(e.path().filename().string()[0] != '.');  // no temporary file left
     // A temporary directory that cannot take the pieces: one line naming it.
     CHECK_THROWS_WITH(
         io::polygonize_regions(t.dem, t.pixels, t.graph.regions.size(), (dir / "missing").string()),

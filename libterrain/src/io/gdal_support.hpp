@@ -8,12 +8,14 @@
 #include <gdal_rat.h>
 
 #include <cstddef>
+#include <exception>
 #include <memory>
 #include <string>
 
 #include "../geo/iau_crs.hpp"
 #include "../geo/ogr_support.hpp"
 #include "terrain/core/dem.hpp"
+#include "terrain/core/progress.hpp"
 #include "terrain/segment/regions.hpp"
 
 namespace terrain::io {
@@ -44,5 +46,26 @@ std::unique_ptr<GDALDataset> create_grid_tiff(const Dem& grid, bool with_transfo
 // Closes the dataset (writing what GDAL cached) and throws if that failed.
 void close_dataset(std::unique_ptr<GDALDataset>& ds, const std::string& path,
                    const GdalErrorCapture& errors);
+
+// GDAL's progress (a GDALProgressFunc and its argument) to a terrain callback, as "write":
+// an exception (a cancel) must not cross GDAL's C code, so it is kept, GDAL is told to stop,
+// and the caller rethrows it (rethrow_if_stopped) once GDAL has returned.
+struct GdalProgress {
+    const ProgressFn& fn;
+    std::exception_ptr stopped{};
+    static int CPL_STDCALL call(double fraction, const char*, void* self) {
+        auto& p = *static_cast<GdalProgress*>(self);
+        try {
+            report_progress(p.fn, fraction, "write");
+            return TRUE;
+        } catch (...) {
+            p.stopped = std::current_exception();
+            return FALSE;
+        }
+    }
+    void rethrow_if_stopped() const {
+        if (stopped) std::rethrow_exception(stopped);
+    }
+};
 
 }  // namespace terrain::io

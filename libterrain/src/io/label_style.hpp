@@ -14,6 +14,7 @@
 
 #include "gdal_support.hpp"
 #include "terrain/core/dem.hpp"
+#include "terrain/core/progress.hpp"
 #include "terrain/segment/regions.hpp"
 
 namespace terrain::io {
@@ -35,10 +36,12 @@ std::unique_ptr<GDALDataset> labels_in_place(
 // predictor), overviews down to about 64 pixels (nearest: every overview pixel is one region's
 // id), the directories first and the smallest overview's tiles before the larger ones',
 // BigTIFF when needed. Returns the file opened (read-only: what is set on it goes to its
-// .aux.xml).
+// .aux.xml). GDAL's progress goes to `progress` ("write", 0 to 1); a callback that cancels
+// stops the copy and its error is thrown.
 std::unique_ptr<GDALDataset> write_cloud_optimized(const Dem& dem, GDALDataset& source,
                                                    const std::string& temp_path,
                                                    const std::string& path,
-                                                   const GdalErrorCapture& errors);
+                                                   const GdalErrorCapture& errors,
+                                                   const ProgressFn& progress = {});
 
 }  // namespace terrain::io

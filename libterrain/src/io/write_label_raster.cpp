@@ -165,7 +165,8 @@ std::unique_ptr<GDALDataset> labels_in_place(
 std::unique_ptr<GDALDataset> write_cloud_optimized(const Dem& dem, GDALDataset& source,
                                                    const std::string& temp_path,
                                                    const std::string& path,
-                                                   const GdalErrorCapture& errors) {
+                                                   const GdalErrorCapture& errors,
+                                                   const ProgressFn& progress) {
     const auto factors = overview_factors(dem);
     CPLStringList options;
     options.SetNameValue("COMPRESS", "DEFLATE");
@@ -179,15 +180,17 @@ std::unique_ptr<GDALDataset> write_cloud_optimized(const Dem& dem, GDALDataset& 
         options.SetNameValue("OVERVIEW_COUNT", std::to_string(factors.size()).c_str());
     GDALDriver* cog = GetGDALDriverManager()->GetDriverByName("COG");
     if (!cog) throw Error("write", "GDAL has no COG driver (GDAL 3.1 or later is needed)");
-    std::unique_ptr<GDALDataset> ds(
-        cog->CreateCopy(temp_path.c_str(), &source, FALSE, options.List(), nullptr, nullptr));
+    GdalProgress reported{progress};
+    std::unique_ptr<GDALDataset> ds(cog->CreateCopy(temp_path.c_str(), &source, FALSE,
+                                                    options.List(), GdalProgress::call, &reported));
+    reported.rethrow_if_stopped();
     if (!ds) throw Error("write", "cannot write '" + path + "'" + errors.suffix());
     return ds;
 }
 
 void write_label_raster(const Dem& dem, const std::vector<std::uint32_t>& pixels,
-                        const segment::RegionGraph& graph, const std::string& path,
-                        bool overwrite) {
+                        const segment::RegionGraph& graph, const std::string& path, bool overwrite,
+                        const ProgressFn& progress) {
     check_grid_size(dem, pixels.size());
     ensure_gdal_registered();
     const GdalErrorCapture errors;
@@ -220,7 +223,7 @@ void write_label_raster(const Dem& dem, const std::vector<std::uint32_t>& pixels
                 throw Error("write",
                             "cannot store the colour table of '" + path + "'" + errors.suffix());
         }
-        auto ds = write_cloud_optimized(dem, *source, output.temp_path(), path, errors);
+        auto ds = write_cloud_optimized(dem, *source, output.temp_path(), path, errors, progress);
         source.reset();
         mem.reset();
         // The attribute table goes to the .aux.xml (GeoTIFF has none), written on closing.

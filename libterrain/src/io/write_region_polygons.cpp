@@ -200,7 +200,8 @@ class PieceLayer final : public OGRLayer {
 // temporary file in `dir` (the system's temporary directory when empty).
 std::unique_ptr<PieceFile> polygonize(const Dem& dem, const std::vector<std::uint32_t>& pixels,
                                       std::size_t region_count, const std::filesystem::path& dir,
-                                      const GdalErrorCapture& errors) {
+                                      const GdalErrorCapture& errors,
+                                      const ProgressFn& progress = {}) {
     GDALDriver* mem = GetGDALDriverManager()->GetDriverByName("MEM");
     if (!mem) throw Error("write", "GDAL's in-memory raster driver is missing");
     // A band over the labels themselves, not a copy (4 bytes a pixel less).
@@ -218,8 +219,11 @@ std::unique_ptr<PieceFile> polygonize(const Dem& dem, const std::vector<std::uin
     GDALRasterBand* band = raster->GetRasterBand(1);
     auto file = std::make_unique<PieceFile>(dir);
     PieceLayer layer(*file, region_count);
-    if (GDALPolygonize(band, band, OGRLayer::ToHandle(&layer), 0, nullptr, nullptr, nullptr) !=
-        CE_None)
+    GdalProgress reported{progress};
+    const CPLErr done = GDALPolygonize(band, band, OGRLayer::ToHandle(&layer), 0, nullptr,
+                                       GdalProgress::call, &reported);
+    reported.rethrow_if_stopped();
+    if (done != CE_None)
         throw Error("write", layer.failure().empty() ? "GDALPolygonize failed" + errors.suffix()
                                                      : layer.failure());
     file->finish(region_count);
@@ -593,10 +597,12 @@ GDALDriver* polygon_driver(const std::string& path, bool overwrite,
     return driver;
 }
 
-// Writes the polygons of `made` (in the DEM's map coordinates), region by region.
+// Writes the polygons of `made` (in the DEM's map coordinates), region by region, reporting
+// each region made (0 to 1 of `progress`).
 void write_polygons(const Dem& dem, const RegionSource& made, const segment::RegionGraph& graph,
                     const std::string& path, bool overwrite, const RegionPolygonOptions& options,
-                    GDALDriver* driver, const GdalErrorCapture& errors) {
+                    GDALDriver* driver, const GdalErrorCapture& errors,
+                    const ProgressFn& progress = {}) {
     const bool geojson = driver == nullptr;
     std::optional<LonLatFrame> frame;
     if (!dem.crs_wkt.empty() && (geojson || options.lonlat)) frame.emplace(dem, "write");
@@ -608,6 +614,8 @@ void write_polygons(const Dem& dem, const RegionSource& made, const segment::Reg
         global.emplace(dem, frame ? *frame : *global_frame);
     }
     const RegionSource polygons = [&](std::size_t i) {
+        report_progress(
+            progress, double(i) / double(std::max<std::size_t>(1, graph.regions.size())), "write");
         Geometry g = made(i);
         if (g) prepare_rings(*g, frame ? &*frame : nullptr, global ? &*global : nullptr);
         return g;
@@ -691,17 +699,20 @@ RegionPolygons polygonize_regions(const Dem& dem, const std::vector<std::uint32_
 
 void write_region_polygons(const Dem& dem, const std::vector<std::uint32_t>& pixels,
                            const segment::RegionGraph& graph, const std::string& path,
-                           bool overwrite, const RegionPolygonOptions& options) {
+                           bool overwrite, const RegionPolygonOptions& options,
+                           const ProgressFn& progress) {
     check_grid_size(dem, pixels.size());
     check_polygon_format(dem, options.driver);
     GDALDriver* driver = polygon_driver(path, overwrite, options);
     const GdalErrorCapture errors;
     // The temporary pieces beside the output: on the same disk, as large as it will be.
-    const auto pieces = polygonize(dem, pixels, graph.regions.size(),
-                                   std::filesystem::absolute(path).parent_path(), errors);
+    // GDALPolygonize 0 to 0.8 of the progress, the regions written to 1.
+    const auto pieces =
+        polygonize(dem, pixels, graph.regions.size(), std::filesystem::absolute(path).parent_path(),
+                   errors, scaled_progress(progress, 0, 0.8));
     write_polygons(
         dem, [&](std::size_t i) { return pieces->region(i); }, graph, path, overwrite, options,
-        driver, errors);
+        driver, errors, scaled_progress(progress, 0.8, 1));
 }
 
 void write_region_polygons(const Dem& dem, const RegionPolygons& polygons,

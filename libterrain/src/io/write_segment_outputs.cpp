@@ -62,21 +62,47 @@ std::vector<std::string> write_segment_outputs(const std::string& dir, const Tri
     const bool overwrite = options.overwrite;
     const double steps = static_cast<double>(paths.size());
     std::size_t done = 0;
+    double reported = 0;
     std::mutex progress_mutex;  // the raster writers report from their own threads
-    auto step = [&] {
+    // (Each file a step; the label raster and the polygons also within theirs. They run side
+    // by side, so the fraction reported is the highest yet: it never goes back.)
+    auto report = [&](double fraction) {
         const std::lock_guard<std::mutex> lock(progress_mutex);
-        report_progress(progress, double(++done) / steps, "write");
+        reported = std::max(reported, fraction);
+        report_progress(progress, reported, "write");
+    };
+    auto step = [&] {
+        std::size_t now;
+        {
+            const std::lock_guard<std::mutex> lock(progress_mutex);
+            now = ++done;
+        }
+        report(double(now) / steps);
+    };
+    auto within = [&](double fraction) {
+        std::size_t now;
+        {
+            const std::lock_guard<std::mutex> lock(progress_mutex);
+            now = done;
+        }
+        report((double(now) + fraction) / steps);
+    };
+    const ProgressFn partly = [&](double fraction, std::string_view) {
+        within(fraction);
+        return true;
     };
     if (dem) {
         // The three raster-based files are independent: written side by side.
         const auto pixels = segment::label_pixels(mesh, *dem, labels);
         tbb::parallel_invoke(
             [&] {
-                write_label_raster(*dem, pixels, graph, paths[0], overwrite);
+                write_label_raster(*dem, pixels, graph, paths[0], overwrite,
+                                   progress ? partly : ProgressFn{});
                 step();
             },
             [&] {
-                write_region_polygons(*dem, pixels, graph, paths[1], overwrite, options.polygons);
+                write_region_polygons(*dem, pixels, graph, paths[1], overwrite, options.polygons,
+                                      progress ? partly : ProgressFn{});
                 step();
             },
             [&] {

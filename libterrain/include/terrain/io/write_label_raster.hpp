@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "terrain/core/dem.hpp"
+#include "terrain/core/progress.hpp"
 #include "terrain/segment/regions.hpp"
 
 namespace terrain::io {
@@ -20,8 +21,11 @@ namespace terrain::io {
 // raster attribute table (one row per region: its properties and its colour as
 // Red/Green/Blue/Alpha columns) that GDAL keeps in `path`.aux.xml beside it (GeoTIFF has no
 // attribute tables); and a QGIS style, label_style_path(path), with the region colours.
+// `progress`: GDAL's writing of the tiles and overviews ("write", 0 to 1); a callback that
+// cancels stops it with terrain::Error and leaves no file.
 void write_label_raster(const Dem& dem, const std::vector<std::uint32_t>& pixels,
-                        const segment::RegionGraph& graph, const std::string& path, bool overwrite);
+                        const segment::RegionGraph& graph, const std::string& path, bool overwrite,
+                        const ProgressFn& progress = {});
 // The QGIS style beside a label raster: `path` with the extension .qml (labels.qml).
 std::string label_style_path(const std::string& path);
 

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "terrain/core/dem.hpp"
+#include "terrain/core/progress.hpp"
 #include "terrain/segment/regions.hpp"
 
 namespace terrain::io {
@@ -38,9 +39,12 @@ void check_polygon_format(const Dem& dem, const std::string& driver);
 // `path`, and each region's outline is read back, written and freed in turn. `pixels`:
 // segment::label_pixels() of the DEM (row-major, 0 = no region). A DEM without CRS gives its
 // map (geotransform) coordinates.
+// `progress` ("write", 0 to 1): GDALPolygonize's, then each region written; a callback that
+// cancels stops it with terrain::Error and leaves no file.
 void write_region_polygons(const Dem& dem, const std::vector<std::uint32_t>& pixels,
                            const segment::RegionGraph& graph, const std::string& path,
-                           bool overwrite, const RegionPolygonOptions& options = {});
+                           bool overwrite, const RegionPolygonOptions& options = {},
+                           const ProgressFn& progress = {});
 
 // The region polygons of one labelling (GDALPolygonize, in the DEM's map coordinates), made
 // once to be written to several files: terrain sweep writes each scale to a GeoPackage layer
