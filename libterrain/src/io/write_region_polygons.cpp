@@ -6,7 +6,6 @@
 #include <unistd.h>
 
 #include <cerrno>
-#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <functional>
@@ -21,6 +20,7 @@
 #include "gdal_support.hpp"
 #include "geojson_file.hpp"
 #include "global_outline.hpp"
+#include "label_style.hpp"
 #include "lonlat_frame.hpp"
 #include "region_attributes.hpp"
 #include "terrain/core/error.hpp"
@@ -202,20 +202,8 @@ std::unique_ptr<PieceFile> polygonize(const Dem& dem, const std::vector<std::uin
                                       std::size_t region_count, const std::filesystem::path& dir,
                                       const GdalErrorCapture& errors,
                                       const ProgressFn& progress = {}) {
-    GDALDriver* mem = GetGDALDriverManager()->GetDriverByName("MEM");
-    if (!mem) throw Error("write", "GDAL's in-memory raster driver is missing");
     // A band over the labels themselves, not a copy (4 bytes a pixel less).
-    std::unique_ptr<GDALDataset> raster(
-        mem->Create("", dem.width, dem.height, 0, GDT_UInt32, nullptr));
-    char pointer[64];
-    std::snprintf(pointer, sizeof pointer, "%p",
-                  static_cast<void*>(const_cast<std::uint32_t*>(pixels.data())));
-    CPLStringList band_options;
-    band_options.SetNameValue("DATAPOINTER", pointer);
-    if (!raster || raster->AddBand(GDT_UInt32, band_options.List()) != CE_None)
-        throw Error("write", "cannot make the label raster to polygonize" + errors.suffix());
-    GeoTransform t = dem.transform;
-    raster->SetGeoTransform(t.data());
+    const auto raster = labels_in_place(dem, {&pixels}, dir.string(), errors);
     GDALRasterBand* band = raster->GetRasterBand(1);
     auto file = std::make_unique<PieceFile>(dir);
     PieceLayer layer(*file, region_count);

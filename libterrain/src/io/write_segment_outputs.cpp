@@ -71,22 +71,16 @@ std::vector<std::string> write_segment_outputs(const std::string& dir, const Tri
         reported = std::max(reported, fraction);
         report_progress(progress, reported, "write");
     };
-    auto step = [&] {
+    // `fraction` of the way through the next file (after `files` more are done).
+    auto within = [&](double fraction, std::size_t files = 0) {
         std::size_t now;
         {
             const std::lock_guard<std::mutex> lock(progress_mutex);
-            now = ++done;
-        }
-        report(double(now) / steps);
-    };
-    auto within = [&](double fraction) {
-        std::size_t now;
-        {
-            const std::lock_guard<std::mutex> lock(progress_mutex);
-            now = done;
+            now = done += files;
         }
         report((double(now) + fraction) / steps);
     };
+    auto step = [&] { within(0, 1); };
     const ProgressFn partly = [&](double fraction, std::string_view) {
         within(fraction);
         return true;

@@ -78,20 +78,10 @@ class Grower {
         for (std::size_t r = 0; r < seeds.size(); ++r) out.seeds.push_back(seeds[r].second);
         // Progress by vertices: after the simplification a few nodes (the seeds first) hold
         // most of them.
-        const double nv = static_cast<double>(std::max<std::size_t>(1, g_.vertex_nodes.size()));
-        std::size_t vertices_assigned = 0;
         progress_ = &progress;
-        done_ = &vertices_assigned;
-        const auto count = [&](i32 n) {
-            const std::size_t before = vertices_assigned;
-            vertices_assigned +=
-                idx(g_.node_vertex_offsets[idx(n) + 1] - g_.node_vertex_offsets[idx(n)]);
-            if ((before >> 18) != (vertices_assigned >> 18))
-                report(static_cast<double>(vertices_assigned) / nv);
-        };
         for (std::size_t r = 0; r < seeds.size(); ++r) {
             assign(seeds[r].second, static_cast<i32>(r));
-            count(seeds[r].second);
+            counted(seeds[r].second);
         }
         const std::size_t total = g_.node_count();
         std::size_t assigned = seeds.size();
@@ -111,7 +101,7 @@ class Grower {
                 assign(c.node, c.region);
                 if (relaxed) ++out.relaxed_nodes;
                 ++assigned;
-                count(c.node);
+                counted(c.node);
             }
             if (assigned == total || relaxed || seeds.empty()) break;
             // Nodes the graph constraint left out: let them join under the standard cost.
@@ -238,17 +228,23 @@ class Grower {
     // looked at (every 2^18 a report: a node the simplification gave a large part of the
     // surface takes seconds), and the fraction reported last.
     const ProgressFn* progress_ = nullptr;
-    const std::size_t* done_ = nullptr;
-    std::size_t visited_ = 0;
+    std::size_t done_ = 0, visited_ = 0;
     double reported_ = 0;
-    void report(double fraction) {
-        reported_ = std::max(reported_, fraction);
+    void report(std::size_t vertices) {
+        if (!progress_) return;
+        const double nv = static_cast<double>(std::max<std::size_t>(1, g_.vertex_nodes.size()));
+        reported_ = std::max(reported_, static_cast<double>(vertices) / nv);
         report_progress(*progress_, reported_, "grow");
+    }
+    // Node n assigned: its vertices are done (a report each 2^18 of them).
+    void counted(i32 n) {
+        const std::size_t before = done_;
+        done_ += idx(g_.node_vertex_offsets[idx(n) + 1] - g_.node_vertex_offsets[idx(n)]);
+        if ((before >> 18) != (done_ >> 18)) report(done_);
     }
     // One more vertex looked at, `partial` vertices into the node being assigned.
     void tick(std::size_t partial) {
-        if ((++visited_ & 0x3ffff) != 0 || !progress_) return;
-        report(double(*done_ + partial) / double(std::max<std::size_t>(1, g_.vertex_nodes.size())));
+        if ((++visited_ & 0x3ffff) == 0) report(done_ + partial);
     }
 };
 
