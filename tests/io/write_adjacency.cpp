@@ -87,9 +87,8 @@ TEST_CASE("adjacency.json agrees with the label raster and the mesh", "[write_ad
     // touch only diagonally, through a triangle's diagonal).
     std::set<Pair> mesh_pairs;
     for (std::size_t v = 0; v < t.mesh.vertex_count(); ++v)
-        for (auto k = t.mesh.neighbor_offsets[v]; k < t.mesh.neighbor_offsets[v + 1]; ++k) {
-            const std::int64_t a = t.labels[v],
-                               b = t.labels[std::size_t(t.mesh.neighbors[std::size_t(k)])];
+        for (const auto nb : t.mesh.neighbors_of(v)) {
+            const std::int64_t a = t.labels[v], b = t.labels[std::size_t(nb)];
             if (a != b) mesh_pairs.insert({std::min(a, b), std::max(a, b)});
         }
     for (const auto& p : graph_edges) CHECK(mesh_pairs.count(p) == 1);

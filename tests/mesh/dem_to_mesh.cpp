@@ -247,6 +247,73 @@ TEST_CASE("dem_to_mesh: a lon/lat grid has the same shape in the body and map fr
     CHECK(total_area(a) == Approx(total_area(b)).epsilon(1e-5));
 }
 
+namespace {
+
+// The grid's adjacency against the CSR finish_mesh makes from the same triangles: the same
+// sorted lists, the same edge count. Returns the number of irregular vertices.
+std::size_t check_grid_adjacency(const TriangleMesh& mesh) {
+    REQUIRE(mesh.grid_adjacency());
+    TriangleMesh csr = mesh;
+    finish_mesh(csr);
+    REQUIRE_FALSE(csr.grid_adjacency());
+    std::size_t differ = 0, degrees = 0;
+    for (std::size_t v = 0; v < mesh.vertex_count(); ++v) {
+        const auto a = mesh.neighbors_of(v), b = csr.neighbors_of(v);
+        degrees += a.size();
+        differ += !std::equal(a.begin(), a.end(), b.begin(), b.end());
+    }
+    CHECK(differ == 0);
+    CHECK(degrees == 2 * mesh.edge_count());
+    CHECK(mesh.edge_count() == csr.edge_count());
+    CHECK(mesh.vertex_areas == csr.vertex_areas);
+    return mesh.irregular_vertices.size();
+}
+
+}  // namespace
+
+TEST_CASE("dem_to_mesh: the adjacency on the grid is the triangles' adjacency", "[mesh]") {
+    SECTION("a full tile: no vertex needs its own list") {
+        const Dem dem =
+            grid_dem(40, 30, 10.0, [](int c, int r) { return 5.0 * std::sin(0.3 * c + 0.2 * r); });
+        CHECK(check_grid_adjacency(mesh::dem_to_mesh(dem)) == 0);
+    }
+    SECTION("NoData speckle: holes, pinches and isolated pixels") {
+        std::uint32_t state = 12345;
+        const Dem dem = grid_dem(60, 50, 10.0, [&](int c, int r) {
+            state = state * 1664525u + 1013904223u;
+            return (state >> 24) < 70 ? kNaN : double((c * 7 + r * 13) % 17);
+        });
+        const auto mesh = mesh::dem_to_mesh(dem);
+        REQUIRE(mesh.pinched_vertices > 0);
+        REQUIRE(mesh.isolated_vertices > 0);
+        const auto irregular = check_grid_adjacency(mesh);
+        CHECK(irregular > 0);
+        CHECK(irregular < mesh.vertex_count() / 2);
+    }
+    SECTION("a global grid: the seam and the poles") {
+        const Dem dem = io::read_dem(test::sample("moon_ldem1_global.tif"));
+        const auto mesh = mesh::dem_to_mesh(dem);
+        REQUIRE(mesh.seam_closed);
+        const auto irregular = check_grid_adjacency(mesh);
+        // The two seam columns, the poles and the rows next to them at most.
+        CHECK(irregular >= 2);
+        CHECK(irregular <= 2 * 180 + 2 + 2 * 360);
+    }
+    SECTION("a global grid with NoData across the seam") {
+        Dem dem = io::read_dem(test::sample("moon_ldem1_global.tif"));
+        for (int r = 40; r < 60; ++r)
+            for (int c : {0, 1, 358, 359}) dem.values[dem.index(c, r)] = kNaN;
+        dem.values[dem.index(0, 100)] = kNaN;
+        check_grid_adjacency(mesh::dem_to_mesh(dem));
+    }
+    SECTION("a grid two pixels wide keeps the CSR") {
+        const Dem dem = grid_dem(2, 5, 1.0, [](int c, int r) { return double(c + r); });
+        const auto mesh = mesh::dem_to_mesh(dem);
+        CHECK_FALSE(mesh.grid_adjacency());
+        CHECK(mesh.neighbor_offsets.size() == mesh.vertex_count() + 1);
+    }
+}
+
 TEST_CASE("dem_to_mesh: the same mesh whatever the thread count", "[mesh]") {
     const Dem dem = io::read_dem(test::sample("moon_ldem4_copernicus.tif"));
     TriangleMesh one, two;
@@ -261,7 +328,9 @@ TEST_CASE("dem_to_mesh: the same mesh whatever the thread count", "[mesh]") {
     CHECK(one.positions == two.positions);
     CHECK(one.triangles == two.triangles);
     CHECK(one.vertex_areas == two.vertex_areas);
-    CHECK(one.neighbors == two.neighbors);
+    CHECK(one.neighbor_directions == two.neighbor_directions);
+    CHECK(one.irregular_vertices == two.irregular_vertices);
+    CHECK(one.irregular_neighbors == two.irregular_neighbors);
 }
 
 TEST_CASE("dem_to_mesh: frames and refusals", "[mesh]") {

@@ -49,8 +49,8 @@ void check_graph(const test::SegmentedTile& t) {
     // Edges: sorted, a < b, exactly the label pairs joined by a mesh edge, with their counts.
     std::map<std::pair<std::uint32_t, std::uint32_t>, std::size_t> cut;
     for (std::size_t v = 0; v < t.mesh.vertex_count(); ++v)
-        for (auto k = t.mesh.neighbor_offsets[v]; k < t.mesh.neighbor_offsets[v + 1]; ++k) {
-            const auto w = std::size_t(t.mesh.neighbors[std::size_t(k)]);
+        for (const auto nb : t.mesh.neighbors_of(v)) {
+            const auto w = std::size_t(nb);
             const auto a = t.labels[v], b = t.labels[w];
             if (w > v && a != b) ++cut[{std::min(a, b), std::max(a, b)}];
         }

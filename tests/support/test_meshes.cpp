@@ -139,9 +139,8 @@ std::vector<int> region_pieces(const TriangleMesh& mesh, const std::vector<std::
         while (!q.empty()) {
             const auto v = q.front();
             q.pop();
-            for (auto i = mesh.neighbor_offsets[v]; i < mesh.neighbor_offsets[v + 1]; ++i) {
-                const auto w =
-                    static_cast<std::size_t>(mesh.neighbors[static_cast<std::size_t>(i)]);
+            for (const auto nb : mesh.neighbors_of(v)) {
+                const auto w = static_cast<std::size_t>(nb);
                 if (!seen[w] && labels[w] == labels[v]) {
                     seen[w] = 1;
                     q.push(w);

@@ -691,8 +691,8 @@ std::vector<float> shape_index_field(const TriangleMesh& mesh, const ShapeIndexO
             if (field[v] != kUnknown) continue;
             double sum = 0;
             int count = 0;
-            for (auto k = mesh.neighbor_offsets[v]; k < mesh.neighbor_offsets[v + 1]; ++k)
-                if (field[mesh.neighbors[k]] != kUnknown) sum += field[mesh.neighbors[k]], ++count;
+            for (const auto w : mesh.neighbors_of(v))
+                if (field[w] != kUnknown) sum += field[w], ++count;
             if (count > 0) updates.emplace_back(std::int32_t(v), float(sum / count));
         }
         for (const auto& [v, value] : updates) field[v] = value;

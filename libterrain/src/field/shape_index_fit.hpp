@@ -56,8 +56,7 @@ void gather_where(const TriangleMesh& mesh, std::int32_t v, int rings, const Ins
         if (begin == end) break;
         for (std::size_t i = begin; i < end; ++i) {
             const auto u = s.gathered[i];
-            for (auto k = mesh.neighbor_offsets[u]; k < mesh.neighbor_offsets[u + 1]; ++k) {
-                const auto w = mesh.neighbors[k];
+            for (const auto w : mesh.neighbors_of(std::size_t(u))) {
                 if (s.stamp[w] == s.current) continue;
                 s.stamp[w] = s.current;
                 if (inside(w)) s.gathered.push_back(w);

@@ -266,7 +266,7 @@ TriangleMesh dem_to_mesh(const Dem& dem, const DemToMeshOptions& options,
     }
 
     // Slices of the progress by the passes' measured cost on global grids.
-    const auto vertex_of = number_vertices(dem, pole, mesh, scaled_progress(progress, 0, 0.05));
+    auto vertex_of = number_vertices(dem, pole, mesh, scaled_progress(progress, 0, 0.05));
     place_vertices(dem, geo, vertex_of, mesh, scaled_progress(progress, 0.05, 0.3));
     triangulate_blocks(dem, vertex_of, mesh, scaled_progress(progress, 0.3, 0.5));
 
@@ -277,14 +277,18 @@ TriangleMesh dem_to_mesh(const Dem& dem, const DemToMeshOptions& options,
         split_pinched_vertices(mesh, nullptr, scaled_progress(progress, 0.6, 0.7));
     mesh.positions.shrink_to_fit();
     mesh.vertex_pixel.shrink_to_fit();
+    // The pixels' vertices after those changes, in the same memory.
+    fill_pixel_to_vertex(mesh, dem, vertex_of);
+    mesh.pixel_vertex = std::move(vertex_of);
     report_progress(progress, 0.7, "mesh");
-    finish_mesh(mesh, scaled_progress(progress, 0.7, 1));
+    finish_grid_mesh(mesh, scaled_progress(progress, 0.7, 1));
     report_progress(progress, 1.0, "mesh");
     return mesh;
 }
 
-std::vector<std::int32_t> pixel_to_vertex(const TriangleMesh& mesh, const Dem& dem) {
-    std::vector<std::int32_t> out(std::size_t(mesh.grid_width) * mesh.grid_height, -1);
+void fill_pixel_to_vertex(const TriangleMesh& mesh, const Dem& dem,
+                          std::vector<std::int32_t>& out) {
+    out.assign(std::size_t(mesh.grid_width) * mesh.grid_height, -1);
     // Backwards, so that the first copy of a split pinch wins.
     for (std::size_t v = mesh.vertex_pixel.size(); v-- > 0;)
         out[mesh.vertex_pixel[v]] = std::int32_t(v);
@@ -294,6 +298,12 @@ std::vector<std::int32_t> pixel_to_vertex(const TriangleMesh& mesh, const Dem& d
         for (int col = 0; col < mesh.grid_width; ++col)
             if (dem.valid(col, row)) out[dem.index(col, row)] = mesh.pole_vertices[which];
     }
+}
+
+std::vector<std::int32_t> pixel_to_vertex(const TriangleMesh& mesh, const Dem& dem) {
+    if (!mesh.pixel_vertex.empty()) return mesh.pixel_vertex;
+    std::vector<std::int32_t> out;
+    fill_pixel_to_vertex(mesh, dem, out);
     return out;
 }
 

@@ -4,7 +4,11 @@
 #include "../core/release.hpp"
 #include "terrain/core/error.hpp"
 
+#include <tbb/blocked_range.h>
+
 #include <algorithm>
+#include <atomic>
+#include <functional>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -30,7 +34,31 @@ std::size_t TriangleMesh::memory_bytes() const {
            triangles.capacity() * sizeof(triangles[0]) + vertex_areas.capacity() * sizeof(float) +
            neighbor_offsets.capacity() * sizeof(std::int32_t) +
            neighbors.capacity() * sizeof(std::int32_t) +
-           vertex_pixel.capacity() * sizeof(std::int32_t);
+           vertex_pixel.capacity() * sizeof(std::int32_t) +
+           pixel_vertex.capacity() * sizeof(std::int32_t) + neighbor_directions.capacity() +
+           irregular_vertices.capacity() * sizeof(std::int32_t) +
+           irregular_offsets.capacity() * sizeof(std::uint32_t) +
+           irregular_neighbors.capacity() * sizeof(std::int32_t);
+}
+
+void TriangleMesh::release_adjacency() {
+    detail::release(neighbor_offsets);
+    detail::release(neighbors);
+    detail::release(neighbor_directions);
+    detail::release(irregular_vertices);
+    detail::release(irregular_offsets);
+    detail::release(irregular_neighbors);
+    grid_edges = 0;
+}
+
+VertexNeighbors TriangleMesh::irregular_neighbors_of(std::size_t v) const {
+    const auto it = std::lower_bound(irregular_vertices.begin(), irregular_vertices.end(),
+                                     static_cast<std::int32_t>(v));
+    const auto i = static_cast<std::size_t>(it - irregular_vertices.begin());
+    VertexNeighbors out;
+    out.list_ = irregular_neighbors.data() + irregular_offsets[i];
+    out.size_ = irregular_offsets[i + 1] - irregular_offsets[i];
+    return out;
 }
 
 namespace {
@@ -81,15 +109,12 @@ void check_adjacency_size(std::uint64_t entries, const char* what) {
 
 }  // namespace
 
-void finish_mesh(TriangleMesh& mesh, const ProgressFn& progress) {
-    const std::size_t n = mesh.positions.size();
-    // Vertex areas: one third of each incident triangle (serial: the same sums every run).
-    // Its passes: areas (0 to 0.25), the corners' lists (counted, made, filled: to 0.6),
-    // sorted (to 0.9), copied at their size (to 1).
-    const detail::PassProgress areas(progress, 0, 0.25, "mesh"),
-        counts(progress, 0.25, 0.35, "mesh"), lists(progress, 0.45, 0.6, "mesh");
+namespace {
+
+// Vertex areas: one third of each incident triangle (serial: the same sums every run).
+void set_vertex_areas(TriangleMesh& mesh, const detail::PassProgress& areas) {
     const std::size_t nt = mesh.triangles.size();
-    std::vector<double> area(n, 0.0);
+    std::vector<double> area(mesh.positions.size(), 0.0);
     for (std::size_t i = 0; i < nt; ++i) {
         areas.at(i, nt);
         const auto& t = mesh.triangles[i];
@@ -97,7 +122,19 @@ void finish_mesh(TriangleMesh& mesh, const ProgressFn& progress) {
         for (int k = 0; k < 3; ++k) area[t[k]] += third;
     }
     mesh.vertex_areas.assign(area.begin(), area.end());
-    detail::release(area);
+}
+
+}  // namespace
+
+void finish_mesh(TriangleMesh& mesh, const ProgressFn& progress) {
+    const std::size_t n = mesh.positions.size();
+    // Its passes: areas (0 to 0.25), the corners' lists (counted, made, filled: to 0.6),
+    // sorted (to 0.9), copied at their size (to 1).
+    const detail::PassProgress counts(progress, 0.25, 0.35, "mesh"),
+        lists(progress, 0.45, 0.6, "mesh");
+    const std::size_t nt = mesh.triangles.size();
+    mesh.release_adjacency();
+    set_vertex_areas(mesh, detail::PassProgress(progress, 0, 0.25, "mesh"));
     report_progress(progress, 0.25, "mesh");
 
     // CSR adjacency from the triangles' edges, each list sorted and without repeats. Before
@@ -142,8 +179,126 @@ void finish_mesh(TriangleMesh& mesh, const ProgressFn& progress) {
                            detail::PassProgress(progress, 0.9, 1, "mesh"));
 }
 
+void finish_grid_mesh(TriangleMesh& mesh, const ProgressFn& progress) {
+    const std::int64_t W = mesh.grid_width;
+    const std::size_t n = mesh.positions.size(), nt = mesh.triangles.size();
+    if (W < 3 || mesh.vertex_pixel.size() != n ||
+        mesh.pixel_vertex.size() != std::size_t(mesh.grid_width) * std::size_t(mesh.grid_height)) {
+        finish_mesh(mesh, progress);
+        return;
+    }
+    // Its passes: areas (0 to 0.3), the directions (made, set: to 0.6), checked (to 0.8), the
+    // irregular vertices' lists (0.9 to 1).
+    const detail::PassProgress directions(progress, 0.35, 0.6, "mesh"),
+        listed(progress, 0.9, 1, "mesh");
+    mesh.release_adjacency();
+    set_vertex_areas(mesh, detail::PassProgress(progress, 0, 0.3, "mesh"));
+    mesh.direction_offsets = {-W - 1, -W, -W + 1, -1, 1, W - 1, W, W + 1};
+    // The direction of the pixel dp away (-1: not one of the 8 around, or across the seam,
+    // which comes out of order and is left to the explicit lists).
+    const auto direction = [W](std::int64_t dp) -> int {
+        if (dp >= -W - 1 && dp <= -W + 1) return static_cast<int>(dp + W + 1);
+        if (dp == -1 || dp == 1) return dp < 0 ? 3 : 4;
+        if (dp >= W - 1 && dp <= W + 1) return static_cast<int>(dp - W + 6);
+        return -1;
+    };
+    // Every edge a -> b of a triangle sets a's bit towards b's pixel, or marks a irregular
+    // when b is not the vertex of a pixel around a's (a pole, a pinch's copy).
+    std::vector<std::uint8_t> bits, irregular;
+    detail::assign_in_slices(bits, n, std::uint8_t{0},
+                             detail::PassProgress(progress, 0.3, 0.35, "mesh"));
+    irregular.assign(n, 0);
+    for (const auto pole : mesh.pole_vertices)
+        if (pole >= 0) irregular[std::size_t(pole)] = 1;
+    for (std::size_t i = 0; i < nt; ++i) {
+        directions.at(i, nt);
+        const auto& t = mesh.triangles[i];
+        for (int k = 0; k < 3; ++k) {
+            const auto a = static_cast<std::size_t>(t[k]);
+            const std::int64_t pa = mesh.vertex_pixel[a];
+            for (int j = 1; j < 3; ++j) {
+                const std::int32_t b = t[(k + j) % 3];
+                const std::int64_t pb = mesh.vertex_pixel[std::size_t(b)];
+                const int d = direction(pb - pa);
+                if (d < 0 || mesh.pixel_vertex[std::size_t(pb)] != b)
+                    irregular[a] = 1;
+                else
+                    bits[a] = static_cast<std::uint8_t>(bits[a] | (1u << d));
+            }
+        }
+    }
+    // A vertex is regular when its neighbours, read off the grid in the directions' order,
+    // come in increasing order (not so across the seam, or next to a pinch's copy).
+    mesh.neighbor_directions = std::move(bits);
+    std::atomic<std::uint64_t> regular_degrees{0};
+    detail::parallel_slices(n, std::size_t{4096}, progress, 0.6, 0.8, "mesh",
+                            [&](const tbb::blocked_range<std::size_t>& r) {
+                                std::uint64_t sum = 0;
+                                for (std::size_t v = r.begin(); v < r.end(); ++v) {
+                                    if (irregular[v]) continue;
+                                    const auto nb = mesh.neighbors_of(v);
+                                    if (std::adjacent_find(nb.begin(), nb.end(),
+                                                           std::greater_equal<>()) != nb.end())
+                                        irregular[v] = 1;
+                                    else
+                                        sum += nb.size();
+                                }
+                                regular_degrees += sum;
+                            });
+    // The irregular vertices' lists, from their triangles.
+    for (std::size_t v = 0; v < n; ++v)
+        if (irregular[v]) {
+            mesh.neighbor_directions[v] = 0;
+            mesh.irregular_vertices.push_back(static_cast<std::int32_t>(v));
+        }
+    const auto rank = [&](std::int32_t v) {
+        return static_cast<std::size_t>(std::lower_bound(mesh.irregular_vertices.begin(),
+                                                         mesh.irregular_vertices.end(), v) -
+                                        mesh.irregular_vertices.begin());
+    };
+    const std::size_t ni = mesh.irregular_vertices.size();
+    std::vector<std::uint32_t> offsets(ni + 1, 0);
+    std::vector<std::int32_t> lists;
+    for (int pass = 0; pass < 2; ++pass) {
+        std::vector<std::uint32_t> fill(offsets.begin(), offsets.end() - 1);
+        for (std::size_t i = 0; i < nt; ++i) {
+            listed.at(std::size_t(pass) * nt + i, 2 * nt);
+            const auto& t = mesh.triangles[i];
+            for (int k = 0; k < 3; ++k) {
+                if (!irregular[std::size_t(t[k])]) continue;
+                const std::size_t at = rank(t[k]);
+                if (pass == 0) {
+                    offsets[at + 1] += 2;
+                } else {
+                    lists[fill[at]++] = t[(k + 1) % 3];
+                    lists[fill[at]++] = t[(k + 2) % 3];
+                }
+            }
+        }
+        if (pass == 0) {
+            std::partial_sum(offsets.begin(), offsets.end(), offsets.begin());
+            check_adjacency_size(offsets.back(), "corners at irregular vertices");
+            lists.assign(offsets.back(), 0);
+        }
+    }
+    detail::release(irregular);
+    mesh.irregular_offsets.assign(ni + 1, 0);
+    std::size_t write = 0;
+    for (std::size_t i = 0; i < ni; ++i) {
+        auto begin = lists.begin() + offsets[i], end = lists.begin() + offsets[i + 1];
+        std::sort(begin, end);
+        end = std::unique(begin, end);
+        for (auto it = begin; it != end; ++it) lists[write++] = *it;
+        mesh.irregular_offsets[i + 1] = static_cast<std::uint32_t>(write);
+    }
+    lists.resize(write);
+    mesh.irregular_neighbors = std::move(lists);
+    mesh.irregular_neighbors.shrink_to_fit();
+    mesh.grid_edges = static_cast<std::size_t>((regular_degrees.load() + write) / 2);
+}
+
 MeshTopology mesh_topology(const TriangleMesh& mesh) {
-    if (mesh.neighbor_offsets.size() != mesh.vertex_count() + 1) {
+    if (!mesh.grid_adjacency() && mesh.neighbor_offsets.size() != mesh.vertex_count() + 1) {
         TriangleMesh finished = mesh;  // no adjacency yet
         finish_mesh(finished);
         return mesh_topology(finished);
@@ -151,32 +306,36 @@ MeshTopology mesh_topology(const TriangleMesh& mesh) {
     MeshTopology topo;
     topo.vertices = mesh.vertex_count();
     topo.faces = mesh.triangle_count();
-    const auto& off = mesh.neighbor_offsets;
-    const auto& nb = mesh.neighbors;
-    // Each edge (a < b) is a slot of a's sorted neighbour list: count its triangles there.
-    std::vector<std::uint8_t> uses(nb.size(), 0);
+    // Each directed edge a -> b is a slot: a's first slot plus b's rank among a's neighbours.
+    std::vector<std::uint64_t> first(topo.vertices + 1, 0);
+    for (std::size_t v = 0; v < topo.vertices; ++v) first[v + 1] = first[v] + mesh.degree(v);
+    const auto slot = [&](std::int32_t a, std::int32_t b) {
+        const auto nb = mesh.neighbors_of(std::size_t(a));
+        return first[std::size_t(a)] +
+               static_cast<std::uint64_t>(std::lower_bound(nb.begin(), nb.end(), b) - nb.begin());
+    };
+    // Each edge (a < b) counts its triangles at the slot a -> b.
+    std::vector<std::uint8_t> uses(first.back(), 0);
     for (const auto& t : mesh.triangles)
         for (int k = 0; k < 3; ++k) {
-            const std::int32_t a = std::min(t[k], t[(k + 1) % 3]),
-                               b = std::max(t[k], t[(k + 1) % 3]);
-            const auto first = nb.begin() + off[a], last = nb.begin() + off[a + 1];
-            const auto slot =
-                static_cast<std::size_t>(std::lower_bound(first, last, b) - nb.begin());
-            uses[slot] = static_cast<std::uint8_t>(std::min(uses[slot] + 1, 3));
+            const auto s = slot(std::min(t[k], t[(k + 1) % 3]), std::max(t[k], t[(k + 1) % 3]));
+            uses[s] = static_cast<std::uint8_t>(std::min(uses[s] + 1, 3));
         }
     detail::DisjointSets<std::uint32_t> sets(topo.vertices);
     // Boundary loops: components of the graph of boundary edges.
     std::vector<std::uint32_t> boundary_vertices;
-    for (std::size_t v = 0; v < topo.vertices; ++v)
-        for (auto i = off[v]; i < off[v + 1]; ++i) {
-            const auto w = static_cast<std::size_t>(nb[static_cast<std::size_t>(i)]);
+    for (std::size_t v = 0; v < topo.vertices; ++v) {
+        const auto nb = mesh.neighbors_of(v);
+        for (std::size_t i = 0; i < nb.size(); ++i) {
+            const auto w = static_cast<std::size_t>(nb[i]);
             if (w <= v) continue;
             ++topo.edges;
-            if (uses[static_cast<std::size_t>(i)] != 1) continue;
+            if (uses[first[v] + i] != 1) continue;
             ++topo.boundary_edges;
             boundary_vertices.push_back(static_cast<std::uint32_t>(v));
             sets.unite(static_cast<std::uint32_t>(w), static_cast<std::uint32_t>(v));
         }
+    }
     for (auto& v : boundary_vertices) v = sets.find(v);
     std::sort(boundary_vertices.begin(), boundary_vertices.end());
     topo.boundary_loops =

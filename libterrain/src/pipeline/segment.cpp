@@ -172,7 +172,7 @@ MeshCounts mesh_counts(const TriangleMesh& mesh) {
     MeshCounts c;
     c.vertices = mesh.vertex_count();
     c.faces = mesh.triangle_count();
-    const auto edges = static_cast<std::int64_t>(mesh.neighbors.size() / 2);
+    const auto edges = static_cast<std::int64_t>(mesh.edge_count());
     c.boundary_edges = static_cast<std::size_t>(2 * edges - 3 * static_cast<std::int64_t>(c.faces));
     c.euler_characteristic =
         static_cast<std::int64_t>(c.vertices) - edges + static_cast<std::int64_t>(c.faces);
@@ -298,8 +298,8 @@ void release_large_data(SegmentResult& result) {
     drop(m.positions);
     drop(m.triangles);
     drop(m.vertex_areas);
-    drop(m.neighbor_offsets);
-    drop(m.neighbors);
+    m.release_adjacency();
+    drop(m.pixel_vertex);
     drop(m.vertex_pixel);
     drop(result.field);
     drop(result.segmentation.labels);

@@ -43,8 +43,7 @@ bool loop_free(const TriangleMesh& mesh) {
     std::vector<std::int64_t> chi(nv, 0);
     for (std::size_t v = 0; v < nv; ++v) {
         std::int64_t upper_neighbours = 0;
-        for (i32 i = mesh.neighbor_offsets[v]; i < mesh.neighbor_offsets[v + 1]; ++i)
-            upper_neighbours += idx(mesh.neighbors[idx(i)]) > v;
+        for (const i32 w : mesh.neighbors_of(v)) upper_neighbours += idx(w) > v;
         chi[idx(components.find(static_cast<i32>(v)))] += 1 - upper_neighbours;
     }
     for (const auto& t : mesh.triangles) chi[idx(components.find(t[0]))] += 1;
@@ -185,9 +184,8 @@ bool contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& prog
             for (i32 i = g.node_vertex_offsets[idx(e)]; i < g.node_vertex_offsets[idx(e) + 1];
                  ++i) {
                 const i32 v = g.node_vertices[idx(i)];
-                for (i32 j = mesh.neighbor_offsets[idx(v)]; j < mesh.neighbor_offsets[idx(v) + 1];
-                     ++j) {
-                    const i32 n = g.vertex_nodes[idx(mesh.neighbors[idx(j)])];
+                for (const i32 w : mesh.neighbors_of(idx(v))) {
+                    const i32 n = g.vertex_nodes[idx(w)];
                     if (ascending ? n >= e : n <= e) continue;
                     const i32 c = find(n);
                     if (std::find(roots.begin(), roots.end(), c) == roots.end()) roots.push_back(c);
@@ -201,7 +199,7 @@ bool contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& prog
     for (auto& s : swept_by_side) detail::release(s);
     const auto components = std::count(join_parent.begin(), join_parent.end(), kNone);
     const auto chi = static_cast<std::int64_t>(mesh.vertex_count()) -
-                     static_cast<std::int64_t>(mesh.neighbors.size() / 2) +
+                     static_cast<std::int64_t>(mesh.edge_count()) +
                      static_cast<std::int64_t>(mesh.triangle_count());
     if (components == 1 ? (chi != 1 && chi != 2) : !loop_free(mesh)) return false;
     report_progress(progress, 0.6, "reeb: join and split trees");

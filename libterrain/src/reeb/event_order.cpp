@@ -97,8 +97,7 @@ void order_events(const TriangleMesh& mesh, const std::vector<float>& field, Ree
     for (std::size_t v = 0; v < tied.size(); ++v) {
         plateau.at(v, tied.size());
         if (!tied[v]) continue;
-        for (auto i = mesh.neighbor_offsets[v]; i < mesh.neighbor_offsets[v + 1]; ++i) {
-            const i32 w = mesh.neighbors[idx(i)];
+        for (const i32 w : mesh.neighbors_of(v)) {
             if (idx(w) > v && field[idx(w)] == field[v]) {
                 if (plateaus.empty()) plateaus.reset(nv);
                 plateaus.unite_to_smaller(static_cast<i32>(v), w);

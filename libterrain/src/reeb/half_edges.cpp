@@ -1,5 +1,6 @@
 // Half-edges from the mesh's sorted adjacency: each directed edge a -> b is a slot of a's
-// neighbour list, so twins meet at the slots (a, b) and (b, a) without a hash table. The same
+// neighbour list (a's first slot plus b's rank there), so twins meet at the slots (a, b) and
+// (b, a) without a hash table. The same
 // slot used twice means the mesh is not a consistently oriented 2-manifold: the sweep needs
 // one (it rotates around vertices and crosses edges), so that is an error here.
 
@@ -16,16 +17,23 @@ using detail::idx;
 using detail::kNone;
 
 HalfEdges build_half_edges(const TriangleMesh& mesh) {
-    const auto& off = mesh.neighbor_offsets;
-    const auto& nb = mesh.neighbors;
+    const std::size_t nv = mesh.vertex_count();
+    std::vector<std::uint32_t> first(nv + 1, 0);
+    for (std::size_t v = 0; v < nv; ++v) {
+        first[v + 1] = first[v] + static_cast<std::uint32_t>(mesh.degree(v));
+        if (first[v + 1] > std::uint32_t{INT32_MAX})
+            throw Error("reeb", "the mesh has more than 2^31 directed edges: too large");
+    }
     auto slot = [&](i32 a, i32 b) -> i32 {
-        const auto first = nb.begin() + off[idx(a)], last = nb.begin() + off[idx(a) + 1];
-        const auto it = std::lower_bound(first, last, b);
-        return (it != last && *it == b) ? static_cast<i32>(it - nb.begin()) : kNone;
+        const auto nb = mesh.neighbors_of(idx(a));
+        const auto it = std::lower_bound(nb.begin(), nb.end(), b);
+        return (it != nb.end() && *it == b)
+                   ? static_cast<i32>(first[idx(a)] + std::uint32_t(it - nb.begin()))
+                   : kNone;
     };
     HalfEdges he;
     const std::size_t n_he = mesh.triangle_count() * 3;
-    std::vector<i32> at_slot(nb.size(), kNone);
+    std::vector<i32> at_slot(first.back(), kNone);
     he.twin.assign(n_he, kNone);
     for (std::size_t h = 0; h < n_he; ++h) {
         const auto& tri = mesh.triangles[h / 3];

@@ -104,24 +104,25 @@ std::vector<LinkReps> link_components(const TriangleMesh& mesh, const ReebGraph&
         by_vertex.at(v, nv);
         if (v + kAhead < nv) __builtin_prefetch(&reps[idx(node[v + kAhead])], 1);
         const i32 n = node[v];
-        const i32 b = mesh.neighbor_offsets[v], e = mesh.neighbor_offsets[v + 1];
+        const auto neighbours = mesh.neighbors_of(v);
+        const auto degree = static_cast<i32>(neighbours.size());
         int below = 0, same = 0;
         i32 some_below = kNone, some_above = kNone;
-        for (i32 i = b; i < e; ++i) {
-            const i32 m = node[idx(mesh.neighbors[idx(i)])];
+        for (const i32 w : neighbours) {
+            const i32 m = node[idx(w)];
             below += m < n;
             same += m == n;  // a plateau
             some_below = m < n ? m : some_below;
             some_above = m < n ? some_above : m;
         }
-        if (e - b > 250 || same > 0) {
+        if (degree > 250 || same > 0) {
             general[idx(n)] = 1;
             reps[idx(n)] = {{kSeveral, kNone}, {kSeveral, kNone}};
             continue;
         }
-        const int above = e - b - below;
+        const int above = degree - below;
         const Star& s = stars[v];
-        const bool interior = s.triangles == e - b;
+        const bool interior = s.triangles == degree;
         const int lower = (above == 0 && interior && below > 0) ? 1 : below - s.lower_edges;
         const int upper = (below == 0 && interior && above > 0) ? 1 : above - s.upper_edges;
         vertex_links[v] = {static_cast<std::uint8_t>(lower), static_cast<std::uint8_t>(upper)};

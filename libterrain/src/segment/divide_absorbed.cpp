@@ -92,8 +92,8 @@ double mean_edge_length(const TriangleMesh& mesh, const detail::PassProgress& pa
     std::size_t count = 0;
     for (std::size_t v = 0; v < mesh.vertex_count(); ++v) {
         pass.at(v, mesh.vertex_count());
-        for (i32 k = mesh.neighbor_offsets[v]; k < mesh.neighbor_offsets[v + 1]; ++k) {
-            sum += edge_length(mesh, v, idx(mesh.neighbors[idx(k)]));
+        for (const i32 w : mesh.neighbors_of(v)) {
+            sum += edge_length(mesh, v, idx(w));
             ++count;
         }
     }
@@ -131,8 +131,7 @@ DivideCounts divide_absorbed(const TriangleMesh& mesh, const reeb::ReebGraph& gr
             if (absorbed[v]) labels[v] = here[(*finer)[v]];
     }
     const auto neighbours = [&](std::size_t v, auto&& f) {
-        for (i32 k = mesh.neighbor_offsets[v]; k < mesh.neighbor_offsets[v + 1]; ++k)
-            f(idx(mesh.neighbors[idx(k)]));
+        for (const i32 w : mesh.neighbors_of(v)) f(idx(w));
     };
     // 2. The part of each region connected to its seed's own vertices.
     std::vector<std::uint8_t> kept(n, 0);

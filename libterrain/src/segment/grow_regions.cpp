@@ -176,9 +176,8 @@ class Grower {
         for (i32 i = first; i < g_.node_vertex_offsets[idx(n) + 1]; ++i) {
             tick(idx(i - first));
             const i32 v = g_.node_vertices[idx(i)];
-            for (i32 k = mesh_.neighbor_offsets[idx(v)]; k < mesh_.neighbor_offsets[idx(v) + 1];
-                 ++k) {
-                const i32 u = g_.vertex_nodes[idx(mesh_.neighbors[idx(k)])];
+            for (const i32 w : mesh_.neighbors_of(idx(v))) {
+                const i32 u = g_.vertex_nodes[idx(w)];
                 if (u == last || node_region_[idx(u)] != kNone) continue;
                 last = u;
                 if (!relaxed && options_.cost == GrowCost::graph && !reeb_eligible(u)) continue;
@@ -192,9 +191,8 @@ class Grower {
         for (i32 i = g_.node_vertex_offsets[idx(u)]; i < g_.node_vertex_offsets[idx(u) + 1]; ++i) {
             tick(0);
             const i32 v = g_.node_vertices[idx(i)];
-            for (i32 k = mesh_.neighbor_offsets[idx(v)]; k < mesh_.neighbor_offsets[idx(v) + 1];
-                 ++k) {
-                const i32 r = node_region_[idx(g_.vertex_nodes[idx(mesh_.neighbors[idx(k)])])];
+            for (const i32 w : mesh_.neighbors_of(idx(v))) {
+                const i32 r = node_region_[idx(g_.vertex_nodes[idx(w)])];
                 if (r != kNone) push(u, r, false);
             }
         }

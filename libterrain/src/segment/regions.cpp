@@ -82,8 +82,9 @@ std::vector<std::int32_t> representative_vertices(const TriangleMesh& mesh,
     for (std::size_t v = 0; v < n; ++v) {
         sources.at(v, n);
         bool source = on_boundary[v];
-        for (auto k = mesh.neighbor_offsets[v]; !source && k < mesh.neighbor_offsets[v + 1]; ++k)
-            source = labels[static_cast<std::size_t>(mesh.neighbors[std::size_t(k)])] != labels[v];
+        for (const auto w : mesh.neighbors_of(v))
+            if (source) break;
+            else source = labels[static_cast<std::size_t>(w)] != labels[v];
         if (source) {
             depth[v] = 0;
             queue.push_back(static_cast<std::int32_t>(v));
@@ -92,8 +93,8 @@ std::vector<std::int32_t> representative_vertices(const TriangleMesh& mesh,
     for (std::size_t head = 0; head < queue.size(); ++head) {
         distances.at(head, n);  // each vertex of a region's pixels once
         const auto v = static_cast<std::size_t>(queue[head]);
-        for (auto k = mesh.neighbor_offsets[v]; k < mesh.neighbor_offsets[v + 1]; ++k) {
-            const auto w = static_cast<std::size_t>(mesh.neighbors[std::size_t(k)]);
+        for (const auto nb : mesh.neighbors_of(v)) {
+            const auto w = static_cast<std::size_t>(nb);
             if (depth[w] >= 0 || labels[w] != labels[v]) continue;
             depth[w] = depth[v] + 1;
             queue.push_back(static_cast<std::int32_t>(w));
@@ -118,8 +119,8 @@ std::unordered_map<std::uint64_t, EdgeSums> boundary_sums(const TriangleMesh& me
     std::unordered_map<std::uint64_t, EdgeSums> sums;
     for (std::size_t v = 0; v < mesh.vertex_count(); ++v) {
         by_vertex.at(v, mesh.vertex_count());
-        for (auto k = mesh.neighbor_offsets[v]; k < mesh.neighbor_offsets[v + 1]; ++k) {
-            const auto w = static_cast<std::size_t>(mesh.neighbors[std::size_t(k)]);
+        for (const auto nb : mesh.neighbors_of(v)) {
+            const auto w = static_cast<std::size_t>(nb);
             if (w > v && labels[w] != labels[v]) ++sums[pair_key(labels[v], labels[w])].mesh_edges;
         }
     }
@@ -309,7 +310,9 @@ std::vector<std::uint32_t> label_pixels(const TriangleMesh& mesh, const Dem& dem
     if (mesh.vertex_pixel.size() != mesh.vertex_count() || labels.size() != mesh.vertex_count() ||
         dem.width != mesh.grid_width || dem.height != mesh.grid_height)
         throw Error("segment", "labels, mesh and DEM grid do not match");
-    const auto vertex = mesh::pixel_to_vertex(mesh, dem);
+    std::vector<std::int32_t> computed;  // when the mesh does not hold it
+    if (mesh.pixel_vertex.empty()) computed = mesh::pixel_to_vertex(mesh, dem);
+    const auto& vertex = mesh.pixel_vertex.empty() ? computed : mesh.pixel_vertex;
     report_progress(progress, 0.2, "regions");
     std::vector<std::uint32_t> out;  // made a slice at a time: its first touch is slow
     detail::assign_in_slices(out, vertex.size(), std::uint32_t{0},

@@ -29,6 +29,10 @@ TriangleMesh dem_to_mesh(const Dem& dem, const DemToMeshOptions& options = {},
 
 // For each pixel (row-major), the vertex made from it, or -1 (NoData, isolated). The pixels
 // of a collapsed pole row all map to the pole vertex; a split pinch maps to its first copy.
+// A copy of mesh.pixel_vertex when the mesh has it.
 std::vector<std::int32_t> pixel_to_vertex(const TriangleMesh& mesh, const Dem& dem);
+// The same, into `out`.
+void fill_pixel_to_vertex(const TriangleMesh& mesh, const Dem& dem,
+                          std::vector<std::int32_t>& out);
 
 }  // namespace terrain::mesh

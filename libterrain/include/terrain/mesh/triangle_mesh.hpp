@@ -1,7 +1,8 @@
 #pragma once
 // The triangle mesh every later stage works on: compact arrays (float positions re-centred
-// on an origin, int32 triangles, CSR vertex adjacency, float vertex areas), about 72 bytes
-// per vertex for a DEM mesh. Vertices made from a DEM keep their pixel.
+// on an origin, int32 triangles, float vertex areas) and the vertex adjacency, a CSR for
+// meshes read from files, on the pixel grid for DEM meshes (about 50 bytes per vertex in
+// all). Vertices made from a DEM keep their pixel.
 
 #include <array>
 #include <cstddef>
@@ -13,6 +14,22 @@
 #include "terrain/core/progress.hpp"
 
 namespace terrain {
+
+// The neighbours of one vertex, sorted by index: a view of a stored list, or the few a grid
+// computes, held in the object itself (so it may be copied freely).
+class VertexNeighbors {
+public:
+    const std::int32_t* begin() const { return list_ ? list_ : own_.data(); }
+    const std::int32_t* end() const { return begin() + size_; }
+    std::size_t size() const { return size_; }
+    std::int32_t operator[](std::size_t i) const { return begin()[i]; }
+
+private:
+    friend struct TriangleMesh;
+    const std::int32_t* list_ = nullptr;
+    std::uint32_t size_ = 0;
+    std::array<std::int32_t, 8> own_;
+};
 
 enum class MeshFrame { body, map, file };
 
@@ -27,10 +44,28 @@ struct TriangleMesh {
     std::vector<std::array<std::int32_t, 3>> triangles;
     // One third of the incident triangles' areas, m^2 (their sum is the surface area).
     std::vector<float> vertex_areas;
-    // CSR adjacency: the mesh neighbours of v are neighbors[neighbor_offsets[v] ..
-    // neighbor_offsets[v+1]), sorted by index.
+    // The adjacency; read it through neighbors_of(v). Meshes from files: a CSR, the
+    // neighbours of v are neighbors[neighbor_offsets[v] .. neighbor_offsets[v+1]), sorted by
+    // index. DEM meshes leave these empty and keep it on the grid (below).
     std::vector<std::int32_t> neighbor_offsets;
     std::vector<std::int32_t> neighbors;
+
+    // The adjacency on the grid (DEM meshes, docs/mesh.md "The adjacency on the grid"):
+    // - pixel_vertex[p]: the vertex of pixel p (-1: none; a collapsed pole row: its pole; a
+    //   split pinch: its first copy);
+    // - neighbor_directions[v]: bit d set when the vertex of the pixel at vertex_pixel[v] +
+    //   direction_offsets[d] (the 8 pixels around, in increasing order) is a neighbour;
+    // - 0 there for the few vertices whose neighbours the grid does not give in order
+    //   (poles, seam columns, pinches and their neighbours): their sorted lists are
+    //   irregular_neighbors[irregular_offsets[i] .. [i+1]), i their rank in
+    //   irregular_vertices.
+    std::vector<std::int32_t> pixel_vertex;
+    std::vector<std::uint8_t> neighbor_directions;
+    std::array<std::int64_t, 8> direction_offsets{};
+    std::vector<std::int32_t> irregular_vertices;
+    std::vector<std::uint32_t> irregular_offsets;
+    std::vector<std::int32_t> irregular_neighbors;
+    std::size_t grid_edges = 0;  // the edges of a grid adjacency
 
     // DEM meshes: the pixel (row*grid_width + col) each vertex was made from; empty for
     // meshes read from files. A pole vertex keeps the first pixel of its row.
@@ -55,11 +90,36 @@ struct TriangleMesh {
         const auto& p = positions[v];
         return {origin[0] + p[0], origin[1] + p[1], origin[2] + p[2]};
     }
-    std::size_t degree(std::size_t v) const {
-        return static_cast<std::size_t>(neighbor_offsets[v + 1] - neighbor_offsets[v]);
+    bool grid_adjacency() const { return !neighbor_directions.empty(); }
+    // The neighbours of v, sorted by index.
+    VertexNeighbors neighbors_of(std::size_t v) const {
+        VertexNeighbors out;
+        if (!grid_adjacency()) {
+            out.list_ = neighbors.data() + neighbor_offsets[v];
+            out.size_ = static_cast<std::uint32_t>(neighbor_offsets[v + 1] - neighbor_offsets[v]);
+            return out;
+        }
+        if (const unsigned bits = neighbor_directions[v]; bits != 0) {
+            const std::int64_t p = vertex_pixel[v];
+            for (unsigned b = bits; b != 0; b &= b - 1)
+                out.own_[out.size_++] = pixel_vertex[static_cast<std::size_t>(
+                    p + direction_offsets[static_cast<std::size_t>(__builtin_ctz(b))])];
+            return out;
+        }
+        return irregular_neighbors_of(v);
+    }
+    std::size_t degree(std::size_t v) const { return neighbors_of(v).size(); }
+    // Edges of the adjacency (each counted once).
+    std::size_t edge_count() const {
+        return grid_adjacency() ? grid_edges : neighbors.size() / 2;
     }
     // Bytes held by the arrays above (capacity, not size).
     std::size_t memory_bytes() const;
+    // Frees the adjacency (both forms).
+    void release_adjacency();
+
+private:
+    VertexNeighbors irregular_neighbors_of(std::size_t v) const;
 };
 
 // Counts of a mesh's topology.
@@ -76,8 +136,15 @@ struct MeshTopology {
 void set_positions(TriangleMesh& mesh, const std::vector<std::array<double, 3>>& points,
                    const ProgressFn& progress = {});
 
-// Fills vertex_areas and the CSR adjacency from positions and triangles.
+// Fills vertex_areas and the CSR adjacency from positions and triangles (dropping any
+// adjacency on the grid).
 void finish_mesh(TriangleMesh& mesh, const ProgressFn& progress = {});
+
+// Fills vertex_areas and the adjacency on the grid from positions, triangles, vertex_pixel,
+// the grid's size and pixel_vertex (set by the caller); a grid under 3 pixels wide gets the
+// CSR. Any vertex the grid does not describe (its neighbours not at the 8 pixels around, or
+// not in increasing order) gets an explicit list, so the adjacency is that of the triangles.
+void finish_grid_mesh(TriangleMesh& mesh, const ProgressFn& progress = {});
 
 MeshTopology mesh_topology(const TriangleMesh& mesh);
 
