@@ -89,7 +89,7 @@ Dem read_dem(const std::string& path, const ReadDemOptions& options, const Progr
     const bool all_valid = band->GetMaskFlags() == GMF_ALL_VALID;
 
     const std::size_t width = static_cast<std::size_t>(dem.width);
-    check_dem_size(path, dem, *band, summary ? nullptr : &options.memory);
+    check_dem_size(path, dem, *band, summary ? nullptr : &options.memory, all_valid);
     // Each row of the grid's values is added as it is read, and the whole grid is reserved
     // (address space only) once the first row has been read: the memory used follows what
     // the file gives, not what its header claims. An 826-byte GeoTIFF declaring 18464 x 65504
@@ -171,6 +171,8 @@ Dem read_dem(const std::string& path, const ReadDemOptions& options, const Progr
                                 " valid pixel(s); a surface needs at least three");
     validate_value_range(path, lo, hi);
     if (summary) *summary = {lo, hi, valid};
+    // Before the mesh and all that follows: the plan with the valid pixels counted.
+    if (!summary && !all_valid) check_dem_valid_pixels(path, dem, valid, &options.memory);
 
     if (options.elevation) {
         dem.elevation = *options.elevation;

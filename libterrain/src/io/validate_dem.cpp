@@ -76,13 +76,29 @@ void validate_dem_grid(const std::string& path, const Dem& dem, const OGRSpatial
                                        : std::string()));
 }
 
+namespace {
+
+std::string grid_name(const std::string& path, const Dem& dem) {
+    return "the " + std::to_string(dem.width) + "x" + std::to_string(dem.height) + " grid of '" +
+           path + "'";
+}
+
+}  // namespace
+
+void check_dem_valid_pixels(const std::string& path, const Dem& dem, std::size_t valid,
+                            const MemoryPlan* plan) {
+    if (!plan || !plan->checked) return;
+    const double pixels = double(dem.width) * double(dem.height);
+    check_memory(grid_name(path, dem) + " with " + std::to_string(valid) + " valid pixels",
+                 plan->dem_bytes(pixels, double(valid)), plan->limit);
+}
+
 void check_dem_size(const std::string& path, const Dem& dem, GDALRasterBand& band,
-                    const MemoryPlan* plan) {
+                    const MemoryPlan* plan, bool all_valid) {
     const double pixels = double(dem.width) * double(dem.height);
     if (plan && plan->checked)
-        check_memory("the " + std::to_string(dem.width) + "x" + std::to_string(dem.height) +
-                         " grid of '" + path + "'",
-                     plan->dem_bytes(pixels), plan->limit);
+        check_memory(grid_name(path, dem), plan->dem_bytes(pixels, all_valid ? pixels : 0.0),
+                     plan->limit);
     // ASCII grids (GDAL's AAIGrid, GRASSASCIIGrid and ISG drivers) find a line by reading
     // every line before it, again for each one that failed: asking for the last row of a
     // grid whose text ends early takes time exponential in the missing lines. Their size is

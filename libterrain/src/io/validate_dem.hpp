@@ -28,9 +28,15 @@ void validate_dem_grid(const std::string& path, const Dem& dem, const OGRSpatial
 
 // The band's declared size against the memory budget (`plan`; null: not checked), and its
 // last row read back (a raster whose data end early, such as a PDS label declaring more rows
-// than its image holds, is refused before the grid is allocated).
+// than its image holds, is refused before the grid is allocated). The valid pixels are those
+// of the whole grid when `all_valid` (no NoData), none otherwise: check_dem_valid_pixels
+// checks again once they are counted.
 void check_dem_size(const std::string& path, const Dem& dem, GDALRasterBand& band,
-                    const MemoryPlan* plan);
+                    const MemoryPlan* plan, bool all_valid);
+
+// The plan again with the valid pixels counted (after reading, before the mesh).
+void check_dem_valid_pixels(const std::string& path, const Dem& dem, std::size_t valid,
+                            const MemoryPlan* plan);
 
 // Scale and offset of the band (before reading).
 void validate_scale(const std::string& path, double scale, double offset);

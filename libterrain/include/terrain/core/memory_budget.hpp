@@ -22,21 +22,24 @@ std::uint64_t parse_memory_size(const std::string& text);
 // "3.2 GB", "512 MB", "900 B"
 std::string format_bytes(double bytes);
 
-// The expected peak of reading an input and of the work planned on it, from its declared
-// size: a fixed part (the process with GDAL, PROJ, CGAL and the thread pool) plus parts
-// proportional to the DEM's pixels, or the mesh file's vertices, faces and face corners; for
-// a DEM at least `floor_bytes` (a stage whose peak does not grow with the input: encoding
-// the preview). pipeline::memory_plan gives the plan of each field (docs/robustness.md).
+// The expected peak of reading an input and of the work planned on it: a fixed part (the
+// process with GDAL, PROJ, CGAL and the thread pool) plus parts proportional to the DEM's
+// pixels (the grids: values, labels) and valid pixels (the mesh and all that follows), or to
+// the mesh file's vertices, faces and face corners; for a DEM at least `floor_bytes` (a stage
+// whose peak does not grow with the input: encoding the preview). pipeline::memory_plan gives
+// the plan of each field (docs/robustness.md).
 struct MemoryPlan {
     double floor_bytes = 0;
     double base_bytes = 0;
     double bytes_per_pixel = 8;  // the grid of doubles alone
+    double bytes_per_valid_pixel = 0;
     double bytes_per_vertex = 200, bytes_per_face = 300, bytes_per_corner = 16;  // reading
     std::uint64_t limit = 0;  // bytes; 0: the process-wide limit, if any (set_memory_limit)
     bool checked = true;      // false: no check (reading a DEM one row at a time)
 
-    double dem_bytes(double pixels) const {
-        const double grows = base_bytes + bytes_per_pixel * pixels;
+    double dem_bytes(double pixels, double valid_pixels) const {
+        const double grows =
+            base_bytes + bytes_per_pixel * pixels + bytes_per_valid_pixel * valid_pixels;
         return grows > floor_bytes ? grows : floor_bytes;
     }
     double mesh_bytes(double vertices, double faces, double corners) const {
