@@ -14,6 +14,7 @@
 #include "terrain/geo/georeference.hpp"
 #include "terrain/io/read_dem.hpp"
 #include "terrain/mesh/dem_to_mesh.hpp"
+#include "../../libterrain/src/mesh/grid_triangles.hpp"
 
 using namespace terrain;
 
@@ -266,6 +267,18 @@ std::size_t check_grid_adjacency(const TriangleMesh& mesh) {
     CHECK(degrees == 2 * mesh.edge_count());
     CHECK(mesh.edge_count() == csr.edge_count());
     CHECK(mesh.vertex_areas == csr.vertex_areas);
+    // The triangles made again from the grid once released: the same, in the same order.
+    TriangleMesh released = mesh;
+    REQUIRE(released.release_triangles());
+    CHECK(released.triangles.empty());
+    CHECK(released.triangle_count() == mesh.triangle_count());
+    std::size_t count = 0, wrong = 0;
+    detail::for_each_triangle(released, [&](std::size_t i, const std::array<std::int32_t, 3>& t) {
+        wrong += i != count || i >= mesh.triangles.size() || mesh.triangles[i] != t;
+        ++count;
+    });
+    CHECK(count == mesh.triangle_count());
+    CHECK(wrong == 0);
     return mesh.irregular_vertices.size();
 }
 
@@ -305,6 +318,21 @@ TEST_CASE("dem_to_mesh: the adjacency on the grid is the triangles' adjacency", 
             for (int c : {0, 1, 358, 359}) dem.values[dem.index(c, r)] = kNaN;
         dem.values[dem.index(0, 100)] = kNaN;
         check_grid_adjacency(mesh::dem_to_mesh(dem));
+    }
+    SECTION("rows growing northwards: the triangles turn the other way") {
+        Dem dem = grid_dem(30, 20, 10.0, [](int c, int r) { return std::cos(0.4 * c) * r; });
+        dem.transform = {0, 10.0, 0, 0, 0, 10.0};
+        geo::georeference(dem);
+        const auto mesh = mesh::dem_to_mesh(dem);
+        CHECK(mesh.triangles_flipped);
+        check_grid_adjacency(mesh);
+    }
+    SECTION("a mesh read from a file keeps its triangles") {
+        TriangleMesh file = mesh::dem_to_mesh(
+            grid_dem(5, 5, 1.0, [](int c, int r) { return double(c * r); }));
+        file.pixel_vertex.clear();
+        CHECK_FALSE(file.release_triangles());
+        CHECK_FALSE(file.triangles.empty());
     }
     SECTION("a grid two pixels wide keeps the CSR") {
         const Dem dem = grid_dem(2, 5, 1.0, [](int c, int r) { return double(c + r); });

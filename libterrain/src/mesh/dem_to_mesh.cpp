@@ -13,13 +13,14 @@
 
 #include "../core/pass_progress.hpp"
 #include "../core/release.hpp"
+#include "grid_triangles.hpp"
 #include "terrain/core/error.hpp"
 
 namespace terrain::mesh {
 namespace {
 
 constexpr double kDegree = std::numbers::pi / 180.0;
-using Triangle = std::array<std::int32_t, 3>;
+using detail::Triangle;
 
 // The DEM's georeference, or an error saying how to get one.
 const GridGeoref& georef_of(const Dem& dem) {
@@ -168,62 +169,22 @@ void place_vertices(const Dem& dem, const GridGeoref& geo,
     set_positions(mesh, xyz, scaled_progress(progress, 0.9, 1));
 }
 
-// Two triangles per 2x2 block of valid pixels, split along the shorter 3-D diagonal (ties
-// to v00-v11), one for three valid pixels, none for fewer (METHOD.md s.1); a closed seam
-// adds the blocks between the last and the first column. With rows growing southwards and
-// columns eastwards (the geotransform's determinant negative) the orders below are
-// counter-clockwise seen from above/outside; otherwise the last two corners swap.
+// Two triangles per 2x2 block of valid pixels, one for three (grid_triangles.hpp); a closed
+// seam adds the blocks between the last and the first column.
 void triangulate_blocks(const Dem& dem, const std::vector<std::int32_t>& vertex_of,
                         TriangleMesh& mesh, const ProgressFn& progress) {
     const int W = dem.width, H = dem.height;
-    const auto& t = dem.transform;
-    const bool flip = t[1] * t[5] - t[2] * t[4] > 0;
-    const int block_cols = mesh.seam_closed ? W : W - 1;
     const int block_rows = H - 1;
     std::vector<std::vector<Triangle>> per_row(static_cast<std::size_t>(block_rows));
     // Rows in parallel (0 to 0.8 of the progress), then joined in order.
     detail::parallel_slices(block_rows, 16, progress, 0, 0.8, "mesh", [&](const auto& rows) {
         for (int row = rows.begin(); row < rows.end(); ++row) {
             auto& out = per_row[row];
-            out.reserve(2 * std::size_t(block_cols));
-            auto emit = [&](std::int32_t p, std::int32_t q, std::int32_t r) {
-                if (p < 0 || q < 0 || r < 0 || p == q || q == r || p == r) return;
-                out.push_back(flip ? Triangle{p, r, q} : Triangle{p, q, r});
-            };
-            for (int col = 0; col < block_cols; ++col) {
-                const int right = (col + 1) % W;
-                const auto v00 = vertex_of[dem.index(col, row)];
-                const auto v10 = vertex_of[dem.index(right, row)];
-                const auto v01 = vertex_of[dem.index(col, row + 1)];
-                const auto v11 = vertex_of[dem.index(right, row + 1)];
-                const int valid = (v00 >= 0) + (v10 >= 0) + (v01 >= 0) + (v11 >= 0);
-                if (valid < 3) continue;
-                if (valid == 3) {
-                    if (v00 < 0)
-                        emit(v10, v01, v11);
-                    else if (v10 < 0)
-                        emit(v00, v01, v11);
-                    else if (v01 < 0)
-                        emit(v00, v11, v10);
-                    else
-                        emit(v00, v01, v10);
-                    continue;
-                }
-                auto dist2 = [&](std::int32_t i, std::int32_t j) {
-                    const auto& p = mesh.positions[i];
-                    const auto& q = mesh.positions[j];
-                    const double d[3] = {double(p[0]) - q[0], double(p[1]) - q[1],
-                                         double(p[2]) - q[2]};
-                    return d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-                };
-                if (dist2(v00, v11) <= dist2(v10, v01)) {
-                    emit(v00, v01, v11);
-                    emit(v00, v11, v10);
-                } else {
-                    emit(v00, v01, v10);
-                    emit(v10, v01, v11);
-                }
-            }
+            out.reserve(2 * std::size_t(W));
+            const std::int32_t* top = vertex_of.data() + dem.index(0, row);
+            detail::block_row_triangles(top, top + W, W, mesh.seam_closed, mesh.triangles_flipped,
+                                        mesh.positions,
+                                        [&](const Triangle& t) { out.push_back(t); });
         }
     });
     std::size_t total = 0;
@@ -258,6 +219,8 @@ TriangleMesh dem_to_mesh(const Dem& dem, const DemToMeshOptions& options,
     mesh.crs_wkt = dem.crs_wkt;
     mesh.grid_width = dem.width;
     mesh.grid_height = dem.height;
+    const auto& t = dem.transform;
+    mesh.triangles_flipped = t[1] * t[5] - t[2] * t[4] > 0;
     // A global grid closes in the body frame: seam, and pole rows whose outer edge is a pole.
     std::array<bool, 2> pole{false, false};
     if (frame == MeshFrame::body && options.close_global && geo.global_longitude) {
@@ -273,8 +236,16 @@ TriangleMesh dem_to_mesh(const Dem& dem, const DemToMeshOptions& options,
     // Leave out valid pixels in no triangle (isolated, or only in degenerate blocks).
     mesh.isolated_vertices =
         remove_unreferenced_vertices(mesh, scaled_progress(progress, 0.5, 0.6));
+    const auto before_split = static_cast<std::int32_t>(mesh.positions.size());
     mesh.pinched_vertices =
         split_pinched_vertices(mesh, nullptr, scaled_progress(progress, 0.6, 0.7));
+    // The triangles naming a copy, which the grid alone would not make again.
+    if (mesh.pinched_vertices > 0)
+        for (std::size_t i = 0; i < mesh.triangles.size(); ++i) {
+            const auto& c = mesh.triangles[i];
+            if (std::max({c[0], c[1], c[2]}) >= before_split)
+                mesh.pinch_triangles.emplace_back(i, c);
+        }
     mesh.positions.shrink_to_fit();
     mesh.vertex_pixel.shrink_to_fit();
     // The pixels' vertices after those changes, in the same memory.

@@ -38,7 +38,8 @@ std::size_t TriangleMesh::memory_bytes() const {
            pixel_vertex.capacity() * sizeof(std::int32_t) + neighbor_directions.capacity() +
            irregular_vertices.capacity() * sizeof(std::int32_t) +
            irregular_offsets.capacity() * sizeof(std::uint32_t) +
-           irregular_neighbors.capacity() * sizeof(std::int32_t);
+           irregular_neighbors.capacity() * sizeof(std::int32_t) +
+           pinch_triangles.capacity() * sizeof(pinch_triangles[0]);
 }
 
 void TriangleMesh::release_adjacency() {
@@ -49,6 +50,16 @@ void TriangleMesh::release_adjacency() {
     detail::release(irregular_offsets);
     detail::release(irregular_neighbors);
     grid_edges = 0;
+}
+
+bool TriangleMesh::release_triangles() {
+    if (triangles_released()) return true;
+    if (triangles.empty() || grid_width < 1 || vertex_pixel.size() != positions.size() ||
+        pixel_vertex.size() != std::size_t(grid_width) * std::size_t(grid_height))
+        return false;
+    released_triangles_ = triangles.size();
+    detail::release(triangles);
+    return true;
 }
 
 VertexNeighbors TriangleMesh::irregular_neighbors_of(std::size_t v) const {

@@ -206,6 +206,9 @@ reeb::ReebGraph compute_reeb(SegmentResult& result, const ProgressFn& progress) 
     auto graph = reeb::build_reeb_graph(result.input.mesh, result.field, {},
                                         scaled_progress(progress, 0, 0.95));
     result.critical_before = reeb::summarize(graph, scaled_progress(progress, 0.95, 1)).critical;
+    // No later stage needs the triangles at random: a DEM mesh frees them (24 bytes a pixel)
+    // and the region graph makes them again from the grid.
+    result.input.mesh.release_triangles();
     result.add_time("reeb", since(t0));
     return graph;
 }

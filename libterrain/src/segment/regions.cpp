@@ -7,6 +7,7 @@
 #include <unordered_map>
 
 #include "../core/pass_progress.hpp"
+#include "../mesh/grid_triangles.hpp"
 #include "pixel_areas.hpp"
 #include "terrain/core/error.hpp"
 #include "terrain/mesh/dem_to_mesh.hpp"
@@ -55,8 +56,9 @@ void check_inputs(const TriangleMesh& mesh, const std::vector<float>& field,
 // Vertices on the mesh's boundary: in a 2-manifold, fewer incident triangles than neighbours.
 std::vector<std::uint8_t> mesh_boundary(const TriangleMesh& mesh) {
     std::vector<std::int32_t> triangles(mesh.vertex_count(), 0);
-    for (const auto& t : mesh.triangles)
+    detail::for_each_triangle(mesh, [&](std::size_t, const std::array<std::int32_t, 3>& t) {
         for (auto v : t) ++triangles[static_cast<std::size_t>(v)];
+    });
     std::vector<std::uint8_t> out(mesh.vertex_count(), 0);
     for (std::size_t v = 0; v < out.size(); ++v)
         out[v] = static_cast<std::size_t>(triangles[v]) != mesh.degree(v);
@@ -124,12 +126,12 @@ std::unordered_map<std::uint64_t, EdgeSums> boundary_sums(const TriangleMesh& me
             if (w > v && labels[w] != labels[v]) ++sums[pair_key(labels[v], labels[w])].mesh_edges;
         }
     }
-    for (std::size_t i = 0; i < mesh.triangle_count(); ++i) {
-        by_triangle.at(i, mesh.triangle_count());
-        const auto& t = mesh.triangles[i];
+    const std::size_t nt = mesh.triangle_count();
+    detail::for_each_triangle(mesh, [&](std::size_t i, const std::array<std::int32_t, 3>& t) {
+        by_triangle.at(i, nt);
         const std::uint32_t l[3] = {labels[std::size_t(t[0])], labels[std::size_t(t[1])],
                                     labels[std::size_t(t[2])]};
-        if (l[0] == l[1] && l[1] == l[2]) continue;
+        if (l[0] == l[1] && l[1] == l[2]) return;
         const Point p[3] = {mesh.position(std::size_t(t[0])), mesh.position(std::size_t(t[1])),
                             mesh.position(std::size_t(t[2]))};
         // Edge k joins corners k and k+1.
@@ -140,12 +142,12 @@ std::unordered_map<std::uint64_t, EdgeSums> boundary_sums(const TriangleMesh& me
                                   (p[0][2] + p[1][2] + p[2][2]) / 3};
             for (int k = 0; k < 3; ++k)
                 sums[pair_key(l[k], l[(k + 1) % 3])].length += distance(centre, mid[k]);
-            continue;
+            return;
         }
         // Two labels: the corner alone on its side is k; its two edges are k-1 and k.
         const int k = l[0] == l[1] ? 2 : (l[1] == l[2] ? 0 : 1);
         sums[pair_key(l[k], l[(k + 1) % 3])].length += distance(mid[(k + 2) % 3], mid[k]);
-    }
+    });
     return sums;
 }
 

@@ -8,6 +8,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "terrain/core/body.hpp"
@@ -66,6 +67,10 @@ struct TriangleMesh {
     std::vector<std::uint32_t> irregular_offsets;
     std::vector<std::int32_t> irregular_neighbors;
     std::size_t grid_edges = 0;  // the edges of a grid adjacency
+    // DEM meshes: the triangles can be made again from the grid (release_triangles): their
+    // orientation, and those that name a split pinch's copy (index, corners), in order.
+    bool triangles_flipped = false;
+    std::vector<std::pair<std::uint64_t, std::array<std::int32_t, 3>>> pinch_triangles;
 
     // DEM meshes: the pixel (row*grid_width + col) each vertex was made from; empty for
     // meshes read from files. A pole vertex keeps the first pixel of its row.
@@ -85,7 +90,14 @@ struct TriangleMesh {
     std::array<std::int32_t, 2> pole_vertices{-1, -1};
 
     std::size_t vertex_count() const { return positions.size(); }
-    std::size_t triangle_count() const { return triangles.size(); }
+    std::size_t triangle_count() const {
+        return triangles_released() ? released_triangles_ : triangles.size();
+    }
+    // A DEM mesh may free its triangles once no stage needs them at random (after the Reeb
+    // graph): detail::for_each_triangle (src/mesh/grid_triangles.hpp) makes them again from the grid, in order.
+    // Returns false, keeping them, for a mesh that cannot (read from a file).
+    bool release_triangles();
+    bool triangles_released() const { return released_triangles_ > 0; }
     std::array<double, 3> position(std::size_t v) const {
         const auto& p = positions[v];
         return {origin[0] + p[0], origin[1] + p[1], origin[2] + p[2]};
@@ -120,6 +132,7 @@ struct TriangleMesh {
 
 private:
     VertexNeighbors irregular_neighbors_of(std::size_t v) const;
+    std::size_t released_triangles_ = 0;
 };
 
 // Counts of a mesh's topology.

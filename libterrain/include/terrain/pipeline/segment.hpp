@@ -147,7 +147,8 @@ struct SegmentResult {
 // The field of the input's mesh into result.field (stage "field").
 void compute_field(SegmentResult& result, const SegmentOptions& options,
                    const ProgressFn& progress = {});
-// The unsimplified Reeb graph of result.field (stage "reeb"); sets critical_before.
+// The unsimplified Reeb graph of result.field (stage "reeb"); sets critical_before. A DEM
+// mesh's triangles are released after it (TriangleMesh::release_triangles).
 reeb::ReebGraph compute_reeb(SegmentResult& result, const ProgressFn& progress = {});
 
 // One scale: the graph simplified with options.simplify and the regions grown on it.

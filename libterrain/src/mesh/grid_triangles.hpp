@@ -1,0 +1,91 @@
+#pragma once
+// Private: the triangles of a DEM's grid (METHOD.md s.1), made one row of 2x2 blocks at a
+// time. dem_to_mesh makes the mesh's triangles with it, and detail::for_each_triangle makes them again
+// for a DEM mesh whose triangles were released after the Reeb graph (release_triangles), in
+// the same order and with the same corners. Not installed.
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "terrain/mesh/triangle_mesh.hpp"
+
+namespace terrain::detail {
+
+using Triangle = std::array<std::int32_t, 3>;
+
+// The triangles of the blocks between two rows of pixels whose vertices are `top` and
+// `bottom` (-1: none), `width` pixels each: two for four vertices, split along the shorter
+// 3-D diagonal (`positions`; ties to top-left/bottom-right), one for three, none for fewer,
+// and none repeating a vertex (a collapsed pole). With `seam` the last block joins the last
+// column to the first. Rows growing southwards and columns eastwards (the geotransform's
+// determinant negative) give counter-clockwise triangles seen from above or outside; `flip`
+// swaps their last two corners otherwise. emit(const Triangle&) for each, in order.
+template <class Emit>
+void block_row_triangles(const std::int32_t* top, const std::int32_t* bottom, int width,
+                         bool seam, bool flip, const std::vector<std::array<float, 3>>& positions,
+                         Emit&& emit) {
+    const auto put = [&](std::int32_t p, std::int32_t q, std::int32_t r) {
+        if (p < 0 || q < 0 || r < 0 || p == q || q == r || p == r) return;
+        emit(flip ? Triangle{p, r, q} : Triangle{p, q, r});
+    };
+    const auto dist2 = [&](std::int32_t i, std::int32_t j) {
+        const auto& p = positions[static_cast<std::size_t>(i)];
+        const auto& q = positions[static_cast<std::size_t>(j)];
+        const double d[3] = {double(p[0]) - q[0], double(p[1]) - q[1], double(p[2]) - q[2]};
+        return d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+    };
+    const int blocks = seam ? width : width - 1;
+    for (int col = 0; col < blocks; ++col) {
+        const int right = col + 1 == width ? 0 : col + 1;
+        const std::int32_t v00 = top[col], v10 = top[right], v01 = bottom[col],
+                           v11 = bottom[right];
+        const int valid = (v00 >= 0) + (v10 >= 0) + (v01 >= 0) + (v11 >= 0);
+        if (valid < 3) continue;
+        if (valid == 3) {
+            if (v00 < 0)
+                put(v10, v01, v11);
+            else if (v10 < 0)
+                put(v00, v01, v11);
+            else if (v01 < 0)
+                put(v00, v11, v10);
+            else
+                put(v00, v01, v10);
+            continue;
+        }
+        if (dist2(v00, v11) <= dist2(v10, v01)) {
+            put(v00, v01, v11);
+            put(v00, v11, v10);
+        } else {
+            put(v00, v01, v10);
+            put(v10, v01, v11);
+        }
+    }
+}
+
+// f(index, triangle) for each triangle of `mesh` in order: its stored triangles, or for a
+// DEM mesh whose triangles were released, the same made again from the grid.
+template <class F>
+void for_each_triangle(const TriangleMesh& mesh, F&& f) {
+    if (!mesh.triangles_released()) {
+        for (std::size_t i = 0; i < mesh.triangles.size(); ++i) f(i, mesh.triangles[i]);
+        return;
+    }
+    const std::size_t W = static_cast<std::size_t>(mesh.grid_width);
+    const auto& patches = mesh.pinch_triangles;
+    std::size_t index = 0, patch = 0;
+    for (int row = 0; row + 1 < mesh.grid_height; ++row) {
+        const std::int32_t* top = mesh.pixel_vertex.data() + static_cast<std::size_t>(row) * W;
+        block_row_triangles(top, top + W, mesh.grid_width, mesh.seam_closed,
+                            mesh.triangles_flipped, mesh.positions, [&](const Triangle& t) {
+                                if (patch < patches.size() && patches[patch].first == index)
+                                    f(index, patches[patch++].second);
+                                else
+                                    f(index, t);
+                                ++index;
+                            });
+    }
+}
+
+}  // namespace terrain::detail
