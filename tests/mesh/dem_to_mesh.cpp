@@ -9,12 +9,12 @@
 #include <map>
 #include <numbers>
 
+#include "../../libterrain/src/mesh/grid_triangles.hpp"
 #include "support/test_support.hpp"
 #include "terrain/core/error.hpp"
 #include "terrain/geo/georeference.hpp"
 #include "terrain/io/read_dem.hpp"
 #include "terrain/mesh/dem_to_mesh.hpp"
-#include "../../libterrain/src/mesh/grid_triangles.hpp"
 
 using namespace terrain;
 
@@ -279,6 +279,13 @@ std::size_t check_grid_adjacency(const TriangleMesh& mesh) {
     });
     CHECK(count == mesh.triangle_count());
     CHECK(wrong == 0);
+    // Its topology is counted the same without them.
+    const auto before = mesh_topology(mesh), after = mesh_topology(released);
+    CHECK(after.edges == before.edges);
+    CHECK(after.boundary_edges == before.boundary_edges);
+    CHECK(after.boundary_loops == before.boundary_loops);
+    CHECK(after.components == before.components);
+    CHECK(after.euler_characteristic == before.euler_characteristic);
     return mesh.irregular_vertices.size();
 }
 
@@ -328,8 +335,8 @@ TEST_CASE("dem_to_mesh: the adjacency on the grid is the triangles' adjacency", 
         check_grid_adjacency(mesh);
     }
     SECTION("a mesh read from a file keeps its triangles") {
-        TriangleMesh file = mesh::dem_to_mesh(
-            grid_dem(5, 5, 1.0, [](int c, int r) { return double(c * r); }));
+        TriangleMesh file =
+            mesh::dem_to_mesh(grid_dem(5, 5, 1.0, [](int c, int r) { return double(c * r); }));
         file.pixel_vertex.clear();
         CHECK_FALSE(file.release_triangles());
         CHECK_FALSE(file.triangles.empty());

@@ -1,8 +1,9 @@
 #pragma once
 // Private: the triangles of a DEM's grid (METHOD.md s.1), made one row of 2x2 blocks at a
-// time. dem_to_mesh makes the mesh's triangles with it, and detail::for_each_triangle makes them again
-// for a DEM mesh whose triangles were released after the Reeb graph (release_triangles), in
-// the same order and with the same corners. Not installed.
+// time. dem_to_mesh makes the mesh's triangles with it, and for_each_triangle makes them
+// again for a DEM mesh whose triangles were released after the Reeb graph
+// (TriangleMesh::release_triangles), in the same order and with the same corners. Not
+// installed.
 
 #include <array>
 #include <cstddef>
@@ -23,8 +24,8 @@ using Triangle = std::array<std::int32_t, 3>;
 // determinant negative) give counter-clockwise triangles seen from above or outside; `flip`
 // swaps their last two corners otherwise. emit(const Triangle&) for each, in order.
 template <class Emit>
-void block_row_triangles(const std::int32_t* top, const std::int32_t* bottom, int width,
-                         bool seam, bool flip, const std::vector<std::array<float, 3>>& positions,
+void block_row_triangles(const std::int32_t* top, const std::int32_t* bottom, int width, bool seam,
+                         bool flip, const std::vector<std::array<float, 3>>& positions,
                          Emit&& emit) {
     const auto put = [&](std::int32_t p, std::int32_t q, std::int32_t r) {
         if (p < 0 || q < 0 || r < 0 || p == q || q == r || p == r) return;
@@ -39,8 +40,7 @@ void block_row_triangles(const std::int32_t* top, const std::int32_t* bottom, in
     const int blocks = seam ? width : width - 1;
     for (int col = 0; col < blocks; ++col) {
         const int right = col + 1 == width ? 0 : col + 1;
-        const std::int32_t v00 = top[col], v10 = top[right], v01 = bottom[col],
-                           v11 = bottom[right];
+        const std::int32_t v00 = top[col], v10 = top[right], v01 = bottom[col], v11 = bottom[right];
         const int valid = (v00 >= 0) + (v10 >= 0) + (v01 >= 0) + (v11 >= 0);
         if (valid < 3) continue;
         if (valid == 3) {
@@ -77,8 +77,8 @@ void for_each_triangle(const TriangleMesh& mesh, F&& f) {
     std::size_t index = 0, patch = 0;
     for (int row = 0; row + 1 < mesh.grid_height; ++row) {
         const std::int32_t* top = mesh.pixel_vertex.data() + static_cast<std::size_t>(row) * W;
-        block_row_triangles(top, top + W, mesh.grid_width, mesh.seam_closed,
-                            mesh.triangles_flipped, mesh.positions, [&](const Triangle& t) {
+        block_row_triangles(top, top + W, mesh.grid_width, mesh.seam_closed, mesh.triangles_flipped,
+                            mesh.positions, [&](const Triangle& t) {
                                 if (patch < patches.size() && patches[patch].first == index)
                                     f(index, patches[patch++].second);
                                 else

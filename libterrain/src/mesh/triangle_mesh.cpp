@@ -2,16 +2,17 @@
 #include "../core/disjoint_sets.hpp"
 #include "../core/pass_progress.hpp"
 #include "../core/release.hpp"
+#include "grid_triangles.hpp"
 #include "terrain/core/error.hpp"
 
 #include <tbb/blocked_range.h>
 
 #include <algorithm>
-#include <atomic>
-#include <functional>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <numeric>
 #include <string>
@@ -242,20 +243,20 @@ void finish_grid_mesh(TriangleMesh& mesh, const ProgressFn& progress) {
     // come in increasing order (not so across the seam, or next to a pinch's copy).
     mesh.neighbor_directions = std::move(bits);
     std::atomic<std::uint64_t> regular_degrees{0};
-    detail::parallel_slices(n, std::size_t{4096}, progress, 0.6, 0.8, "mesh",
-                            [&](const tbb::blocked_range<std::size_t>& r) {
-                                std::uint64_t sum = 0;
-                                for (std::size_t v = r.begin(); v < r.end(); ++v) {
-                                    if (irregular[v]) continue;
-                                    const auto nb = mesh.neighbors_of(v);
-                                    if (std::adjacent_find(nb.begin(), nb.end(),
-                                                           std::greater_equal<>()) != nb.end())
-                                        irregular[v] = 1;
-                                    else
-                                        sum += nb.size();
-                                }
-                                regular_degrees += sum;
-                            });
+    detail::parallel_slices(
+        n, std::size_t{4096}, progress, 0.6, 0.8, "mesh",
+        [&](const tbb::blocked_range<std::size_t>& r) {
+            std::uint64_t sum = 0;
+            for (std::size_t v = r.begin(); v < r.end(); ++v) {
+                if (irregular[v]) continue;
+                const auto nb = mesh.neighbors_of(v);
+                if (std::adjacent_find(nb.begin(), nb.end(), std::greater_equal<>()) != nb.end())
+                    irregular[v] = 1;
+                else
+                    sum += nb.size();
+            }
+            regular_degrees += sum;
+        });
     // The irregular vertices' lists, from their triangles.
     for (std::size_t v = 0; v < n; ++v)
         if (irregular[v]) {
@@ -263,9 +264,9 @@ void finish_grid_mesh(TriangleMesh& mesh, const ProgressFn& progress) {
             mesh.irregular_vertices.push_back(static_cast<std::int32_t>(v));
         }
     const auto rank = [&](std::int32_t v) {
-        return static_cast<std::size_t>(std::lower_bound(mesh.irregular_vertices.begin(),
-                                                         mesh.irregular_vertices.end(), v) -
-                                        mesh.irregular_vertices.begin());
+        return static_cast<std::size_t>(
+            std::lower_bound(mesh.irregular_vertices.begin(), mesh.irregular_vertices.end(), v) -
+            mesh.irregular_vertices.begin());
     };
     const std::size_t ni = mesh.irregular_vertices.size();
     std::vector<std::uint32_t> offsets(ni + 1, 0);
@@ -326,12 +327,15 @@ MeshTopology mesh_topology(const TriangleMesh& mesh) {
                static_cast<std::uint64_t>(std::lower_bound(nb.begin(), nb.end(), b) - nb.begin());
     };
     // Each edge (a < b) counts its triangles at the slot a -> b.
+    // (Triangles through for_each_triangle: a DEM mesh may have released them.)
+    using Corners = std::array<std::int32_t, 3>;
     std::vector<std::uint8_t> uses(first.back(), 0);
-    for (const auto& t : mesh.triangles)
+    detail::for_each_triangle(mesh, [&](std::size_t, const Corners& t) {
         for (int k = 0; k < 3; ++k) {
             const auto s = slot(std::min(t[k], t[(k + 1) % 3]), std::max(t[k], t[(k + 1) % 3]));
             uses[s] = static_cast<std::uint8_t>(std::min(uses[s] + 1, 3));
         }
+    });
     detail::DisjointSets<std::uint32_t> sets(topo.vertices);
     // Boundary loops: components of the graph of boundary edges.
     std::vector<std::uint32_t> boundary_vertices;
@@ -354,11 +358,11 @@ MeshTopology mesh_topology(const TriangleMesh& mesh) {
                                  boundary_vertices.begin());
     // Components by triangles.
     sets.reset(topo.vertices);
-    for (const auto& t : mesh.triangles)
-        for (int k = 1; k < 3; ++k) sets.unite(std::uint32_t(t[k]), std::uint32_t(t[0]));
     std::vector<char> used(topo.vertices, 0);
-    for (const auto& t : mesh.triangles)
+    detail::for_each_triangle(mesh, [&](std::size_t, const Corners& t) {
+        for (int k = 1; k < 3; ++k) sets.unite(std::uint32_t(t[k]), std::uint32_t(t[0]));
         for (int k = 0; k < 3; ++k) used[t[k]] = 1;
+    });
     for (std::size_t v = 0; v < topo.vertices; ++v)
         if (used[v] && sets.is_root(std::uint32_t(v))) ++topo.components;
     topo.euler_characteristic =

@@ -84,9 +84,9 @@ std::vector<std::int32_t> representative_vertices(const TriangleMesh& mesh,
     for (std::size_t v = 0; v < n; ++v) {
         sources.at(v, n);
         bool source = on_boundary[v];
-        for (const auto w : mesh.neighbors_of(v))
-            if (source) break;
-            else source = labels[static_cast<std::size_t>(w)] != labels[v];
+        const auto nb = mesh.neighbors_of(v);
+        for (auto w = nb.begin(); !source && w != nb.end(); ++w)
+            source = labels[static_cast<std::size_t>(*w)] != labels[v];
         if (source) {
             depth[v] = 0;
             queue.push_back(static_cast<std::int32_t>(v));

@@ -32,7 +32,6 @@ TriangleMesh dem_to_mesh(const Dem& dem, const DemToMeshOptions& options = {},
 // A copy of mesh.pixel_vertex when the mesh has it.
 std::vector<std::int32_t> pixel_to_vertex(const TriangleMesh& mesh, const Dem& dem);
 // The same, into `out`.
-void fill_pixel_to_vertex(const TriangleMesh& mesh, const Dem& dem,
-                          std::vector<std::int32_t>& out);
+void fill_pixel_to_vertex(const TriangleMesh& mesh, const Dem& dem, std::vector<std::int32_t>& out);
 
 }  // namespace terrain::mesh

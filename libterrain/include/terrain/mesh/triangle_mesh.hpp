@@ -19,13 +19,13 @@ namespace terrain {
 // The neighbours of one vertex, sorted by index: a view of a stored list, or the few a grid
 // computes, held in the object itself (so it may be copied freely).
 class VertexNeighbors {
-public:
+  public:
     const std::int32_t* begin() const { return list_ ? list_ : own_.data(); }
     const std::int32_t* end() const { return begin() + size_; }
     std::size_t size() const { return size_; }
     std::int32_t operator[](std::size_t i) const { return begin()[i]; }
 
-private:
+  private:
     friend struct TriangleMesh;
     const std::int32_t* list_ = nullptr;
     std::uint32_t size_ = 0;
@@ -94,8 +94,8 @@ struct TriangleMesh {
         return triangles_released() ? released_triangles_ : triangles.size();
     }
     // A DEM mesh may free its triangles once no stage needs them at random (after the Reeb
-    // graph): detail::for_each_triangle (src/mesh/grid_triangles.hpp) makes them again from the grid, in order.
-    // Returns false, keeping them, for a mesh that cannot (read from a file).
+    // graph): detail::for_each_triangle (src/mesh/grid_triangles.hpp) makes them again from the
+    // grid, in order. Returns false, keeping them, for a mesh that cannot (read from a file).
     bool release_triangles();
     bool triangles_released() const { return released_triangles_ > 0; }
     std::array<double, 3> position(std::size_t v) const {
@@ -122,15 +122,13 @@ struct TriangleMesh {
     }
     std::size_t degree(std::size_t v) const { return neighbors_of(v).size(); }
     // Edges of the adjacency (each counted once).
-    std::size_t edge_count() const {
-        return grid_adjacency() ? grid_edges : neighbors.size() / 2;
-    }
+    std::size_t edge_count() const { return grid_adjacency() ? grid_edges : neighbors.size() / 2; }
     // Bytes held by the arrays above (capacity, not size).
     std::size_t memory_bytes() const;
     // Frees the adjacency (both forms).
     void release_adjacency();
 
-private:
+  private:
     VertexNeighbors irregular_neighbors_of(std::size_t v) const;
     std::size_t released_triangles_ = 0;
 };
