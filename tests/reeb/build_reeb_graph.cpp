@@ -311,6 +311,48 @@ TEST_CASE("The contour tree and the sweep give the same graph on disks and spher
     }
 }
 
+TEST_CASE("A DEM mesh's Reeb graph is the same with its triangles released", "[reeb]") {
+    // pipeline::compute_reeb releases a tree's triangles before the Reeb graph: the contour
+    // tree then walks them again from the grid (links, plateaus' stars, loop check).
+    const auto dem = io::read_dem(test::sample("vesta_hamo_tile.lbl"));
+    const auto disk = mesh::dem_to_mesh(dem);
+    const auto globe_dem = io::read_dem(test::sample("moon_ldem1_global.tif"));
+    const auto sphere = mesh::dem_to_mesh(globe_dem);
+    // Two fans meeting at a pinch, on a grid with a NoData column: two disks, one copy.
+    const auto pinched = mesh::dem_to_mesh(test::grid_dem(9, 9, [](int c, int r) {
+        return c == 4 && r != 4 ? std::nan("") : std::sin(0.9 * c) * std::cos(0.7 * r);
+    }));
+    REQUIRE(pinched.pinched_vertices == 1);
+    auto quantized = [](std::vector<float> f) {
+        for (float& x : f) x = std::floor(x / 25);  // noise_field is in [0, 100): plateaus
+        return f;
+    };
+    const std::vector<std::pair<const TriangleMesh*, std::vector<float>>> cases = {
+        {&disk, field::shape_index_field(disk)},
+        {&disk, quantized(test::noise_field(disk.vertex_count(), 3))},
+        {&sphere, field::height_field(sphere, &globe_dem)},
+        {&sphere, quantized(test::noise_field(sphere.vertex_count(), 7))},
+        {&pinched, quantized(test::noise_field(pinched.vertex_count(), 11))},
+    };
+    for (const auto& [mesh, f] : cases) {
+        TriangleMesh released = *mesh;
+        REQUIRE(reeb::reeb_is_tree(released));
+        REQUIRE(released.release_triangles());
+        CHECK(reeb::reeb_is_tree(released));
+        const auto a = reeb::build_reeb_graph(*mesh, f);
+        const auto b = reeb::build_reeb_graph(released, f);
+        REQUIRE(reeb::check_reeb_graph(b, f).empty());
+        CHECK(a.node_values == b.node_values);
+        CHECK(a.node_kinds == b.node_kinds);
+        CHECK(a.node_lower_links == b.node_lower_links);
+        CHECK(a.node_upper_links == b.node_upper_links);
+        CHECK(a.node_vertices == b.node_vertices);
+        CHECK(a.vertex_nodes == b.vertex_nodes);
+        CHECK(a.arcs == b.arcs);
+        CHECK(a.arc_nodes == b.arc_nodes);
+    }
+}
+
 TEST_CASE("The Reeb graph's progress is monotone, on the caller's thread, whatever the threads",
           "[reeb]") {
     // The join and split sweeps run side by side; with one thread they run one after the

@@ -53,11 +53,14 @@ void TriangleMesh::release_adjacency() {
     grid_edges = 0;
 }
 
+bool TriangleMesh::triangles_releasable() const {
+    return !triangles.empty() && grid_width >= 1 && vertex_pixel.size() == positions.size() &&
+           pixel_vertex.size() == std::size_t(grid_width) * std::size_t(grid_height);
+}
+
 bool TriangleMesh::release_triangles() {
     if (triangles_released()) return true;
-    if (triangles.empty() || grid_width < 1 || vertex_pixel.size() != positions.size() ||
-        pixel_vertex.size() != std::size_t(grid_width) * std::size_t(grid_height))
-        return false;
+    if (!triangles_releasable()) return false;
     released_triangles_ = triangles.size();
     detail::release(triangles);
     return true;

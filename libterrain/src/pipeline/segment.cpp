@@ -203,12 +203,15 @@ void compute_field(SegmentResult& result, const SegmentOptions& options,
 
 reeb::ReebGraph compute_reeb(SegmentResult& result, const ProgressFn& progress) {
     const auto t0 = clock::now();
-    auto graph = reeb::build_reeb_graph(result.input.mesh, result.field, {},
-                                        scaled_progress(progress, 0, 0.95));
+    auto& mesh = result.input.mesh;
+    // A DEM mesh frees its triangles (24 bytes a pixel) once no stage needs them at random,
+    // and the stages after make them again from the grid, in order. When the Reeb graph is a
+    // tree (every component a disk or a sphere: the contour tree makes it) that is before it;
+    // with loops the contour-tracking sweep walks them at random, so after.
+    if (mesh.triangles_releasable() && reeb::reeb_is_tree(mesh)) mesh.release_triangles();
+    auto graph = reeb::build_reeb_graph(mesh, result.field, {}, scaled_progress(progress, 0, 0.95));
     result.critical_before = reeb::summarize(graph, scaled_progress(progress, 0.95, 1)).critical;
-    // No later stage needs the triangles at random: a DEM mesh frees them (24 bytes a pixel)
-    // and the region graph makes them again from the grid.
-    result.input.mesh.release_triangles();
+    mesh.release_triangles();
     result.add_time("reeb", since(t0));
     return graph;
 }

@@ -24,6 +24,7 @@
 #include "../core/indices.hpp"
 #include "../core/pass_progress.hpp"
 #include "../core/release.hpp"
+#include "../mesh/grid_triangles.hpp"
 #include "link_components.hpp"
 #include "terrain/core/error.hpp"
 
@@ -37,16 +38,20 @@ bool loop_free(const TriangleMesh& mesh) {
     // A component's Euler characteristic is 2 - 2g - b: it is 1 or 2 exactly when the
     // component is a disk (g = 0, b = 1) or a sphere (g = 0, b = 0).
     const std::size_t nv = mesh.vertex_count();
+    // (Triangles through for_each_triangle: a DEM mesh may have released them.)
+    using Corners = std::array<i32, 3>;
     detail::DisjointSets<i32> components(nv);  // each rooted at its lowest vertex
-    for (const auto& t : mesh.triangles)
+    detail::for_each_triangle(mesh, [&](std::size_t, const Corners& t) {
         for (int k = 0; k < 2; ++k) components.unite_to_smaller(t[idx(k)], t[idx(k + 1)]);
+    });
     std::vector<std::int64_t> chi(nv, 0);
     for (std::size_t v = 0; v < nv; ++v) {
         std::int64_t upper_neighbours = 0;
         for (const i32 w : mesh.neighbors_of(v)) upper_neighbours += idx(w) > v;
         chi[idx(components.find(static_cast<i32>(v)))] += 1 - upper_neighbours;
     }
-    for (const auto& t : mesh.triangles) chi[idx(components.find(t[0]))] += 1;
+    detail::for_each_triangle(
+        mesh, [&](std::size_t, const Corners& t) { chi[idx(components.find(t[0]))] += 1; });
     for (std::size_t v = 0; v < nv; ++v)
         if (components.is_root(static_cast<i32>(v)) && chi[v] != 1 && chi[v] != 2) return false;
     return true;

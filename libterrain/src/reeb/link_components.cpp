@@ -11,6 +11,7 @@
 #include <algorithm>
 
 #include "../core/pass_progress.hpp"
+#include "../mesh/grid_triangles.hpp"
 
 namespace terrain::reeb::internal {
 
@@ -19,9 +20,23 @@ using detail::kNone;
 
 std::pair<int, int> LinkCounter::count(const TriangleMesh& mesh, const ReebGraph& g, i32 e,
                                        const std::vector<i32>& star) {
+    return count_star(
+        g, e,
+        star.size(), [&](std::size_t i) -> const auto& { return mesh.triangles[idx(star[i])]; });
+}
+
+std::pair<int, int> LinkCounter::count(const ReebGraph& g, i32 e,
+                                       const std::vector<std::array<i32, 3>>& star) {
+    return count_star(
+        g, e, star.size(), [&](std::size_t i) -> const auto& { return star[i]; });
+}
+
+template <class Corners>
+std::pair<int, int> LinkCounter::count_star(const ReebGraph& g, i32 e, std::size_t size,
+                                            const Corners& corners) {
     verts_.clear();
-    for (const i32 t : star)
-        for (const i32 c : mesh.triangles[idx(t)])
+    for (std::size_t i = 0; i < size; ++i)
+        for (const i32 c : corners(i))
             if (g.vertex_nodes[idx(c)] != e) verts_.push_back(c);
     std::sort(verts_.begin(), verts_.end());
     verts_.erase(std::unique(verts_.begin(), verts_.end()), verts_.end());
@@ -29,8 +44,8 @@ std::pair<int, int> LinkCounter::count(const TriangleMesh& mesh, const ReebGraph
     auto index = [&](i32 v) {
         return static_cast<i32>(std::lower_bound(verts_.begin(), verts_.end(), v) - verts_.begin());
     };
-    for (const i32 t : star) {
-        const auto& tri = mesh.triangles[idx(t)];
+    for (std::size_t i = 0; i < size; ++i) {
+        const auto& tri = corners(i);
         for (int j = 0; j < 3; ++j) {
             const i32 a = tri[idx(j)], b = tri[idx((j + 1) % 3)];
             const i32 na = g.vertex_nodes[idx(a)], nb = g.vertex_nodes[idx(b)];
@@ -65,9 +80,9 @@ std::vector<LinkReps> link_components(const TriangleMesh& mesh, const ReebGraph&
     std::vector<Star> stars;
     detail::assign_in_slices(stars, nv, Star{{kNone, kNone, kNone, kNone}, 0, 0, 0, {0, 0}},
                              detail::PassProgress(progress, 0, 0.2, "reeb: links"));
-    for (std::size_t ti = 0; ti < nt; ++ti) {
+    // (Through for_each_triangle: a DEM mesh may have released its triangles.)
+    detail::for_each_triangle(mesh, [&](std::size_t ti, const std::array<i32, 3>& t) {
         by_triangle.at(ti, nt);
-        const auto& t = mesh.triangles[ti];
         const std::array<i32, 3> n{node[idx(t[0])], node[idx(t[1])], node[idx(t[2])]};
         for (const i32 c : t) ++stars[idx(c)].triangles;
         if (n[0] != n[1] && n[1] != n[2] && n[0] != n[2]) {
@@ -84,7 +99,7 @@ std::vector<LinkReps> link_components(const TriangleMesh& mesh, const ReebGraph&
             const int side = n[idx(a)] > n[idx(mid)] ? 0 : 1;
             s.starts[idx(2 * side + (s.runs[idx(side)] & 1))] = n[idx(b)];
             ++s.runs[idx(side)];
-            continue;
+            return;
         }
         // Two corners in one node (a plateau): the third sees an edge of its lower or upper
         // link; the plateau's corners see an edge touching their node, which does not count.
@@ -93,7 +108,7 @@ std::vector<LinkReps> link_components(const TriangleMesh& mesh, const ReebGraph&
             stars[idx(t[idx(k)])].lower_edges += (m > p) & (m > q);
             stars[idx(t[idx(k)])].upper_edges += (m < p) & (m < q);
         }
-    }
+    });
     std::vector<LinkReps> reps;
     detail::assign_in_slices(reps, nn, LinkReps{},
                              detail::PassProgress(progress, 0.6, 0.65, "reeb: links"));
@@ -149,19 +164,31 @@ void count_general_links(const TriangleMesh& mesh, ReebGraph& g, const std::vect
             wanted[idx(g.node_vertices[idx(i)])] = 1;
     }
     if (wanted.empty()) return;
-    std::vector<std::pair<i32, i32>> star;  // (node, triangle)
+    // (node, triangle's index, its corners), through for_each_triangle: a DEM mesh may have
+    // released its triangles.
+    struct Entry {
+        i32 node, triangle;
+        std::array<i32, 3> corners;
+    };
+    std::vector<Entry> star;
     const detail::PassProgress heartbeat(progress, 0, 0, "reeb: links");
-    for (std::size_t t = 0; t < mesh.triangle_count(); ++t)
-        for (heartbeat.at(t, mesh.triangle_count()); const i32 c : mesh.triangles[t])
-            if (wanted[idx(c)]) star.push_back({g.vertex_nodes[idx(c)], static_cast<i32>(t)});
-    std::sort(star.begin(), star.end());
+    const std::size_t nt = mesh.triangle_count();
+    detail::for_each_triangle(mesh, [&](std::size_t t, const std::array<i32, 3>& corners) {
+        heartbeat.at(t, nt);
+        for (const i32 c : corners)
+            if (wanted[idx(c)])
+                star.push_back({g.vertex_nodes[idx(c)], static_cast<i32>(t), corners});
+    });
+    std::sort(star.begin(), star.end(), [](const Entry& a, const Entry& b) {
+        return a.node != b.node ? a.node < b.node : a.triangle < b.triangle;
+    });
     LinkCounter counter;
-    std::vector<i32> tris;
+    std::vector<std::array<i32, 3>> tris;
     for (std::size_t i = 0; i < star.size();) {
-        const i32 n = star[i].first;
+        const i32 n = star[i].node;
         tris.clear();
-        for (; i < star.size() && star[i].first == n; ++i) tris.push_back(star[i].second);
-        set_links(g, n, counter.count(mesh, g, n, tris));
+        for (; i < star.size() && star[i].node == n; ++i) tris.push_back(star[i].corners);
+        set_links(g, n, counter.count(g, n, tris));
     }
 }
 

@@ -23,11 +23,17 @@ using detail::i32;
 // it (the paper's link subgraphs).
 class LinkCounter {
   public:
-    // `star`: the triangles with a corner in node e (repeats allowed).
+    // `star`: the triangles with a corner in node e (repeats allowed), by index.
     std::pair<int, int> count(const TriangleMesh& mesh, const ReebGraph& g, i32 e,
                               const std::vector<i32>& star);
+    // The same from the triangles' corners.
+    std::pair<int, int> count(const ReebGraph& g, i32 e,
+                              const std::vector<std::array<i32, 3>>& star);
 
   private:
+    template <class Corners>
+    std::pair<int, int> count_star(const ReebGraph& g, i32 e, std::size_t size,
+                                   const Corners& corners);
     std::vector<i32> verts_;
     detail::DisjointSets<i32> components_;  // over verts_
 };

@@ -153,11 +153,14 @@ SimplifyResult simplify(const TriangleMesh& mesh, ReebGraph&& graph, const Simpl
     detail::release(graph.node_arcs);
     internal::Simplifier simplifier(mesh, graph, options, internal::kBigDegree, progress);
     simplifier.own_input(graph);
-    // The working copy holds the arcs now; the output reads only the vertex lists and links.
+    // The working copy holds the arcs and the values now; the output reads only the vertex
+    // lists and links.
     detail::release(graph.arcs);
     detail::release(graph.arc_offsets);
     detail::release(graph.arc_nodes);
     detail::release(graph.node_kinds);
+    detail::release(graph.node_values);
+    detail::release(graph.vertex_nodes);
     simplifier.run(progress, result);  // (which leaves the graph empty)
     return result;
 }

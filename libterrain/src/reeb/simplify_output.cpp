@@ -17,7 +17,7 @@ namespace terrain::reeb::internal {
 using detail::find_root;
 
 void WorkingGraph::write_result(SimplifyResult& result, const ProgressFn& progress) {
-    const std::size_t nn = g_.node_count(), nl = regular_.size();
+    const std::size_t nn = input_nodes_, nl = regular_.size();
     // Its passes: the fates (0 to 0.2), the new numbers (to 0.3), the arcs (to 0.4), the
     // vertices (to 0.8), the field (to 1).
     using detail::PassProgress;
@@ -112,7 +112,7 @@ void WorkingGraph::write_result(SimplifyResult& result, const ProgressFn& progre
     detail::release(kept);
     release_working_graph();
     // Vertices: grouped by new node, in the order of their old nodes.
-    const std::size_t nv = g_.vertex_nodes.size();
+    const std::size_t nv = input_vertices_;
     for (std::size_t i = 1; i < size.size(); ++i) size[i] += size[i - 1];
     out.node_vertex_offsets = size;
     detail::assign_in_slices(out.node_vertices, g_.node_vertices.size(), i32{0}, made(0.4));

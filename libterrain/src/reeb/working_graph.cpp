@@ -156,7 +156,10 @@ double node_area(const TriangleMesh& mesh, const ReebGraph& g, std::size_t n,
 
 WorkingGraph::WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big_degree,
                            const ProgressFn& progress)
-    : g_(g), big_degree_(big_degree) {
+    : g_(g),
+      input_nodes_(g.node_count()),
+      input_vertices_(g.vertex_nodes.size()),
+      big_degree_(big_degree) {
     // Its passes: the lists (0 to 0.1), the nodes (to 0.6), the arcs (to 1), each with its
     // large blocks made a slice at a time (their first touch is slow, docs/performance.md).
     using detail::PassProgress;

@@ -336,6 +336,9 @@ class WorkingGraph {
     }
 
     const ReebGraph& g_;
+    // g_'s node and vertex counts (a graph handed over may have given up the arrays they
+    // come from once copied).
+    std::size_t input_nodes_ = 0, input_vertices_ = 0;
     // Each node of g_: its number here (then, in write_result, its node in the result).
     std::vector<i32> node_map_;
     i32 critical_count_ = 0;  // critical nodes: 0 .. critical_count_ - 1

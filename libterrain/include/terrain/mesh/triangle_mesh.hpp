@@ -98,6 +98,8 @@ struct TriangleMesh {
     // grid, in order. Returns false, keeping them, for a mesh that cannot (read from a file).
     bool release_triangles();
     bool triangles_released() const { return released_triangles_ > 0; }
+    // Whether release_triangles would free them (a DEM mesh that holds them).
+    bool triangles_releasable() const;
     std::array<double, 3> position(std::size_t v) const {
         const auto& p = positions[v];
         return {origin[0] + p[0], origin[1] + p[1], origin[2] + p[2]};
