@@ -148,19 +148,11 @@ SimplifyResult simplify(const TriangleMesh& mesh, ReebGraph&& graph, const Simpl
     if (graph.vertex_nodes.size() != mesh.vertex_count())
         throw Error("simplify", "the graph was not built on this mesh");
     SimplifyResult result;
-    // The copy does not read the regular nodes' arcs: they go before it (the copy's end is
-    // the peak of the simplification's memory).
-    detail::release(graph.node_arcs);
-    internal::Simplifier simplifier(mesh, graph, options, internal::kBigDegree, progress);
+    // The copy frees the graph's arrays as it reads them for the last time (the copy's end is
+    // the peak of the simplification's memory); the output reads only the vertex lists and
+    // links, and frees them too.
+    internal::Simplifier simplifier(mesh, graph, options, internal::kBigDegree, progress, &graph);
     simplifier.own_input(graph);
-    // The working copy holds the arcs and the values now; the output reads only the vertex
-    // lists and links.
-    detail::release(graph.arcs);
-    detail::release(graph.arc_offsets);
-    detail::release(graph.arc_nodes);
-    detail::release(graph.node_kinds);
-    detail::release(graph.node_values);
-    detail::release(graph.vertex_nodes);
     simplifier.run(progress, result);  // (which leaves the graph empty)
     return result;
 }

@@ -155,7 +155,7 @@ double node_area(const TriangleMesh& mesh, const ReebGraph& g, std::size_t n,
 }  // namespace
 
 WorkingGraph::WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big_degree,
-                           const ProgressFn& progress)
+                           const ProgressFn& progress, ReebGraph* owned)
     : g_(g),
       input_nodes_(g.node_count()),
       input_vertices_(g.vertex_nodes.size()),
@@ -166,6 +166,10 @@ WorkingGraph::WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big
     const PassProgress lists(progress, 0.03, 0.1, "simplify"),
         nodes(progress, 0.25, 0.6, "simplify"), arcs(progress, 0.76, 1, "simplify");
     const std::size_t nn = g.node_count(), na = g.arc_count(), nl = g.arc_nodes.size();
+    if (owned) {  // not read here: the regular nodes' arcs, the vertices' nodes
+        detail::release(owned->node_arcs);
+        detail::release(owned->vertex_nodes);
+    }
     // node_map_[n]: arc ends marked, the other regular nodes of the lists by their position in
     // arc_nodes (`placed` says which positions hold their node); then the new numbers.
     constexpr i32 kEnd = -2;
@@ -217,6 +221,10 @@ WorkingGraph::WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big
         }
     }
     total_area_ = mesh_area_or_one(total_area_);
+    if (owned) {  // the nodes are copied
+        detail::release(owned->node_values);
+        detail::release(owned->node_kinds);
+    }
     // Arc a joins its lower then its upper end, a in order.
     detail::assign_in_slices(arcs_, na, Arc{}, PassProgress(progress, 0.6, 0.7, "simplify"));
     detail::assign_in_slices(set_parent_, na, kNone, PassProgress(progress, 0.7, 0.73, "simplify"));
@@ -246,6 +254,11 @@ WorkingGraph::WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big
             arc.tail = r;
             arc.area += area(r);
         }
+    }
+    if (owned) {  // the arcs are copied
+        detail::release(owned->arcs);
+        detail::release(owned->arc_offsets);
+        detail::release(owned->arc_nodes);
     }
 }
 

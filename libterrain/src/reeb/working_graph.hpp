@@ -49,9 +49,13 @@ class WorkingGraph {
     // Throws terrain::Error when an arc's list holds an arc end or a node of another list.
     // Nodes reaching big_degree arcs become big (kBigDegree; tests lower it to exercise big
     // nodes on small graphs and raise it to turn them off). The copy reports its progress
-    // (0 to 1), as the output does: each is a pass over every node, vertex and arc.
+    // (0 to 1), as the output does: each is a pass over every node, vertex and arc. With
+    // `owned` (g itself, handed over: simplify(ReebGraph&&)) the copy frees g's arrays as it
+    // reads them for the last time (its values, kinds, vertex nodes and arcs), so that they
+    // are not held beside the working graph at the peak of the simplification's memory; the
+    // vertex lists and links stay for write_result.
     WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big_degree = kBigDegree,
-                 const ProgressFn& progress = {});
+                 const ProgressFn& progress = {}, ReebGraph* owned = nullptr);
 
     // The simplified graph and the rewritten field (simplify_output.cpp). The working graph is
     // freed as it goes: nothing else may be asked of it after.
