@@ -3,7 +3,7 @@
 // graph laid out for few cache misses. Nodes are numbered anew: first the nodes that are in no
 // arc's list (the critical ones, the only possible arc ends), in their order, then the listed
 // regular nodes in the order of arc_nodes, so that each list starts out contiguous. A
-// critical node is one 64-byte record (value, area, flags, arc counts and its arcs: up to 8
+// critical node is one 48-byte record (value, area, flags, arc counts and its arcs: up to 4
 // in the record, more in a run of a shared arena); regular nodes sit in doubly linked lists,
 // one per arc, sorted by value. A list absorbed whole is never walked: its area moves at once
 // and its nodes learn where they went in the output, through union-find sets of lists (see
@@ -67,10 +67,13 @@ class WorkingGraph {
     std::size_t working_bytes() const;
 
   protected:
-    // A critical node (one of the first critical_count_), in one cache line: its fields and its
-    // `size` arcs, the newest last, with room for kInline << shift (see arc_run()).
-    static constexpr i32 kInline = 8;
-    struct alignas(64) CriticalNode {
+    // A critical node (one of the first critical_count_): its fields and its `size` arcs, the
+    // newest last, with room for kInline << shift (see arc_run()). 48 bytes: about half the
+    // vertices of a noisy grid are critical, and a 64-byte record with 8 arcs inline was
+    // both larger (8 bytes a pixel more at the simplification's peak) and slower (bench_reeb,
+    // 4 M vertices: 1.27-1.37 s against 1.02-1.20 s): most nodes have 1 to 4 arcs.
+    static constexpr i32 kInline = 4;
+    struct alignas(16) CriticalNode {
         double area = 0;  // its vertices' and its absorbed nodes' area
         float value = 0;
         mutable i32 forward = kNone;  // the node that absorbed it (live() shortens the path)
@@ -83,7 +86,7 @@ class WorkingGraph {
         // in its arc's list.
         std::array<i32, kInline> own{};
     };
-    static_assert(sizeof(CriticalNode) == 64);
+    static_assert(sizeof(CriticalNode) == 48);
     // A node's `forward`: the critical node that absorbed it; for a node in a list, -2 - the
     // set of its list (see Arc::set); kNone for a critical node.
     struct RegularNode {
