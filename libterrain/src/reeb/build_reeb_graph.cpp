@@ -21,8 +21,8 @@
 
 namespace terrain::reeb {
 
-bool reeb_is_tree(const TriangleMesh& mesh) {
-    return internal::loop_free(mesh);
+bool reeb_is_tree(const TriangleMesh& mesh, const ProgressFn& progress) {
+    return internal::loop_free(mesh, progress);
 }
 
 ReebGraph build_reeb_graph(const TriangleMesh& mesh, const std::vector<float>& field,

@@ -34,24 +34,32 @@ using detail::i32;
 using detail::idx;
 using detail::kNone;
 
-bool loop_free(const TriangleMesh& mesh) {
+bool loop_free(const TriangleMesh& mesh, const ProgressFn& progress) {
     // A component's Euler characteristic is 2 - 2g - b: it is 1 or 2 exactly when the
     // component is a disk (g = 0, b = 1) or a sphere (g = 0, b = 0).
-    const std::size_t nv = mesh.vertex_count();
+    const std::size_t nv = mesh.vertex_count(), nt = mesh.triangle_count();
+    // Its passes: the triangles (0 to 0.4), the vertices (to 0.7), the triangles (to 1).
+    const detail::PassProgress joined(progress, 0, 0.4, "reeb: loops"),
+        counted(progress, 0.4, 0.7, "reeb: loops"), closed(progress, 0.7, 1, "reeb: loops");
     // (Triangles through for_each_triangle: a DEM mesh may have released them.)
     using Corners = std::array<i32, 3>;
     detail::DisjointSets<i32> components(nv);  // each rooted at its lowest vertex
-    detail::for_each_triangle(mesh, [&](std::size_t, const Corners& t) {
+    detail::for_each_triangle(mesh, [&](std::size_t i, const Corners& t) {
+        joined.at(i, nt);
         for (int k = 0; k < 2; ++k) components.unite_to_smaller(t[idx(k)], t[idx(k + 1)]);
     });
     std::vector<std::int64_t> chi(nv, 0);
     for (std::size_t v = 0; v < nv; ++v) {
+        counted.at(v, nv);
         std::int64_t upper_neighbours = 0;
         for (const i32 w : mesh.neighbors_of(v)) upper_neighbours += idx(w) > v;
         chi[idx(components.find(static_cast<i32>(v)))] += 1 - upper_neighbours;
     }
-    detail::for_each_triangle(
-        mesh, [&](std::size_t, const Corners& t) { chi[idx(components.find(t[0]))] += 1; });
+    detail::for_each_triangle(mesh, [&](std::size_t i, const Corners& t) {
+        closed.at(i, nt);
+        chi[idx(components.find(t[0]))] += 1;
+    });
+    report_progress(progress, 1.0, "reeb: loops");
     for (std::size_t v = 0; v < nv; ++v)
         if (components.is_root(static_cast<i32>(v)) && chi[v] != 1 && chi[v] != 2) return false;
     return true;

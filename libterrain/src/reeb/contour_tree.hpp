@@ -9,7 +9,8 @@ namespace terrain::reeb::internal {
 
 // True when the Reeb graph of any field on the mesh is a tree: every connected component is
 // of genus 0 with at most one boundary loop (a disk or a sphere). Assumes a 2-manifold.
-bool loop_free(const TriangleMesh& mesh);
+// Reports its passes (triangles, vertices, triangles) through `progress`, 0 to 1.
+bool loop_free(const TriangleMesh& mesh, const ProgressFn& progress = {});
 
 // The Reeb graph of the field whose events order_events put in g, when the mesh has no loops
 // (then it is the contour tree). Returns false, leaving the graph half made, when the mesh

@@ -113,8 +113,8 @@ struct ReebOptions {
 };
 
 // True when every connected component of the mesh is a disk or a sphere, so that the Reeb
-// graph of any field on it is a tree.
-bool reeb_is_tree(const TriangleMesh& mesh);
+// graph of any field on it is a tree. Reports its progress ("reeb: loops", 0 to 1).
+bool reeb_is_tree(const TriangleMesh& mesh, const ProgressFn& progress = {});
 
 // The Reeb graph of `field` (one value per mesh vertex, no NaN) on a consistently oriented
 // 2-manifold mesh, as dem_to_mesh and read_mesh make them (the contour tree reads each
