@@ -208,10 +208,10 @@ reeb::ReebGraph compute_reeb(SegmentResult& result, const ProgressFn& progress) 
     // and the stages after make them again from the grid, in order. When the Reeb graph is a
     // tree (every component a disk or a sphere: the contour tree makes it) that is before it;
     // with loops the contour-tracking sweep walks them at random, so after.
-    if (mesh.triangles_releasable() && reeb::reeb_is_tree(mesh, scaled_progress(progress, 0, 0.05)))
+    if (mesh.triangles_releasable() && reeb::reeb_is_tree(mesh, scaled_progress(progress, 0, 0.1)))
         mesh.release_triangles();
     auto graph =
-        reeb::build_reeb_graph(mesh, result.field, {}, scaled_progress(progress, 0.05, 0.95));
+        reeb::build_reeb_graph(mesh, result.field, {}, scaled_progress(progress, 0.1, 0.95));
     result.critical_before = reeb::summarize(graph, scaled_progress(progress, 0.95, 1)).critical;
     mesh.release_triangles();
     result.add_time("reeb", since(t0));
