@@ -52,9 +52,8 @@ std::vector<float> vertex_field(const TriangleMesh& mesh, const Dem* dem,
 
 std::vector<float> field_to_pixels(const TriangleMesh& mesh, const Dem& dem,
                                    const std::vector<float>& field) {
-    std::vector<std::int32_t> computed;  // when the mesh does not hold it
-    if (mesh.pixel_vertex.empty()) computed = mesh::pixel_to_vertex(mesh, dem);
-    const auto& p2v = mesh.pixel_vertex.empty() ? computed : mesh.pixel_vertex;
+    std::vector<std::int32_t> storage;
+    const auto& p2v = mesh::pixel_vertices(mesh, dem, storage);
     std::vector<float> out(p2v.size(), std::nanf(""));
     for (std::size_t p = 0; p < p2v.size(); ++p)
         if (p2v[p] >= 0) out[p] = field[static_cast<std::size_t>(p2v[p])];

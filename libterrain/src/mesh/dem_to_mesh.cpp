@@ -271,6 +271,13 @@ void fill_pixel_to_vertex(const TriangleMesh& mesh, const Dem& dem,
     }
 }
 
+const std::vector<std::int32_t>& pixel_vertices(const TriangleMesh& mesh, const Dem& dem,
+                                                std::vector<std::int32_t>& storage) {
+    if (!mesh.pixel_vertex.empty()) return mesh.pixel_vertex;
+    fill_pixel_to_vertex(mesh, dem, storage);
+    return storage;
+}
+
 std::vector<std::int32_t> pixel_to_vertex(const TriangleMesh& mesh, const Dem& dem) {
     if (!mesh.pixel_vertex.empty()) return mesh.pixel_vertex;
     std::vector<std::int32_t> out;

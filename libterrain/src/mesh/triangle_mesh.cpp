@@ -126,6 +126,24 @@ void check_adjacency_size(std::uint64_t entries, const char* what) {
 
 namespace {
 
+// Sorts each of the `count` lists lists[offsets[i] .. offsets[i + 1]) and drops its repeats,
+// packing them one after the other from the front of `lists`; packed(i, end) is told where
+// list i now ends. Returns the packed length.
+template <class Packed>
+std::size_t pack_sorted_lists(std::vector<std::int32_t>& lists,
+                              const std::vector<std::uint32_t>& offsets, std::size_t count,
+                              Packed&& packed) {
+    std::size_t write = 0;
+    for (std::size_t i = 0; i < count; ++i) {
+        auto begin = lists.begin() + offsets[i], end = lists.begin() + offsets[i + 1];
+        std::sort(begin, end);
+        end = std::unique(begin, end);
+        for (auto it = begin; it != end; ++it) lists[write++] = *it;
+        packed(i, write);
+    }
+    return write;
+}
+
 // Vertex areas: one third of each incident triangle (serial: the same sums every run).
 void set_vertex_areas(TriangleMesh& mesh, const detail::PassProgress& areas) {
     const std::size_t nt = mesh.triangles.size();
@@ -178,18 +196,14 @@ void finish_mesh(TriangleMesh& mesh, const ProgressFn& progress) {
     report_progress(progress, 0.6, "mesh");
     mesh.neighbor_offsets.assign(n + 1, 0);
     const detail::PassProgress sorted(progress, 0.6, 0.9, "mesh");
-    std::size_t write = 0;
-    for (std::size_t v = 0; v < n; ++v) {
-        auto begin = all.begin() + offsets[v], end = all.begin() + offsets[v + 1];
-        std::sort(begin, end);
-        end = std::unique(begin, end);
-        for (auto it = begin; it != end; ++it) all[write++] = *it;
-        if (write > std::size_t{INT32_MAX})
-            throw Error("mesh", "the mesh has more than 2^31 vertex neighbours (" +
-                                    std::to_string(n) + " vertices): too large");
-        mesh.neighbor_offsets[v + 1] = static_cast<std::int32_t>(write);
-        sorted.at(v, n);
-    }
+    const std::size_t write =
+        pack_sorted_lists(all, offsets, n, [&](std::size_t v, std::size_t end) {
+            if (end > std::size_t{INT32_MAX})
+                throw Error("mesh", "the mesh has more than 2^31 vertex neighbours (" +
+                                        std::to_string(n) + " vertices): too large");
+            mesh.neighbor_offsets[v + 1] = static_cast<std::int32_t>(end);
+            sorted.at(v, n);
+        });
     detail::copy_in_slices(mesh.neighbors, all.data(), write,
                            detail::PassProgress(progress, 0.9, 1, "mesh"));
 }
@@ -298,18 +312,25 @@ void finish_grid_mesh(TriangleMesh& mesh, const ProgressFn& progress) {
     }
     detail::release(irregular);
     mesh.irregular_offsets.assign(ni + 1, 0);
-    std::size_t write = 0;
-    for (std::size_t i = 0; i < ni; ++i) {
-        auto begin = lists.begin() + offsets[i], end = lists.begin() + offsets[i + 1];
-        std::sort(begin, end);
-        end = std::unique(begin, end);
-        for (auto it = begin; it != end; ++it) lists[write++] = *it;
-        mesh.irregular_offsets[i + 1] = static_cast<std::uint32_t>(write);
-    }
+    const std::size_t write =
+        pack_sorted_lists(lists, offsets, ni, [&](std::size_t i, std::size_t end) {
+            mesh.irregular_offsets[i + 1] = static_cast<std::uint32_t>(end);
+        });
     lists.resize(write);
     mesh.irregular_neighbors = std::move(lists);
     mesh.irregular_neighbors.shrink_to_fit();
     mesh.grid_edges = static_cast<std::size_t>((regular_degrees.load() + write) / 2);
+}
+
+std::vector<std::uint32_t> first_edge_slots(const TriangleMesh& mesh) {
+    const std::size_t n = mesh.vertex_count();
+    std::vector<std::uint32_t> first(n + 1, 0);
+    for (std::size_t v = 0; v < n; ++v) {
+        first[v + 1] = first[v] + static_cast<std::uint32_t>(mesh.degree(v));
+        if (first[v + 1] > std::uint32_t{INT32_MAX})
+            throw Error("mesh", "the mesh has more than 2^31 directed edges: too large");
+    }
+    return first;
 }
 
 MeshTopology mesh_topology(const TriangleMesh& mesh) {
@@ -321,9 +342,7 @@ MeshTopology mesh_topology(const TriangleMesh& mesh) {
     MeshTopology topo;
     topo.vertices = mesh.vertex_count();
     topo.faces = mesh.triangle_count();
-    // Each directed edge a -> b is a slot: a's first slot plus b's rank among a's neighbours.
-    std::vector<std::uint64_t> first(topo.vertices + 1, 0);
-    for (std::size_t v = 0; v < topo.vertices; ++v) first[v + 1] = first[v] + mesh.degree(v);
+    const auto first = first_edge_slots(mesh);
     const auto slot = [&](std::int32_t a, std::int32_t b) {
         const auto nb = mesh.neighbors_of(std::size_t(a));
         return first[std::size_t(a)] +

@@ -17,13 +17,7 @@ using detail::idx;
 using detail::kNone;
 
 HalfEdges build_half_edges(const TriangleMesh& mesh) {
-    const std::size_t nv = mesh.vertex_count();
-    std::vector<std::uint32_t> first(nv + 1, 0);
-    for (std::size_t v = 0; v < nv; ++v) {
-        first[v + 1] = first[v] + static_cast<std::uint32_t>(mesh.degree(v));
-        if (first[v + 1] > std::uint32_t{INT32_MAX})
-            throw Error("reeb", "the mesh has more than 2^31 directed edges: too large");
-    }
+    const auto first = first_edge_slots(mesh);
     auto slot = [&](i32 a, i32 b) -> i32 {
         const auto nb = mesh.neighbors_of(idx(a));
         const auto it = std::lower_bound(nb.begin(), nb.end(), b);

@@ -312,9 +312,8 @@ std::vector<std::uint32_t> label_pixels(const TriangleMesh& mesh, const Dem& dem
     if (mesh.vertex_pixel.size() != mesh.vertex_count() || labels.size() != mesh.vertex_count() ||
         dem.width != mesh.grid_width || dem.height != mesh.grid_height)
         throw Error("segment", "labels, mesh and DEM grid do not match");
-    std::vector<std::int32_t> computed;  // when the mesh does not hold it
-    if (mesh.pixel_vertex.empty()) computed = mesh::pixel_to_vertex(mesh, dem);
-    const auto& vertex = mesh.pixel_vertex.empty() ? computed : mesh.pixel_vertex;
+    std::vector<std::int32_t> storage;
+    const auto& vertex = mesh::pixel_vertices(mesh, dem, storage);
     report_progress(progress, 0.2, "regions");
     std::vector<std::uint32_t> out;  // made a slice at a time: its first touch is slow
     detail::assign_in_slices(out, vertex.size(), std::uint32_t{0},

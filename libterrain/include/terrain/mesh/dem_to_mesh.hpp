@@ -31,6 +31,9 @@ TriangleMesh dem_to_mesh(const Dem& dem, const DemToMeshOptions& options = {},
 // of a collapsed pole row all map to the pole vertex; a split pinch maps to its first copy.
 // A copy of mesh.pixel_vertex when the mesh has it.
 std::vector<std::int32_t> pixel_to_vertex(const TriangleMesh& mesh, const Dem& dem);
+// mesh.pixel_vertex when the mesh holds it (no copy), else the map made into `storage`.
+const std::vector<std::int32_t>& pixel_vertices(const TriangleMesh& mesh, const Dem& dem,
+                                                std::vector<std::int32_t>& storage);
 // The same, into `out`.
 void fill_pixel_to_vertex(const TriangleMesh& mesh, const Dem& dem, std::vector<std::int32_t>& out);
 

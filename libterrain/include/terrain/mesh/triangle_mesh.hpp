@@ -161,6 +161,11 @@ void finish_grid_mesh(TriangleMesh& mesh, const ProgressFn& progress = {});
 
 MeshTopology mesh_topology(const TriangleMesh& mesh);
 
+// Each vertex's first slot among the directed edges (the prefix sums of the degrees, n + 1 of
+// them): the edge a -> b is slot first[a] + b's rank among a's neighbours. Throws
+// terrain::Error (stage "mesh") past 2^31 directed edges.
+std::vector<std::uint32_t> first_edge_slots(const TriangleMesh& mesh);
+
 // Splits every vertex whose triangles form several fans (meeting only at the vertex): the
 // largest fan (ties: the one with the lowest triangle) keeps it, each other fan gets a copy
 // appended at the end (vertex_pixel copied too). Returns the number of vertices split and
