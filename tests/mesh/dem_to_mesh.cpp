@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <map>
 #include <numbers>
@@ -250,9 +251,25 @@ TEST_CASE("dem_to_mesh: a lon/lat grid has the same shape in the body and map fr
 
 namespace {
 
+// The positions freed and placed again from the DEM: the same floats, every vertex.
+void check_positions_placed_again(const TriangleMesh& mesh, const Dem& dem) {
+    TriangleMesh copy = mesh;
+    REQUIRE(copy.release_positions());
+    CHECK(copy.positions.empty());
+    CHECK(copy.vertex_count() == mesh.vertex_count());
+    mesh::restore_positions(dem, copy);
+    CHECK_FALSE(copy.positions_released());
+    REQUIRE(copy.positions.size() == mesh.positions.size());
+    std::size_t differ = 0;
+    for (std::size_t v = 0; v < mesh.vertex_count(); ++v)
+        differ += std::memcmp(copy.positions[v].data(), mesh.positions[v].data(),
+                              sizeof(mesh.positions[v])) != 0;
+    CHECK(differ == 0);
+}
+
 // The grid's adjacency against the CSR finish_mesh makes from the same triangles: the same
 // sorted lists, the same edge count. Returns the number of irregular vertices.
-std::size_t check_grid_adjacency(const TriangleMesh& mesh) {
+std::size_t check_grid_adjacency(const TriangleMesh& mesh, const Dem& dem) {
     REQUIRE(mesh.grid_adjacency());
     TriangleMesh csr = mesh;
     finish_mesh(csr);
@@ -267,9 +284,11 @@ std::size_t check_grid_adjacency(const TriangleMesh& mesh) {
     CHECK(degrees == 2 * mesh.edge_count());
     CHECK(mesh.edge_count() == csr.edge_count());
     CHECK(mesh.vertex_areas == csr.vertex_areas);
-    // The triangles made again from the grid once released: the same, in the same order.
+    // The triangles made again from the grid once released: the same, in the same order,
+    // from the diagonals recorded (no position is read: they are freed too).
     TriangleMesh released = mesh;
     REQUIRE(released.release_triangles());
+    REQUIRE(released.release_positions());
     CHECK(released.triangles.empty());
     CHECK(released.triangle_count() == mesh.triangle_count());
     std::size_t count = 0, wrong = 0;
@@ -286,6 +305,7 @@ std::size_t check_grid_adjacency(const TriangleMesh& mesh) {
     CHECK(after.boundary_loops == before.boundary_loops);
     CHECK(after.components == before.components);
     CHECK(after.euler_characteristic == before.euler_characteristic);
+    check_positions_placed_again(mesh, dem);
     return mesh.irregular_vertices.size();
 }
 
@@ -295,7 +315,7 @@ TEST_CASE("dem_to_mesh: the adjacency on the grid is the triangles' adjacency", 
     SECTION("a full tile: no vertex needs its own list") {
         const Dem dem =
             grid_dem(40, 30, 10.0, [](int c, int r) { return 5.0 * std::sin(0.3 * c + 0.2 * r); });
-        CHECK(check_grid_adjacency(mesh::dem_to_mesh(dem)) == 0);
+        CHECK(check_grid_adjacency(mesh::dem_to_mesh(dem), dem) == 0);
     }
     SECTION("NoData speckle: holes, pinches and isolated pixels") {
         std::uint32_t state = 12345;
@@ -306,7 +326,7 @@ TEST_CASE("dem_to_mesh: the adjacency on the grid is the triangles' adjacency", 
         const auto mesh = mesh::dem_to_mesh(dem);
         REQUIRE(mesh.pinched_vertices > 0);
         REQUIRE(mesh.isolated_vertices > 0);
-        const auto irregular = check_grid_adjacency(mesh);
+        const auto irregular = check_grid_adjacency(mesh, dem);
         CHECK(irregular > 0);
         CHECK(irregular < mesh.vertex_count() / 2);
     }
@@ -314,7 +334,8 @@ TEST_CASE("dem_to_mesh: the adjacency on the grid is the triangles' adjacency", 
         const Dem dem = io::read_dem(test::sample("moon_ldem1_global.tif"));
         const auto mesh = mesh::dem_to_mesh(dem);
         REQUIRE(mesh.seam_closed);
-        const auto irregular = check_grid_adjacency(mesh);
+        REQUIRE(mesh.pole_vertices[0] >= 0);
+        const auto irregular = check_grid_adjacency(mesh, dem);
         // The two seam columns, the poles and the rows next to them at most.
         CHECK(irregular >= 2);
         CHECK(irregular <= 2 * 180 + 2 + 2 * 360);
@@ -324,7 +345,7 @@ TEST_CASE("dem_to_mesh: the adjacency on the grid is the triangles' adjacency", 
         for (int r = 40; r < 60; ++r)
             for (int c : {0, 1, 358, 359}) dem.values[dem.index(c, r)] = kNaN;
         dem.values[dem.index(0, 100)] = kNaN;
-        check_grid_adjacency(mesh::dem_to_mesh(dem));
+        check_grid_adjacency(mesh::dem_to_mesh(dem), dem);
     }
     SECTION("rows growing northwards: the triangles turn the other way") {
         Dem dem = grid_dem(30, 20, 10.0, [](int c, int r) { return std::cos(0.4 * c) * r; });
@@ -332,7 +353,7 @@ TEST_CASE("dem_to_mesh: the adjacency on the grid is the triangles' adjacency", 
         geo::georeference(dem);
         const auto mesh = mesh::dem_to_mesh(dem);
         CHECK(mesh.triangles_flipped);
-        check_grid_adjacency(mesh);
+        check_grid_adjacency(mesh, dem);
     }
     SECTION("a mesh read from a file keeps its triangles") {
         TriangleMesh file =
@@ -340,6 +361,8 @@ TEST_CASE("dem_to_mesh: the adjacency on the grid is the triangles' adjacency", 
         file.pixel_vertex.clear();
         CHECK_FALSE(file.release_triangles());
         CHECK_FALSE(file.triangles.empty());
+        CHECK_FALSE(file.release_positions());
+        CHECK_FALSE(file.positions.empty());
     }
     SECTION("a grid two pixels wide keeps the CSR") {
         const Dem dem = grid_dem(2, 5, 1.0, [](int c, int r) { return double(c + r); });
@@ -451,6 +474,28 @@ TEST_CASE("dem_to_mesh: the same hill on a lon/lat grid and on a UTM grid has th
     CHECK(a.second == Approx(b.second).epsilon(0.005));
     CHECK(a.first == Approx(b.first).epsilon(0.005));
     CHECK(a.first > 0.02 * 2 * std::numbers::pi * sigma * sigma);  // the hill adds real area
+    // Every way of placing a vertex places it again the same (the positions freed during the
+    // Reeb graph and the simplification): a tangent plane, map metres, and the body frame from
+    // lon/lat and through the CRS's transformation.
+    mesh::DemToMeshOptions body;
+    body.frame = MeshFrame::body;
+    SECTION("lon/lat, tangent plane") {
+        check_positions_placed_again(mesh::dem_to_mesh(lonlat, tangent_plane), lonlat);
+    }
+    SECTION("lon/lat, body") {
+        check_positions_placed_again(mesh::dem_to_mesh(lonlat, body), lonlat);
+    }
+    SECTION("UTM, map metres") {
+        check_positions_placed_again(mesh::dem_to_mesh(utm), utm);
+    }
+    SECTION("UTM, body") {
+        check_positions_placed_again(mesh::dem_to_mesh(utm, body), utm);
+    }
+    SECTION("another grid is refused") {
+        TriangleMesh m = mesh::dem_to_mesh(utm);
+        REQUIRE(m.release_positions());
+        CHECK_THROWS_AS(mesh::restore_positions(lonlat, m), Error);
+    }
 }
 
 TEST_CASE("dem_to_mesh reports every pass of a large grid, never going back", "[mesh]") {

@@ -57,6 +57,10 @@ TEST_CASE("pipeline::segment gives labels, regions and the files of terrain segm
     std::vector<std::string> stages;
     for (const auto& t : result.timings) stages.push_back(t.name);
     CHECK(stages == std::vector<std::string>{"read", "mesh", "field", "reeb", "simplify", "grow"});
+    // The positions, freed while the Reeb graph and the simplification ran, are back: the
+    // same floats as those of the mesh made of the DEM.
+    CHECK_FALSE(result.input.mesh.positions_released());
+    CHECK(result.input.mesh.positions == mesh::dem_to_mesh(*result.dem()).positions);
 
     // The directory: labels.tif holds label_pixels(); run.json is listed last.
     const auto dir = test::scratch_dir("pipeline_segment");

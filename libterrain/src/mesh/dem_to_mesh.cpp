@@ -79,93 +79,126 @@ std::vector<std::int32_t> number_vertices(const Dem& dem, std::array<bool, 2> po
 // Vertex positions in metres in the mesh's frame (docs/mesh.md, "Frames"): body-fixed X,Y,Z
 // from lon/lat and the value (a radius along the geocentric direction, or a height on the
 // ellipsoid); in the map frame easting/northing and height, or a local tangent plane for a
-// lon/lat grid. Rows in parallel (the mapping keeps one PROJ transformation per thread).
+// lon/lat grid. dem_to_mesh places them once; restore_positions places them again, the same
+// numbers, for a mesh that freed them (TriangleMesh::release_positions).
+class VertexPlacer {
+  public:
+    VertexPlacer(const Dem& dem, const GridGeoref& geo, MeshFrame frame)
+        : dem_(dem), frame_(frame), unit_(geo.linear_unit_m) {
+        const bool geographic_crs = geo.kind == CrsKind::geographic;
+        const bool need_lonlat = frame == MeshFrame::body || geographic_crs;
+        if (need_lonlat && !geographic_crs) {
+            if (!geo.lonlat)
+                throw Error("mesh",
+                            "cannot transform the DEM's CRS to longitude/latitude on its body");
+            lonlat_ = geo.lonlat.get();
+        }
+        if (need_lonlat)
+            earth_ = std::make_unique<GeographicLib::Geocentric>(dem.body.semi_major_axis,
+                                                                 dem.body.flattening);
+        if (frame == MeshFrame::map && geographic_crs) {
+            const auto centre = dem.map_xy(dem.width / 2.0, dem.height / 2.0);
+            tangent_ =
+                std::make_unique<GeographicLib::LocalCartesian>(centre[1], centre[0], 0.0, *earth_);
+        }
+    }
+
+    // put(v, point) for each pixel whose vertex_of is a vertex v >= 0, rows in parallel (the
+    // mapping keeps one PROJ transformation per thread), rows `skip[0]` and `skip[1]` left
+    // out; the progress from `begin` to `end`. Throws when a pixel cannot be placed.
+    template <class Put>
+    void place_pixels(const std::vector<std::int32_t>& vertex_of, std::array<int, 2> skip,
+                      const ProgressFn& progress, double begin, double end, Put&& put) const {
+        const int W = dem_.width, H = dem_.height;
+        std::vector<std::uint8_t> failed(static_cast<std::size_t>(H), 0);
+        detail::parallel_slices(
+            H, 8, progress, begin, end, "mesh", [&](const tbb::blocked_range<int>& rows) {
+                std::vector<double> lon(W), lat(W);
+                std::vector<std::uint8_t> ok(W, 1);
+                for (int row = rows.begin(); row < rows.end(); ++row) {
+                    if (row == skip[0] || row == skip[1]) continue;
+                    for (int col = 0; col < W; ++col) {
+                        const auto xy = dem_.map_xy(col + 0.5, row + 0.5);
+                        lon[col] = xy[0];
+                        lat[col] = xy[1];
+                    }
+                    if (lonlat_)
+                        lonlat_->to_lonlat(std::size_t(W), lon.data(), lat.data(), ok.data());
+                    for (int col = 0; col < W; ++col) {
+                        const auto p = dem_.index(col, row);
+                        const auto v = vertex_of[p];
+                        if (v < 0) continue;
+                        if (!ok[col] || !std::isfinite(lon[col]) || !std::isfinite(lat[col])) {
+                            failed[row] = 1;
+                            continue;
+                        }
+                        put(v, point(col, row, lon[col], lat[col]));
+                    }
+                }
+            });
+        if (std::find(failed.begin(), failed.end(), 1) != failed.end())
+            throw Error("mesh", "some pixels of '" + dem_.source +
+                                    "' fall outside the CRS's valid area and cannot be placed");
+    }
+
+    // A collapsed pole row's vertex (0: north, 1: south): at the pole, at the mean radius
+    // (height) of its row.
+    std::array<double, 3> pole(int which, int row) const {
+        double sum = 0;
+        int n = 0;
+        for (int col = 0; col < dem_.width; ++col)
+            if (dem_.valid(col, row)) sum += dem_.at(col, row), ++n;
+        const double value = sum / n, lat = which == 0 ? 90.0 : -90.0;
+        std::array<double, 3> out;
+        if (dem_.elevation == ElevationKind::radius)
+            out = {0.0, 0.0, which == 0 ? value : -value};
+        else
+            earth_->Forward(lat, 0.0, value, out[0], out[1], out[2]);
+        return out;
+    }
+
+  private:
+    std::array<double, 3> point(int col, int row, double lon, double lat) const {
+        const double value = dem_.values[dem_.index(col, row)];
+        std::array<double, 3> out;
+        if (frame_ == MeshFrame::body) {
+            if (dem_.elevation == ElevationKind::radius) {
+                // Radii are distances from the centre along the geocentric direction.
+                const double cl = std::cos(lat * kDegree);
+                out = {value * cl * std::cos(lon * kDegree), value * cl * std::sin(lon * kDegree),
+                       value * std::sin(lat * kDegree)};
+            } else {
+                earth_->Forward(lat, lon, value, out[0], out[1], out[2]);
+            }
+        } else if (tangent_) {
+            tangent_->Forward(lat, lon, dem_.height_at(col, row), out[0], out[1], out[2]);
+        } else {
+            out = {lon * unit_, lat * unit_, dem_.height_at(col, row)};
+        }
+        return out;
+    }
+
+    const Dem& dem_;
+    MeshFrame frame_;
+    double unit_;
+    const LonLatMapping* lonlat_ = nullptr;  // null: map coordinates are lon/lat already
+    std::unique_ptr<GeographicLib::Geocentric> earth_;
+    std::unique_ptr<GeographicLib::LocalCartesian> tangent_;
+};
+
 void place_vertices(const Dem& dem, const GridGeoref& geo,
                     const std::vector<std::int32_t>& vertex_of, TriangleMesh& mesh,
                     const ProgressFn& progress) {
-    const int W = dem.width, H = dem.height;
-    const MeshFrame frame = mesh.frame;
-    const bool geographic_crs = geo.kind == CrsKind::geographic;
-    const bool need_lonlat = frame == MeshFrame::body || geographic_crs;
-    const LonLatMapping* lonlat = nullptr;  // null: map coordinates are lon/lat already
-    if (need_lonlat && !geographic_crs) {
-        if (!geo.lonlat)
-            throw Error("mesh", "cannot transform the DEM's CRS to longitude/latitude on its body");
-        lonlat = geo.lonlat.get();
-    }
-    // The points' memory (0 to 0.35 of the progress), then the rows (to 1).
+    const VertexPlacer placer(dem, geo, mesh.frame);
+    // The points' memory (0 to 0.35 of the progress), then the rows (to 0.9).
     std::vector<std::array<double, 3>> xyz;
     detail::assign_in_slices(xyz, mesh.vertex_pixel.size(), {},
                              detail::PassProgress(progress, 0, 0.35, "mesh"));
-    const double a = dem.body.semi_major_axis, f = dem.body.flattening;
-    const double unit = geo.linear_unit_m;
-    std::unique_ptr<GeographicLib::Geocentric> earth;
-    if (need_lonlat) earth = std::make_unique<GeographicLib::Geocentric>(a, f);
-    std::unique_ptr<GeographicLib::LocalCartesian> tangent;
-    if (frame == MeshFrame::map && geographic_crs) {
-        const auto centre = dem.map_xy(W / 2.0, H / 2.0);
-        tangent =
-            std::make_unique<GeographicLib::LocalCartesian>(centre[1], centre[0], 0.0, *earth);
-    }
-    std::vector<std::uint8_t> failed(static_cast<std::size_t>(H), 0);
-    detail::parallel_slices(
-        H, 8, progress, 0.35, 0.9, "mesh", [&](const tbb::blocked_range<int>& rows) {
-            std::vector<double> lon(W), lat(W);
-            std::vector<std::uint8_t> ok(W, 1);
-            for (int row = rows.begin(); row < rows.end(); ++row) {
-                for (int col = 0; col < W; ++col) {
-                    const auto xy = dem.map_xy(col + 0.5, row + 0.5);
-                    lon[col] = xy[0];
-                    lat[col] = xy[1];
-                }
-                if (lonlat) lonlat->to_lonlat(std::size_t(W), lon.data(), lat.data(), ok.data());
-                for (int col = 0; col < W; ++col) {
-                    const auto p = dem.index(col, row);
-                    const auto v = vertex_of[p];
-                    if (v < 0) continue;
-                    if (!ok[col] || !std::isfinite(lon[col]) || !std::isfinite(lat[col])) {
-                        failed[row] = 1;
-                        continue;
-                    }
-                    const double value = dem.values[p];
-                    auto& out = xyz[v];
-                    if (frame == MeshFrame::body) {
-                        if (dem.elevation == ElevationKind::radius) {
-                            // Radii are distances from the centre along the geocentric direction.
-                            const double cl = std::cos(lat[col] * kDegree);
-                            out = {value * cl * std::cos(lon[col] * kDegree),
-                                   value * cl * std::sin(lon[col] * kDegree),
-                                   value * std::sin(lat[col] * kDegree)};
-                        } else {
-                            earth->Forward(lat[col], lon[col], value, out[0], out[1], out[2]);
-                        }
-                    } else if (tangent) {
-                        tangent->Forward(lat[col], lon[col], dem.height_at(col, row), out[0],
-                                         out[1], out[2]);
-                    } else {
-                        out = {lon[col] * unit, lat[col] * unit, dem.height_at(col, row)};
-                    }
-                }
-            }
-        });
-    if (std::find(failed.begin(), failed.end(), 1) != failed.end())
-        throw Error("mesh", "some pixels of '" + dem.source +
-                                "' fall outside the CRS's valid area and cannot be placed");
-    // The pole vertices: at the pole, at the mean radius (height) of their row.
-    for (int which = 0; which < 2; ++which) {
-        if (mesh.pole_rows[which] < 0) continue;
-        const int row = mesh.pole_rows[which];
-        double sum = 0;
-        int n = 0;
-        for (int col = 0; col < W; ++col)
-            if (dem.valid(col, row)) sum += dem.at(col, row), ++n;
-        const double value = sum / n, lat = which == 0 ? 90.0 : -90.0;
-        auto& out = xyz[mesh.pole_vertices[which]];
-        if (dem.elevation == ElevationKind::radius)
-            out = {0.0, 0.0, which == 0 ? value : -value};
-        else
-            earth->Forward(lat, 0.0, value, out[0], out[1], out[2]);
-    }
+    placer.place_pixels(vertex_of, {-1, -1}, progress, 0.35, 0.9,
+                        [&](std::int32_t v, const std::array<double, 3>& p) { xyz[v] = p; });
+    for (int which = 0; which < 2; ++which)
+        if (mesh.pole_rows[which] >= 0)
+            xyz[mesh.pole_vertices[which]] = placer.pole(which, mesh.pole_rows[which]);
     set_positions(mesh, xyz, scaled_progress(progress, 0.9, 1));
 }
 
@@ -176,15 +209,25 @@ void triangulate_blocks(const Dem& dem, const std::vector<std::int32_t>& vertex_
     const int W = dem.width, H = dem.height;
     const int block_rows = H - 1;
     std::vector<std::vector<Triangle>> per_row(static_cast<std::size_t>(block_rows));
+    // Each block's diagonal is recorded (a bit, each row of blocks in its own words), so
+    // that the triangles can be made again without the positions.
+    const std::size_t words = detail::diagonal_words(W);
+    mesh.block_diagonals.assign(static_cast<std::size_t>(std::max(block_rows, 0)) * words, 0);
     // Rows in parallel (0 to 0.8 of the progress), then joined in order.
     detail::parallel_slices(block_rows, 16, progress, 0, 0.8, "mesh", [&](const auto& rows) {
         for (int row = rows.begin(); row < rows.end(); ++row) {
             auto& out = per_row[row];
             out.reserve(2 * std::size_t(W));
             const std::int32_t* top = vertex_of.data() + dem.index(0, row);
+            std::uint64_t* bits = mesh.block_diagonals.data() + std::size_t(row) * words;
+            const auto split = [&](int col, std::int32_t v00, std::int32_t v10, std::int32_t v01,
+                                   std::int32_t v11) {
+                const bool across = detail::split_top_right(mesh.positions, v00, v10, v01, v11);
+                if (across) bits[unsigned(col) / 64] |= std::uint64_t{1} << (unsigned(col) % 64);
+                return across;
+            };
             detail::block_row_triangles(top, top + W, W, mesh.seam_closed, mesh.triangles_flipped,
-                                        mesh.positions,
-                                        [&](const Triangle& t) { out.push_back(t); });
+                                        split, [&](const Triangle& t) { out.push_back(t); });
         }
     });
     std::size_t total = 0;
@@ -255,6 +298,36 @@ TriangleMesh dem_to_mesh(const Dem& dem, const DemToMeshOptions& options,
     finish_grid_mesh(mesh, scaled_progress(progress, 0.7, 1));
     report_progress(progress, 1.0, "mesh");
     return mesh;
+}
+
+void restore_positions(const Dem& dem, TriangleMesh& mesh, const ProgressFn& progress) {
+    if (!mesh.positions_released()) return;
+    if (dem.width != mesh.grid_width || dem.height != mesh.grid_height)
+        throw Error("mesh", "the positions are placed again from the DEM the mesh was made of");
+    const VertexPlacer placer(dem, georef_of(dem), mesh.frame);
+    const std::size_t n = mesh.vertex_count();
+    // The same points as dem_to_mesh's, less the same origin, as floats.
+    std::vector<std::array<float, 3>> positions;
+    detail::assign_in_slices(positions, n, {}, detail::PassProgress(progress, 0, 0.3, "mesh"));
+    const auto& o = mesh.origin;
+    const auto put = [&](std::int32_t v, const std::array<double, 3>& p) {
+        for (int k = 0; k < 3; ++k) positions[std::size_t(v)][k] = static_cast<float>(p[k] - o[k]);
+    };
+    // Every pixel's vertex but the pole rows' (the pole is placed alone) ...
+    placer.place_pixels(mesh.pixel_vertex, mesh.pole_rows, progress, 0.3, 0.9, put);
+    for (int which = 0; which < 2; ++which)
+        if (mesh.pole_rows[which] >= 0)
+            put(mesh.pole_vertices[which], placer.pole(which, mesh.pole_rows[which]));
+    // ... and a split pinch's copies where its first copy is (pixel_vertex names the first).
+    const detail::PassProgress copies(progress, 0.9, 1, "mesh");
+    for (std::size_t v = 0; v < n; ++v) {
+        copies.at(v, n);
+        const std::int32_t first = mesh.pixel_vertex[std::size_t(mesh.vertex_pixel[v])];
+        if (first != std::int32_t(v) && !mesh.is_pole(v))
+            positions[v] = positions[std::size_t(first)];
+    }
+    mesh.set_restored_positions(std::move(positions));
+    report_progress(progress, 1.0, "mesh");
 }
 
 void fill_pixel_to_vertex(const TriangleMesh& mesh, const Dem& dem,

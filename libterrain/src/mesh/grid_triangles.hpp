@@ -16,26 +16,38 @@ namespace terrain::detail {
 
 using Triangle = std::array<std::int32_t, 3>;
 
-// The triangles of the blocks between two rows of pixels whose vertices are `top` and
-// `bottom` (-1: none), `width` pixels each: two for four vertices, split along the shorter
-// 3-D diagonal (`positions`; ties to top-left/bottom-right), one for three, none for fewer,
-// and none repeating a vertex (a collapsed pole). With `seam` the last block joins the last
-// column to the first. Rows growing southwards and columns eastwards (the geotransform's
-// determinant negative) give counter-clockwise triangles seen from above or outside; `flip`
-// swaps their last two corners otherwise. emit(const Triangle&) for each, in order.
-template <class Emit>
-void block_row_triangles(const std::int32_t* top, const std::int32_t* bottom, int width, bool seam,
-                         bool flip, const std::vector<std::array<float, 3>>& positions,
-                         Emit&& emit) {
-    const auto put = [&](std::int32_t p, std::int32_t q, std::int32_t r) {
-        if (p < 0 || q < 0 || r < 0 || p == q || q == r || p == r) return;
-        emit(flip ? Triangle{p, r, q} : Triangle{p, q, r});
-    };
+// Whether the block of four vertices v00 v10 (top) v01 v11 (bottom) is split along its
+// top-right to bottom-left diagonal: when it is the shorter in 3-D (ties go to the other).
+inline bool split_top_right(const std::vector<std::array<float, 3>>& positions, std::int32_t v00,
+                            std::int32_t v10, std::int32_t v01, std::int32_t v11) {
     const auto dist2 = [&](std::int32_t i, std::int32_t j) {
         const auto& p = positions[static_cast<std::size_t>(i)];
         const auto& q = positions[static_cast<std::size_t>(j)];
         const double d[3] = {double(p[0]) - q[0], double(p[1]) - q[1], double(p[2]) - q[2]};
         return d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+    };
+    return !(dist2(v00, v11) <= dist2(v10, v01));
+}
+
+// The words of one row of blocks in TriangleMesh::block_diagonals.
+inline std::size_t diagonal_words(int width) {
+    return (static_cast<std::size_t>(width) + 63) / 64;
+}
+
+// The triangles of the blocks between two rows of pixels whose vertices are `top` and
+// `bottom` (-1: none), `width` pixels each: two for four vertices, split along the diagonal
+// that split(col, v00, v10, v01, v11) names (true: top-right to bottom-left; the shorter in
+// 3-D when the mesh is made, split_top_right), one for three, none for fewer, and none
+// repeating a vertex (a collapsed pole). With `seam` the last block joins the last column to
+// the first. Rows growing southwards and columns eastwards (the geotransform's determinant
+// negative) give counter-clockwise triangles seen from above or outside; `flip` swaps their
+// last two corners otherwise. emit(const Triangle&) for each, in order.
+template <class Split, class Emit>
+void block_row_triangles(const std::int32_t* top, const std::int32_t* bottom, int width, bool seam,
+                         bool flip, Split&& split, Emit&& emit) {
+    const auto put = [&](std::int32_t p, std::int32_t q, std::int32_t r) {
+        if (p < 0 || q < 0 || r < 0 || p == q || q == r || p == r) return;
+        emit(flip ? Triangle{p, r, q} : Triangle{p, q, r});
     };
     const int blocks = seam ? width : width - 1;
     for (int col = 0; col < blocks; ++col) {
@@ -54,7 +66,7 @@ void block_row_triangles(const std::int32_t* top, const std::int32_t* bottom, in
                 put(v00, v01, v10);
             continue;
         }
-        if (dist2(v00, v11) <= dist2(v10, v01)) {
+        if (!split(col, v00, v10, v01, v11)) {
             put(v00, v01, v11);
             put(v00, v11, v10);
         } else {
@@ -65,7 +77,8 @@ void block_row_triangles(const std::int32_t* top, const std::int32_t* bottom, in
 }
 
 // f(index, triangle) for each triangle of `mesh` in order: its stored triangles, or for a
-// DEM mesh whose triangles were released, the same made again from the grid.
+// DEM mesh whose triangles were released, the same made again from the grid (with the
+// diagonals recorded when it was made: no position is read).
 template <class F>
 void for_each_triangle(const TriangleMesh& mesh, F&& f) {
     if (!mesh.triangles_released()) {
@@ -75,10 +88,17 @@ void for_each_triangle(const TriangleMesh& mesh, F&& f) {
     const std::size_t W = static_cast<std::size_t>(mesh.grid_width);
     const auto& patches = mesh.pinch_triangles;
     std::size_t index = 0, patch = 0;
+    const std::size_t words = diagonal_words(mesh.grid_width);
     for (int row = 0; row + 1 < mesh.grid_height; ++row) {
         const std::int32_t* top = mesh.pixel_vertex.data() + static_cast<std::size_t>(row) * W;
+        const std::uint64_t* bits =
+            mesh.block_diagonals.data() + static_cast<std::size_t>(row) * words;
+        const auto split = [bits](int col, std::int32_t, std::int32_t, std::int32_t, std::int32_t) {
+            return ((bits[static_cast<unsigned>(col) / 64] >> (static_cast<unsigned>(col) % 64)) &
+                    1) != 0;
+        };
         block_row_triangles(top, top + W, mesh.grid_width, mesh.seam_closed, mesh.triangles_flipped,
-                            mesh.positions, [&](const Triangle& t) {
+                            split, [&](const Triangle& t) {
                                 if (patch < patches.size() && patches[patch].first == index)
                                     f(index, patches[patch++].second);
                                 else

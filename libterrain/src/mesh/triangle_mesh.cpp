@@ -40,7 +40,8 @@ std::size_t TriangleMesh::memory_bytes() const {
            irregular_vertices.capacity() * sizeof(std::int32_t) +
            irregular_offsets.capacity() * sizeof(std::uint32_t) +
            irregular_neighbors.capacity() * sizeof(std::int32_t) +
-           pinch_triangles.capacity() * sizeof(pinch_triangles[0]);
+           pinch_triangles.capacity() * sizeof(pinch_triangles[0]) +
+           block_diagonals.capacity() * sizeof(std::uint64_t);
 }
 
 void TriangleMesh::release_adjacency() {
@@ -54,8 +55,10 @@ void TriangleMesh::release_adjacency() {
 }
 
 bool TriangleMesh::triangles_releasable() const {
-    return !triangles.empty() && grid_width >= 1 && vertex_pixel.size() == positions.size() &&
-           pixel_vertex.size() == std::size_t(grid_width) * std::size_t(grid_height);
+    return !triangles.empty() && grid_width >= 1 && vertex_pixel.size() == vertex_count() &&
+           pixel_vertex.size() == std::size_t(grid_width) * std::size_t(grid_height) &&
+           block_diagonals.size() ==
+               std::size_t(grid_height - 1) * ((std::size_t(grid_width) + 63) / 64);
 }
 
 bool TriangleMesh::release_triangles() {
@@ -64,6 +67,25 @@ bool TriangleMesh::release_triangles() {
     released_triangles_ = triangles.size();
     detail::release(triangles);
     return true;
+}
+
+bool TriangleMesh::release_positions() {
+    if (positions_released()) return true;
+    const bool grid = frame != MeshFrame::file && !positions.empty() &&
+                      vertex_pixel.size() == positions.size() &&
+                      pixel_vertex.size() == std::size_t(grid_width) * std::size_t(grid_height) &&
+                      (grid_height < 2 || !block_diagonals.empty());
+    if (!grid) return false;
+    released_vertices_ = positions.size();
+    detail::release(positions);
+    return true;
+}
+
+void TriangleMesh::set_restored_positions(std::vector<std::array<float, 3>>&& placed) {
+    if (!positions_released() || placed.size() != released_vertices_)
+        throw Error("mesh", "internal: the positions placed again are not one a vertex");
+    positions = std::move(placed);
+    released_vertices_ = 0;
 }
 
 VertexNeighbors TriangleMesh::irregular_neighbors_of(std::size_t v) const {

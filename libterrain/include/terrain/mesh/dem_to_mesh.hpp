@@ -27,6 +27,11 @@ MeshFrame default_frame(const Dem& dem);
 TriangleMesh dem_to_mesh(const Dem& dem, const DemToMeshOptions& options = {},
                          const ProgressFn& progress = {});
 
+// Places again the positions of a DEM mesh made of `dem` (dem_to_mesh) that freed them
+// (TriangleMesh::release_positions): the same floats, from the same computation. Nothing to
+// do when the mesh holds them. Throws terrain::Error (stage "mesh") for another grid.
+void restore_positions(const Dem& dem, TriangleMesh& mesh, const ProgressFn& progress = {});
+
 // For each pixel (row-major), the vertex made from it, or -1 (NoData, isolated). The pixels
 // of a collapsed pole row all map to the pole vertex; a split pinch maps to its first copy.
 // A copy of mesh.pixel_vertex when the mesh has it.

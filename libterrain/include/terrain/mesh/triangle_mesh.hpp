@@ -71,6 +71,9 @@ struct TriangleMesh {
     // orientation, and those that name a split pinch's copy (index, corners), in order.
     bool triangles_flipped = false;
     std::vector<std::pair<std::uint64_t, std::array<std::int32_t, 3>>> pinch_triangles;
+    // The diagonal each 2x2 block of four vertices was split along: bit `col` of row `row`'s
+    // words (ceil(grid_width / 64) of them a row of blocks) set for top-right to bottom-left.
+    std::vector<std::uint64_t> block_diagonals;
 
     // DEM meshes: the pixel (row*grid_width + col) each vertex was made from; empty for
     // meshes read from files. A pole vertex keeps the first pixel of its row.
@@ -89,7 +92,21 @@ struct TriangleMesh {
     std::array<int, 2> pole_rows{-1, -1};
     std::array<std::int32_t, 2> pole_vertices{-1, -1};
 
-    std::size_t vertex_count() const { return positions.size(); }
+    std::size_t vertex_count() const {
+        return positions_released() ? released_vertices_ : positions.size();
+    }
+    // A DEM mesh may also free its positions (12 bytes a vertex) while the stages that do not
+    // read them run (the Reeb graph and the simplification): mesh::restore_positions(dem, mesh)
+    // places them again, the same floats. Returns false, keeping them, for a mesh that cannot
+    // (read from a file, or without its recorded diagonals, which the triangles made again from
+    // the grid read instead of the positions).
+    bool release_positions();
+    bool positions_released() const { return released_vertices_ > 0; }
+    // For mesh::restore_positions: the positions placed again (one a vertex).
+    void set_restored_positions(std::vector<std::array<float, 3>>&& placed);
+    bool is_pole(std::size_t v) const {
+        return std::int32_t(v) == pole_vertices[0] || std::int32_t(v) == pole_vertices[1];
+    }
     std::size_t triangle_count() const {
         return triangles_released() ? released_triangles_ : triangles.size();
     }
@@ -133,6 +150,7 @@ struct TriangleMesh {
   private:
     VertexNeighbors irregular_neighbors_of(std::size_t v) const;
     std::size_t released_triangles_ = 0;
+    std::size_t released_vertices_ = 0;
 };
 
 // Counts of a mesh's topology.
