@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <set>
 #include <string>
@@ -77,6 +78,26 @@ TEST_CASE("pipeline::segment gives labels, regions and the files of terrain segm
     // The same DEM handed over in memory gives the same labels.
     auto again = pipeline::segment(pipeline::input_from_dem(io::read_dem(path)), options);
     CHECK(again.label_pixels() == pixels);
+}
+
+TEST_CASE("pipeline::segment gives the DEM back bit for bit, floats or not", "[pipeline]") {
+    // The values are held as floats while the Reeb graph and the simplification run when
+    // every one is a float (the first DEM), and stay doubles otherwise (the second: tenths of
+    // a metre on a Moon radius); either way the growing and the outputs see the same numbers.
+    for (const double step : {0.5, 0.1}) {
+        INFO("step " << step);
+        const Dem dem = test::grid_dem(90, 70, [&](int c, int r) {
+            if ((c - 30) * (c - 30) + (r - 20) * (r - 20) < 40) return std::nan("");
+            return 1737400.0 + step * std::round(40 * std::sin(c * 0.2) * std::cos(r * 0.15) +
+                                                  ((c * 7919 + r * 104729) % 13));
+        });
+        const auto result = pipeline::segment(pipeline::input_from_dem(dem, "map"), {});
+        REQUIRE(result.dem());
+        const auto& back = result.dem()->values;
+        REQUIRE(back.size() == dem.values.size());
+        CHECK(std::memcmp(back.data(), dem.values.data(), back.size() * sizeof(double)) == 0);
+        CHECK(result.segmentation.region_count > 1);
+    }
 }
 
 TEST_CASE("pipeline options are checked before any work", "[pipeline]") {
