@@ -604,3 +604,44 @@ TEST_CASE("shape index with the disk window on real DEMs", "[shape_index][shared
         }
     }
 }
+
+TEST_CASE("shape index is the same with a DEM mesh's triangles freed and its pixel map made anew",
+          "[shape_index]") {
+    // The pipeline frees a DEM mesh's triangles before the field when its Reeb graph is a tree:
+    // the normals walk them again from the grid, and the grid method reads the mesh's pixel
+    // map (a map of its own when the mesh has none). Every value must be the same, bit for bit:
+    // the global Moon (seam and collapsed poles) and a NoData speckle (pinches, isolated
+    // pixels), by each method and window.
+    Dem speckle = analytic(120, 5.0, [](double x, double y) {
+        return 30 * std::sin(x * 0.02) * std::cos(y * 0.025) + 0.01 * x * y;
+    });
+    std::uint32_t state = 99;
+    for (double& v : speckle.values) {
+        state = state * 1664525u + 1013904223u;
+        if ((state >> 24) < 20) v = std::nan("");
+    }
+    const std::pair<const char*, Dem> dems[] = {
+        {"global Moon", io::read_dem(test::sample("moon_ldem1_global.tif"))},
+        {"NoData speckle", std::move(speckle)}};
+    for (const auto& [name, dem] : dems) {
+        const auto mesh = mesh::dem_to_mesh(dem);
+        REQUIRE(mesh.triangles_releasable());
+        const double radius = name == std::string("global Moon") ? 150000.0 : 30.0;
+        field::ShapeIndexOptions rings, grid = with_method(radius, field::ShapeIndexMethod::grid),
+                                        disk = grid;
+        disk.window = field::ShapeIndexWindow::disk;
+        for (const auto& [what, options] :
+             {std::pair{"rings", rings}, std::pair{"grid", grid}, std::pair{"disk", disk}}) {
+            INFO(name << ", " << what);
+            const auto before = field::shape_index_field(mesh, options);
+            TriangleMesh released = mesh;
+            REQUIRE(released.release_triangles());
+            CHECK(field::shape_index_field(released, options) == before);
+            TriangleMesh unmapped = mesh;  // a CSR adjacency and no pixel map
+            finish_mesh(unmapped);
+            unmapped.pixel_vertex.clear();
+            CHECK(field::shape_index_field(unmapped, options) == before);
+        }
+    }
+    CHECK(mesh::dem_to_mesh(dems[1].second).pinched_vertices > 0);
+}

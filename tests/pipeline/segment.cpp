@@ -89,7 +89,7 @@ TEST_CASE("pipeline::segment gives the DEM back bit for bit, floats or not", "[p
         const Dem dem = test::grid_dem(90, 70, [&](int c, int r) {
             if ((c - 30) * (c - 30) + (r - 20) * (r - 20) < 40) return std::nan("");
             return 1737400.0 + step * std::round(40 * std::sin(c * 0.2) * std::cos(r * 0.15) +
-                                                  ((c * 7919 + r * 104729) % 13));
+                                                 ((c * 7919 + r * 104729) % 13));
         });
         const auto result = pipeline::segment(pipeline::input_from_dem(dem, "map"), {});
         REQUIRE(result.dem());

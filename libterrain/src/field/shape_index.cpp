@@ -14,6 +14,7 @@
 #include <span>
 
 #include "../core/pass_progress.hpp"
+#include "../mesh/grid_triangles.hpp"
 #include "shape_index_fit.hpp"
 #include "terrain/core/error.hpp"
 
@@ -29,15 +30,16 @@ std::vector<Vec3> vertex_normals(const TriangleMesh& mesh, const ProgressFn& pro
     terrain::detail::assign_in_slices(
         normals, mesh.vertex_count(), Vec3{0, 0, 0},
         terrain::detail::PassProgress(progress, 0, 0.3, "shape index"));
+    // (In order, the stored triangles or those a DEM mesh makes again from its grid.)
     const std::size_t nt = mesh.triangle_count();
-    for (std::size_t i = 0; i < nt; ++i) {
-        summed.at(i, nt);
-        const auto& t = mesh.triangles[i];
-        const auto& p = mesh.positions;
-        const Vec3 n = cross(sub(p[t[1]], p[t[0]]), sub(p[t[2]], p[t[0]]));
-        for (auto v : t)
-            for (int k = 0; k < 3; ++k) normals[v][k] += n[k];
-    }
+    const auto& p = mesh.positions;
+    terrain::detail::for_each_triangle(
+        mesh, [&](std::size_t i, const std::array<std::int32_t, 3>& t) {
+            summed.at(i, nt);
+            const Vec3 n = cross(sub(p[t[1]], p[t[0]]), sub(p[t[2]], p[t[0]]));
+            for (auto v : t)
+                for (int k = 0; k < 3; ++k) normals[v][k] += n[k];
+        });
     for (std::size_t v = 0; v < normals.size(); ++v) {
         normalised.at(v, normals.size());
         normals[v] = normalized(normals[v]);
@@ -69,13 +71,17 @@ GridLayout grid_layout(const TriangleMesh& mesh) {
     GridLayout g;
     g.width = mesh.grid_width, g.height = mesh.grid_height;
     g.seam = mesh.seam_closed;
-    g.pixel_vertex.assign(std::size_t(g.width) * std::size_t(g.height), -1);
-    for (std::size_t v = mesh.vertex_pixel.size(); v-- > 0;)
-        g.pixel_vertex[std::size_t(mesh.vertex_pixel[v])] = std::int32_t(v);
+    const std::size_t pixels = std::size_t(g.width) * std::size_t(g.height);
+    if (mesh.pixel_vertex.size() == pixels) {
+        g.pixel_vertex = mesh.pixel_vertex.data();
+    } else {  // the first copy of a split pinch owns its pixel, as in the mesh's map
+        g.own.assign(pixels, -1);
+        for (std::size_t v = mesh.vertex_pixel.size(); v-- > 0;)
+            g.own[std::size_t(mesh.vertex_pixel[v])] = std::int32_t(v);
+        g.pixel_vertex = g.own.data();
+    }
     // A collapsed pole row is one vertex: it takes the mesh path.
-    for (int row : mesh.pole_rows)
-        if (row >= 0)
-            std::fill_n(g.pixel_vertex.begin() + std::ptrdiff_t(row) * g.width, g.width, -1);
+    g.pole_rows = mesh.pole_rows;
     // On a body, the disk window's tiles are made smaller where 64 pixels span more than
     // kMaxDiskTileAngle: from the longest distance between neighbouring pixels and the
     // largest distance from the body's centre among about 64 x 64 pixels spread over the grid.
@@ -582,9 +588,12 @@ std::size_t grid_for_each_vertex(const TriangleMesh& mesh, const GridLayout& g,
         report_progress(progress, double(tr + 1) / tile_rows, "shape index");
     }
     std::vector<std::int32_t> unowned;
-    for (std::size_t v = 0; v < mesh.vertex_count(); ++v)
-        if (g.pixel_vertex[std::size_t(mesh.vertex_pixel[v])] != std::int32_t(v))
+    for (std::size_t v = 0; v < mesh.vertex_count(); ++v) {
+        const auto p = std::size_t(mesh.vertex_pixel[v]);
+        if (g.vertex_at(int(p % std::size_t(g.width)), int(p / std::size_t(g.width))) !=
+            std::int32_t(v))
             unowned.push_back(std::int32_t(v));
+    }
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, unowned.size(), 64), [&](const auto& r) {
         auto& s = scratch.local();
         for (std::size_t i = r.begin(); i < r.end(); ++i) {

@@ -69,11 +69,23 @@ void gather_where(const TriangleMesh& mesh, std::int32_t v, int rings, const Ins
 struct GridLayout {
     int width = 0, height = 0;
     bool seam = false;
-    std::vector<std::int32_t> pixel_vertex;  // the vertex a pixel owns, or -1
-    int disk_tile = 64;                      // pixels per side of the disk window's tiles
+    // Each pixel's vertex, or -1: the mesh's (TriangleMesh::pixel_vertex, not copied), or
+    // `own` made for a mesh without it. The collapsed pole rows own none here (`pole_rows`):
+    // their one vertex takes the mesh path.
+    const std::int32_t* pixel_vertex = nullptr;
+    std::array<int, 2> pole_rows{-1, -1};
+    std::vector<std::int32_t> own;
+    int disk_tile = 64;  // pixels per side of the disk window's tiles
+
+    GridLayout() = default;
+    GridLayout(GridLayout&&) = default;  // (own's block moves with it: pixel_vertex stays)
+    GridLayout& operator=(GridLayout&&) = default;
+    GridLayout(const GridLayout&) = delete;
+    GridLayout& operator=(const GridLayout&) = delete;
 
     // The vertex pixel (col, row) of the grid owns, or -1.
     std::int32_t vertex_at(int col, int row) const {
+        if (row == pole_rows[0] || row == pole_rows[1]) return -1;
         return pixel_vertex[std::size_t(row) * std::size_t(width) + std::size_t(col)];
     }
     // The same for any (col, row): -1 off the grid's rows, and off its columns unless it is

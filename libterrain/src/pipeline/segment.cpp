@@ -316,11 +316,21 @@ SegmentResult segment(Input input, const SegmentOptions& options, const Progress
     // Slices of the progress by the stages' measured cost on global grids of 1 to 66 M
     // pixels (docs/performance.md): field 0.2, Reeb graph 0.2, simplification 0.2, growing
     // and dividing 0.3, region graph 0.1.
-    compute_field(result, options, scaled_progress(progress, 0, 0.2));
+    // A DEM mesh whose Reeb graph is a tree (every component a disk or a sphere) frees its
+    // triangles (24 bytes a pixel) before the field: no stage reads them at random, the
+    // shape index's normals and the later stages walk them again from the grid in order.
+    // The SDF casts rays through them: it keeps them. (The loop check is counted with the
+    // field, which it precedes.)
+    auto& mesh = result.input.mesh;
+    const auto tf = clock::now();
+    if (field::parse_field_kind(options.field) != field::FieldKind::sdf &&
+        mesh.triangles_releasable() && reeb::reeb_is_tree(mesh, scaled_progress(progress, 0, 0.02)))
+        mesh.release_triangles();
+    result.add_time("field", since(tf));
+    compute_field(result, options, scaled_progress(progress, 0.02, 0.2));
     // A DEM mesh frees its positions (12 bytes a vertex) while the Reeb graph and the
     // simplification run, which do not read them, and places them again before the growing:
     // the same floats (docs/mesh.md, "Positions freed and placed again").
-    auto& mesh = result.input.mesh;
     const bool placed_again = result.input.dem && mesh.release_positions();
     PackedHeights packed;
     const auto tp = clock::now();
