@@ -426,3 +426,43 @@ TEST_CASE("A moving degenerate extremum costs what changes, not its degree", "[s
     CHECK(static_cast<double>(scanned.moved) > 20 * arcs);  // the case is the hard one
     CHECK(big.result.field == scanned.result.field);
 }
+
+TEST_CASE("A graph handed over gives the result of the same graph lent, plateaus and all",
+          "[simplify]") {
+    // Handed over, a graph with ascending vertex lists (build_reeb_graph's) gives them up once
+    // its nodes are copied and the output makes them again from its vertices' nodes; a graph
+    // whose lists are not ascending keeps them. Either way the result is that of the graph
+    // lent (simplify(const&)), every array. Quantized noise makes plateaus: nodes of many
+    // vertices.
+    const auto& s = vesta();
+    std::vector<float> quantized(s.si.size());
+    for (std::size_t v = 0; v < quantized.size(); ++v)
+        quantized[v] = std::round(s.si[v] / 8.0f) * 8.0f + float((v * 2654435761u) % 3);
+    reeb::SimplifyOptions o;
+    o.persistence = 10;
+    o.area_ratio = 0.5;
+    for (const bool ascending : {true, false}) {
+        INFO((ascending ? "ascending lists" : "a list not ascending"));
+        auto g = reeb::build_reeb_graph(s.mesh, quantized);
+        std::size_t plateau = g.node_count();
+        for (std::size_t n = 0; n < g.node_count() && plateau == g.node_count(); ++n)
+            if (g.node_vertex_offsets[n + 1] - g.node_vertex_offsets[n] > 2) plateau = n;
+        REQUIRE(plateau < g.node_count());
+        if (!ascending)
+            std::reverse(g.node_vertices.begin() + g.node_vertex_offsets[plateau],
+                         g.node_vertices.begin() + g.node_vertex_offsets[plateau + 1]);
+        const auto lent = reeb::simplify(s.mesh, g, o);
+        const auto given = reeb::simplify(s.mesh, std::move(g), o);
+        CHECK(given.field == lent.field);
+        CHECK(given.absorbed == lent.absorbed);
+        CHECK(given.graph.node_values == lent.graph.node_values);
+        CHECK(given.graph.node_kinds == lent.graph.node_kinds);
+        CHECK(given.graph.node_vertex_offsets == lent.graph.node_vertex_offsets);
+        CHECK(given.graph.node_vertices == lent.graph.node_vertices);
+        CHECK(given.graph.vertex_nodes == lent.graph.vertex_nodes);
+        CHECK(given.graph.arcs == lent.graph.arcs);
+        CHECK(given.graph.arc_nodes == lent.graph.arc_nodes);
+        CHECK(g.node_vertices.capacity() == 0);
+        CHECK(g.vertex_nodes.capacity() == 0);
+    }
+}

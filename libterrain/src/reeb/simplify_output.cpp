@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <array>
+#include <numeric>
 
 #include "../core/disjoint_sets.hpp"
 #include "../core/pass_progress.hpp"
@@ -19,10 +20,10 @@ using detail::find_root;
 void WorkingGraph::write_result(SimplifyResult& result, const ProgressFn& progress) {
     const std::size_t nn = input_nodes_, nl = regular_.size();
     // Its passes: the fates (0 to 0.2), the new numbers (to 0.3), the arcs (to 0.4), the
-    // vertices (to 0.8), the field (to 1).
+    // input's vertex lists made again (to 0.5), the vertices (to 0.8), the field (to 1).
     using detail::PassProgress;
     const PassProgress fates(progress, 0, 0.2, "simplify"), numbers(progress, 0.2, 0.3, "simplify"),
-        arcs(progress, 0.3, 0.4, "simplify"), vertices(progress, 0.4, 0.8, "simplify");
+        arcs(progress, 0.3, 0.4, "simplify"), vertices(progress, 0.5, 0.8, "simplify");
     // code[i]: for an absorbed node, the critical node that finally took it (nodes are
     // only absorbed into critical nodes); for a remaining node, -2 - its new id.
     // A listed node's forward: the fate of its set's root (kNone for a list still there).
@@ -61,9 +62,14 @@ void WorkingGraph::write_result(SimplifyResult& result, const ProgressFn& progre
     }
     const std::size_t count = kept.size();
     std::vector<i32> size(count + 1, 0);
-    for (std::size_t n = 0; n < nn; ++n) {
+    for (std::size_t n = 0; n < nn; ++n)
         if (node_map_[n] < 0) node_map_[n] = -2 - code[idx(-2 - node_map_[n])];
-        size[idx(node_map_[n]) + 1] += g_.node_vertex_offsets[n + 1] - g_.node_vertex_offsets[n];
+    if (lists_from_vertex_nodes_) {
+        for (const i32 n : owned_->vertex_nodes) ++size[idx(node_map_[idx(n)]) + 1];
+    } else {
+        for (std::size_t n = 0; n < nn; ++n)
+            size[idx(node_map_[n]) + 1] +=
+                g_.node_vertex_offsets[n + 1] - g_.node_vertex_offsets[n];
     }
     ReebGraph& out = result.graph;
     out.node_values.resize(count);
@@ -111,13 +117,37 @@ void WorkingGraph::write_result(SimplifyResult& result, const ProgressFn& progre
     detail::release(code);
     detail::release(kept);
     release_working_graph();
-    // Vertices: grouped by new node, in the order of their old nodes.
     const std::size_t nv = input_vertices_;
+    if (lists_from_vertex_nodes_) {
+        // The input's vertex lists again, each ascending (a counting sort of the vertices by
+        // node): what the graph handed over held.
+        const PassProgress counted(progress, 0.4, 0.45, "simplify"),
+            listed(progress, 0.45, 0.5, "simplify");
+        auto& offsets = owned_->node_vertex_offsets;
+        auto& listed_vertices = owned_->node_vertices;
+        const auto& of = owned_->vertex_nodes;
+        detail::assign_in_slices(offsets, nn + 1, i32{0}, made(0.4));
+        for (std::size_t v = 0; v < nv; ++v) {
+            counted.at(v, nv);
+            ++offsets[idx(of[v]) + 1];
+        }
+        std::partial_sum(offsets.begin(), offsets.end(), offsets.begin());
+        detail::assign_in_slices(listed_vertices, nv, i32{0}, made(0.45));
+        std::vector<i32> fill(offsets.begin(), offsets.end() - 1);
+        for (std::size_t v = 0; v < nv; ++v) {
+            listed.at(v, nv);
+            listed_vertices[idx(fill[idx(of[v])]++)] = static_cast<i32>(v);
+        }
+        detail::release(fill);
+        detail::release(owned_->vertex_nodes);
+    }
+    report_progress(progress, 0.5, "simplify");
+    // Vertices: grouped by new node, in the order of their old nodes.
     for (std::size_t i = 1; i < size.size(); ++i) size[i] += size[i - 1];
     out.node_vertex_offsets = size;
-    detail::assign_in_slices(out.node_vertices, g_.node_vertices.size(), i32{0}, made(0.4));
-    detail::assign_in_slices(out.vertex_nodes, nv, i32{0}, made(0.4));
-    detail::assign_in_slices(result.absorbed, nv, std::uint8_t{0}, made(0.4));
+    detail::assign_in_slices(out.node_vertices, g_.node_vertices.size(), i32{0}, made(0.5));
+    detail::assign_in_slices(out.vertex_nodes, nv, i32{0}, made(0.5));
+    detail::assign_in_slices(result.absorbed, nv, std::uint8_t{0}, made(0.5));
     for (std::size_t n = 0; n < nn; ++n) {
         vertices.at(n, nn);
         if (n + kAhead < nn) {

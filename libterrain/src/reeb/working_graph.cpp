@@ -136,12 +136,13 @@ std::size_t WorkingGraph::working_bytes() const {
 namespace {
 
 // The summed area of node n's vertices, added in increasing vertex order (as a sweep over
-// the vertices would add them).
+// the vertices would add them). `sorted` turns false when the node's list is not ascending.
 double node_area(const TriangleMesh& mesh, const ReebGraph& g, std::size_t n,
-                 std::vector<i32>& scratch) {
+                 std::vector<i32>& scratch, bool& sorted) {
     const i32* v = g.node_vertices.data() + g.node_vertex_offsets[n];
     const std::size_t count = idx(g.node_vertex_offsets[n + 1] - g.node_vertex_offsets[n]);
-    if (!std::is_sorted(v, v + count)) {
+    if (count > 1 && !std::is_sorted(v, v + count)) {
+        sorted = false;
         scratch.assign(v, v + count);
         std::sort(scratch.begin(), scratch.end());
         v = scratch.data();
@@ -166,10 +167,8 @@ WorkingGraph::WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big
     const PassProgress lists(progress, 0.03, 0.1, "simplify"),
         nodes(progress, 0.25, 0.6, "simplify"), arcs(progress, 0.76, 1, "simplify");
     const std::size_t nn = g.node_count(), na = g.arc_count(), nl = g.arc_nodes.size();
-    if (owned) {  // not read here: the regular nodes' arcs, the vertices' nodes
-        detail::release(owned->node_arcs);
-        detail::release(owned->vertex_nodes);
-    }
+    owned_ = owned;
+    if (owned) detail::release(owned->node_arcs);  // not read here
     // node_map_[n]: arc ends marked, the other regular nodes of the lists by their position in
     // arc_nodes (`placed` says which positions hold their node); then the new numbers.
     constexpr i32 kEnd = -2;
@@ -197,6 +196,7 @@ WorkingGraph::WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big
                              PassProgress(progress, 0.2, 0.25, "simplify"));
     total_area_ = 0;
     std::vector<i32> scratch;
+    bool sorted = true;  // every node's vertex list ascending
     i32 k = 0;
     for (std::size_t n = 0; n < nn; ++n) {
         nodes.at(n, nn);
@@ -207,7 +207,7 @@ WorkingGraph::WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big
                 __builtin_prefetch(&mesh.vertex_areas[idx(g.node_vertices[idx(i)])]);
             if (node_map_[m] >= 0) __builtin_prefetch(&regular_[idx(node_map_[m])], 1);
         }
-        const double area = node_area(mesh, g, n, scratch);
+        const double area = node_area(mesh, g, n, scratch, sorted);
         total_area_ += area;
         if (node_map_[n] < 0) {
             critical_[idx(k)].area = area;
@@ -224,6 +224,14 @@ WorkingGraph::WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big
     if (owned) {  // the nodes are copied
         detail::release(owned->node_values);
         detail::release(owned->node_kinds);
+        // The vertex lists or the vertices' nodes, whichever write_result will not read.
+        lists_from_vertex_nodes_ = sorted && owned->vertex_nodes.size() == input_vertices_;
+        if (lists_from_vertex_nodes_) {
+            detail::release(owned->node_vertices);
+            detail::release(owned->node_vertex_offsets);
+        } else {
+            detail::release(owned->vertex_nodes);
+        }
     }
     // Arc a joins its lower then its upper end, a in order.
     detail::assign_in_slices(arcs_, na, Arc{}, PassProgress(progress, 0.6, 0.7, "simplify"));

@@ -363,6 +363,11 @@ class WorkingGraph {
     std::vector<i32> free_big_;     // BigNodes given back, for reuse
     std::vector<i32> pending_big_;  // nodes flagged kPending
     ReebGraph* owned_ = nullptr;    // the input graph, when handed over (own_input)
+    // A graph handed over whose vertex lists are all ascending (build_reeb_graph's) gives up
+    // its lists (4 bytes a vertex and 4 a node) once the nodes are copied and keeps its
+    // vertex_nodes (4 bytes a vertex): write_result makes the same lists again from them, once
+    // the working graph is freed.
+    bool lists_from_vertex_nodes_ = false;
     // Frees the records, runs, arcs, sets and big nodes (write_result, once the arcs are out).
     void release_working_graph();
     std::size_t moves_ = 0;  // link() calls
