@@ -71,7 +71,7 @@ bool contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& prog
     g.node_upper_links.assign(nn, 1);
     std::vector<char> general;
     std::vector<LinkCounts> vertex_links;
-    const std::vector<LinkReps> reps =
+    std::vector<LinkReps> reps =
         link_components(mesh, g, vertex_links, general, scaled_progress(progress, 0.2, 0.3));
 
     // Each event's parent in the join tree (below it) and in the split tree (above it).
@@ -210,6 +210,7 @@ bool contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& prog
     };
     tbb::parallel_invoke([&] { sweep(true, join_parent); }, [&] { sweep(false, split_parent); });
     for (auto& s : swept_by_side) detail::release(s);
+    detail::release(reps);  // (16 bytes a node: what the arcs below are made beside)
     const auto components = std::count(join_parent.begin(), join_parent.end(), kNone);
     const auto chi = static_cast<std::int64_t>(mesh.vertex_count()) -
                      static_cast<std::int64_t>(mesh.edge_count()) +
@@ -269,6 +270,8 @@ bool contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& prog
     }
     detail::release(queue);
     detail::release(children);
+    detail::release(join_parent);
+    detail::release(split_parent);
     report_progress(progress, 0.75, "reeb: contour tree");
 
     // Up-edges per node (CSR, in the order of the removed leaves' indices), and down degrees.

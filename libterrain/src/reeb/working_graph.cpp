@@ -165,7 +165,7 @@ WorkingGraph::WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big
     // large blocks made a slice at a time (their first touch is slow, docs/performance.md).
     using detail::PassProgress;
     const PassProgress lists(progress, 0.03, 0.1, "simplify"),
-        nodes(progress, 0.25, 0.6, "simplify"), arcs(progress, 0.76, 1, "simplify");
+        nodes(progress, 0.25, 0.6, "simplify"), arcs(progress, 0.7, 1, "simplify");
     const std::size_t nn = g.node_count(), na = g.arc_count(), nl = g.arc_nodes.size();
     owned_ = owned;
     if (owned) detail::release(owned->node_arcs);  // not read here
@@ -235,8 +235,6 @@ WorkingGraph::WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big
     }
     // Arc a joins its lower then its upper end, a in order.
     detail::assign_in_slices(arcs_, na, Arc{}, PassProgress(progress, 0.6, 0.7, "simplify"));
-    detail::assign_in_slices(set_parent_, na, kNone, PassProgress(progress, 0.7, 0.73, "simplify"));
-    detail::assign_in_slices(set_fate_, na, kNone, PassProgress(progress, 0.73, 0.76, "simplify"));
     for (std::size_t a = 0; a < na; ++a) {
         arcs.at(a, na);
         Arc& arc = arcs_[a];
@@ -268,6 +266,11 @@ WorkingGraph::WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big
         detail::release(owned->arc_offsets);
         detail::release(owned->arc_nodes);
     }
+    detail::release(placed);
+    // The lists' sets, made once the input's arcs are freed (the copy's end is the peak of
+    // the simplification's memory).
+    detail::assign_in_slices(set_parent_, na, kNone, PassProgress(progress, 1, 1, "simplify"));
+    detail::assign_in_slices(set_fate_, na, kNone, PassProgress(progress, 1, 1, "simplify"));
 }
 
 }  // namespace terrain::reeb::internal
