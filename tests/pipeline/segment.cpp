@@ -3,6 +3,7 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <climits>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -91,12 +92,31 @@ TEST_CASE("pipeline::segment gives the DEM back bit for bit, floats or not", "[p
             return 1737400.0 + step * std::round(40 * std::sin(c * 0.2) * std::cos(r * 0.15) +
                                                  ((c * 7919 + r * 104729) % 13));
         });
-        const auto result = pipeline::segment(pipeline::input_from_dem(dem, "map"), {});
+        // Parked on disk (every array, whatever its size) or held in memory: the same.
+        pipeline::SegmentOptions parking, holding;
+        parking.park_min_bytes = 0;
+        parking.park_directory = test::scratch_dir("pipeline_parked").string();
+        holding.park_min_bytes = SIZE_MAX;
+        const auto result = pipeline::segment(pipeline::input_from_dem(dem, "map"), parking);
         REQUIRE(result.dem());
         const auto& back = result.dem()->values;
         REQUIRE(back.size() == dem.values.size());
         CHECK(std::memcmp(back.data(), dem.values.data(), back.size() * sizeof(double)) == 0);
         CHECK(result.segmentation.region_count > 1);
+        // Parked: the DEM's values (as floats when they all are), the field, the pixel maps.
+        const std::size_t n = dem.values.size(), nv = result.input.mesh.vertex_count();
+        CHECK(result.parked_bytes == (step == 0.5 ? 4 : 8) * n + 4 * nv + 4 * n + 4 * nv + nv);
+        const auto held = pipeline::segment(pipeline::input_from_dem(dem, "map"), holding);
+        CHECK(result.label_pixels() == held.label_pixels());
+        CHECK(result.field == held.field);
+        CHECK(result.segmentation.labels == held.segmentation.labels);
+        const auto &m = result.input.mesh, &h = held.input.mesh;
+        CHECK(m.pixel_vertex == h.pixel_vertex);
+        CHECK(m.vertex_pixel == h.vertex_pixel);
+        CHECK(m.neighbor_directions == h.neighbor_directions);
+        CHECK(m.positions == h.positions);
+        CHECK(held.parked_bytes == 0);
+        CHECK(std::distance(fs::directory_iterator(parking.park_directory), {}) == 0);
     }
 }
 

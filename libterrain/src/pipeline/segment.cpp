@@ -13,6 +13,7 @@
 
 #include "../core/pass_progress.hpp"
 #include "../core/release.hpp"
+#include "parked_arrays.hpp"
 #include "terrain/core/error.hpp"
 #include "terrain/core/json_writer.hpp"
 #include "terrain/core/version.hpp"
@@ -269,6 +270,17 @@ class PackedHeights {
         detail::release(dem.values);
         packed_ = true;
     }
+    // The bytes of the DEM's values as held now.
+    std::size_t bytes(const Dem& dem) const {
+        return packed_ ? values_.size() * sizeof(float) : dem.values.size() * sizeof(double);
+    }
+    // The floats parked (parked_arrays.hpp) and read back.
+    bool park(internal::ParkedArrays& parked, const ProgressFn& progress) {
+        return packed_ && parked.park(values_, progress, 0, 1);
+    }
+    void restore(internal::ParkedArrays& parked, const ProgressFn& progress) {
+        if (packed_) parked.restore(values_, progress, 0, 1);
+    }
     void unpack(Dem& dem, const ProgressFn& progress) {
         if (!packed_) return;
         const std::size_t n = values_.size();
@@ -332,22 +344,49 @@ SegmentResult segment(Input input, const SegmentOptions& options, const Progress
     // simplification run, which do not read them, and places them again before the growing:
     // the same floats (docs/mesh.md, "Positions freed and placed again").
     const bool placed_again = result.input.dem && mesh.release_positions();
+    // The DEM's values, then the field and the mesh's pixel maps, wait unread through the Reeb
+    // graph and the simplification, which hold the run's peak of memory: they are parked on
+    // disk (parked_arrays.hpp; docs/performance.md, "Arrays parked on disk") when large.
     PackedHeights packed;
+    internal::ParkedArrays parked(options.park_directory, options.park_min_bytes);
     const auto tp = clock::now();
-    if (result.input.dem) packed.pack(*result.input.dem, scaled_progress(progress, 0.2, 0.21));
+    if (result.input.dem) {
+        Dem& dem = *result.input.dem;
+        packed.pack(dem, scaled_progress(progress, 0.2, 0.205));
+        parked.decide(packed.bytes(dem) + sizeof(float) * result.field.size() +
+                      sizeof(std::int32_t) * (mesh.pixel_vertex.size() + mesh.vertex_pixel.size()) +
+                      mesh.neighbor_directions.size());
+        if (!packed.park(parked, scaled_progress(progress, 0.205, 0.21)))
+            parked.park(dem.values, progress, 0.205, 0.21);
+    }
     result.add_time("reeb", since(tp));  // (which it precedes: the times stay in run order)
     auto graph = compute_reeb(result, scaled_progress(progress, 0.21, 0.4));
     // One scale only: the simplification takes the graph and frees what it no longer needs,
     // which lowers the peak memory.
     const auto t0 = clock::now();
+    if (parked.on()) {
+        parked.park(result.field, progress, 0.4, 0.403);
+        parked.park(mesh.pixel_vertex, progress, 0.403, 0.406);
+        parked.park(mesh.vertex_pixel, progress, 0.406, 0.409);
+        parked.park(mesh.neighbor_directions, progress, 0.409, 0.41);
+    }
+    result.parked_bytes = parked.parked_bytes();
     const auto thresholds = simplify_options(options, result.input.mesh);
     result.area_ratio_percent = thresholds.area_ratio;
     const auto simplified = reeb::simplify(result.input.mesh, std::move(graph), thresholds,
-                                           scaled_progress(progress, 0.4, 0.6));
+                                           scaled_progress(progress, 0.41, 0.6));
     const double seconds = since(t0);
     // (Counted with the growing, which it precedes: the stages' times stay in run order.)
     const auto t2 = clock::now();
-    if (result.input.dem) packed.unpack(*result.input.dem, scaled_progress(progress, 0.6, 0.61));
+    parked.restore(mesh.neighbor_directions, progress, 0.6, 0.601);
+    parked.restore(mesh.vertex_pixel, progress, 0.601, 0.602);
+    parked.restore(mesh.pixel_vertex, progress, 0.602, 0.603);
+    parked.restore(result.field, progress, 0.603, 0.604);
+    if (result.input.dem) {
+        parked.restore(result.input.dem->values, progress, 0.604, 0.605);
+        packed.restore(parked, scaled_progress(progress, 0.604, 0.605));
+        packed.unpack(*result.input.dem, scaled_progress(progress, 0.605, 0.61));
+    }
     if (placed_again)
         mesh::restore_positions(*result.input.dem, mesh, scaled_progress(progress, 0.61, 0.62));
     const double placing = since(t2);
@@ -487,6 +526,7 @@ void write_run_json(const SegmentResult& result, const std::string& input_path,
         .field("relaxed_nodes", result.segmentation.relaxed_nodes)
         .field("absorbed_vertices", result.divided.absorbed)
         .field("absorbed_relabelled", result.divided.relabelled)
+        .field("parked_bytes", result.parked_bytes)
         .end_object();
     j.key("timings_seconds").begin_object();
     double total = 0;

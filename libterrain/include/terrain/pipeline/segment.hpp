@@ -82,6 +82,13 @@ struct SegmentOptions {
     // nodes: "divide" (default) gives them back to the regions around by their own values
     // (segment::divide_absorbed); "whole" keeps each node one unit, as the paper does.
     std::string absorbed = "divide";
+    // Large arrays that wait unread through the Reeb graph and the simplification (the DEM's
+    // values, the field, the mesh's pixel maps) are parked in an unlinked temporary file in
+    // this directory (empty: $TMPDIR, else /tmp) when they hold park_min_bytes or more; a
+    // directory that refuses the file, or a full disk, leaves them in memory. The outputs are
+    // the same either way (docs/performance.md, "Arrays parked on disk").
+    std::string park_directory;
+    std::size_t park_min_bytes = std::size_t{64} << 20;
 };
 
 enum class Absorbed { divide, whole };
@@ -128,6 +135,7 @@ struct SegmentResult {
     Input input;
     std::vector<float> field;         // per mesh vertex, as computed
     std::size_t critical_before = 0;  // critical nodes of the unsimplified Reeb graph
+    std::size_t parked_bytes = 0;     // the most bytes parked on disk at once (segment())
     reeb::ReebSummary after;          // the simplified graph of the segmentation
     // Its region_count counts every region of the table: on a DEM, after the vertices'
     // regions, those of valid pixels in no triangle (segment::label_pixels).

@@ -1,0 +1,80 @@
+#pragma once
+// Private: large arrays parked in a temporary file while the stages that do not read them run
+// (docs/performance.md, "Arrays parked on disk"). The Reeb graph and the simplification hold
+// the run's peak of memory; the DEM's values, the field and the mesh's pixel maps wait beside
+// them unread. Parked, they leave the resident set: their bytes go to a file the kernel writes
+// back and may evict, and they are read back, the same bytes, before the growing.
+//
+// The file is unlinked as soon as it is made (O_TMPFILE, or a named file removed at once), so
+// nothing is left behind whatever ends the process. A directory that refuses the file, or a
+// write that fails (a full disk), parks nothing more: the arrays stay in memory and the run
+// goes on, the same. A read that fails throws terrain::Error: the data would be lost.
+// Not installed.
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+#include "terrain/core/progress.hpp"
+
+namespace terrain::pipeline::internal {
+
+class ParkedArrays {
+  public:
+    // `dir`: where the file goes (empty: the system's temporary directory, $TMPDIR).
+    // Arrays below `min_bytes` in all are not worth the file: parking them does nothing.
+    ParkedArrays(std::string dir, std::size_t min_bytes);
+    ~ParkedArrays();
+    ParkedArrays(const ParkedArrays&) = delete;
+    ParkedArrays& operator=(const ParkedArrays&) = delete;
+
+    // Decides, from the bytes the arrays to be parked hold in all, whether to park them: when
+    // they reach min_bytes and the file can be made.
+    void decide(std::size_t bytes);
+    // Whether parking is on.
+    bool on() const { return fd_ >= 0 && !full_; }
+
+    // Writes v's elements to the file and frees v; returns false (v kept) when parking is
+    // off or the write fails. Progress from `begin` to `end` of `progress`.
+    template <class T>
+    bool park(std::vector<T>& v, const ProgressFn& progress, double begin, double end) {
+        static_assert(std::is_trivially_copyable_v<T>);
+        if (!write(&v, v.data(), v.size(), sizeof(T), progress, begin, end)) return false;
+        std::vector<T>().swap(v);
+        return true;
+    }
+    // Reads back what park(v) wrote into v (nothing when v was not parked).
+    template <class T>
+    void restore(std::vector<T>& v, const ProgressFn& progress, double begin, double end) {
+        const Entry* e = find(&v);
+        if (!e) return;
+        std::vector<T> back(e->count);
+        read(*e, back.data(), progress, begin, end);
+        v.swap(back);
+        forget(&v);
+    }
+    // Bytes parked now.
+    std::size_t parked_bytes() const;
+
+  private:
+    struct Entry {
+        const void* owner;
+        std::uint64_t offset, count, size;
+    };
+    bool write(const void* owner, const void* data, std::size_t count, std::size_t size,
+               const ProgressFn& progress, double begin, double end);
+    void read(const Entry& e, void* data, const ProgressFn& progress, double begin, double end);
+    const Entry* find(const void* owner) const;
+    void forget(const void* owner);
+
+    std::string dir_;
+    std::size_t min_bytes_;
+    int fd_ = -1;
+    bool full_ = false;      // a write failed: nothing more is parked
+    std::uint64_t end_ = 0;  // the file's length
+    std::vector<Entry> entries_;
+};
+
+}  // namespace terrain::pipeline::internal
