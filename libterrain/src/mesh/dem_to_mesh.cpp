@@ -280,8 +280,21 @@ TriangleMesh dem_to_mesh(const Dem& dem, const DemToMeshOptions& options,
     mesh.isolated_vertices =
         remove_unreferenced_vertices(mesh, scaled_progress(progress, 0.5, 0.6));
     const auto before_split = static_cast<std::int32_t>(mesh.positions.size());
+    // Only a vertex next to a missing pixel, or on the grid's first or last two rows or
+    // columns (the grid's edge, the poles, the seam), can be pinched: the fan of a vertex
+    // whose 8 neighbouring pixels are valid is the full disk of its four complete blocks, and
+    // a split elsewhere never parts two triangles sharing an edge.
+    const auto may_pinch = [&](std::size_t v) {
+        const std::int32_t p = mesh.vertex_pixel[v];
+        const int col = p % dem.width, row = p / dem.width;
+        if (row < 2 || row >= dem.height - 2 || col < 1 || col >= dem.width - 1) return true;
+        for (int r = row - 1; r <= row + 1; ++r)
+            for (int c = col - 1; c <= col + 1; ++c)
+                if (!dem.valid(c, r)) return true;
+        return false;
+    };
     mesh.pinched_vertices =
-        split_pinched_vertices(mesh, nullptr, scaled_progress(progress, 0.6, 0.7));
+        split_pinched_vertices(mesh, nullptr, scaled_progress(progress, 0.6, 0.7), may_pinch);
     // The triangles naming a copy, which the grid alone would not make again.
     if (mesh.pinched_vertices > 0)
         for (std::size_t i = 0; i < mesh.triangles.size(); ++i) {

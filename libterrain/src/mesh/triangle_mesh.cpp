@@ -418,18 +418,31 @@ MeshTopology mesh_topology(const TriangleMesh& mesh) {
 // Every fan after the largest (ties: the one holding the lowest triangle index) gets a copy
 // of v. Returns the number of vertices split.
 std::size_t split_pinched_vertices(TriangleMesh& mesh, std::int32_t* first_pinched,
-                                   const ProgressFn& progress) {
+                                   const ProgressFn& progress,
+                                   const std::function<bool(std::size_t)>& may_pinch) {
     const std::size_t n = mesh.positions.size();
     // Its passes: the incident triangles (counted, made, listed: 0 to 0.5), the fans (to 1).
     const detail::PassProgress counted(progress, 0, 0.15, "mesh"),
         listed(progress, 0.3, 0.5, "mesh"), each_vertex(progress, 0.5, 1, "mesh");
     check_adjacency_size(3 * std::uint64_t{mesh.triangles.size()}, "triangle corners");
-    std::vector<std::uint32_t> offsets(n + 1, 0);
+    // The incident triangles of the vertices looked at (all, or those that may be pinched),
+    // by their rank among them.
+    std::vector<std::int32_t> rank_of;  // with may_pinch: each vertex's rank, -1 if not looked at
+    std::size_t looked_at = n;
+    if (may_pinch) {
+        rank_of.assign(n, -1);
+        looked_at = 0;
+        for (std::size_t v = 0; v < n; ++v)
+            if (may_pinch(v)) rank_of[v] = std::int32_t(looked_at++);
+    }
+    const auto rank = [&](std::int32_t v) { return may_pinch ? rank_of[std::size_t(v)] : v; };
+    std::vector<std::uint32_t> offsets(looked_at + 1, 0);
     for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
         counted.at(t, mesh.triangles.size());
-        for (auto v : mesh.triangles[t]) ++offsets[v + 1];
+        for (auto v : mesh.triangles[t])
+            if (const std::int32_t r = rank(v); r >= 0) ++offsets[std::size_t(r) + 1];
     }
-    for (std::size_t v = 0; v < n; ++v) offsets[v + 1] += offsets[v];
+    for (std::size_t r = 0; r < looked_at; ++r) offsets[r + 1] += offsets[r];
     std::vector<std::int32_t> incident;
     detail::assign_in_slices(incident, offsets.back(), 0,
                              detail::PassProgress(progress, 0.15, 0.3, "mesh"));
@@ -437,7 +450,9 @@ std::size_t split_pinched_vertices(TriangleMesh& mesh, std::int32_t* first_pinch
         std::vector<std::uint32_t> fill(offsets.begin(), offsets.end() - 1);
         for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
             listed.at(t, mesh.triangles.size());
-            for (auto v : mesh.triangles[t]) incident[fill[v]++] = std::int32_t(t);
+            for (auto v : mesh.triangles[t])
+                if (const std::int32_t r = rank(v); r >= 0)
+                    incident[fill[std::size_t(r)]++] = std::int32_t(t);
         }
     }
     std::size_t split = 0;
@@ -447,8 +462,11 @@ std::size_t split_pinched_vertices(TriangleMesh& mesh, std::int32_t* first_pinch
     constexpr std::int32_t kPairwise = 16;
     for (std::size_t v = 0; v < n; ++v) {
         each_vertex.at(v, n);
-        const std::size_t begin = offsets[v];
-        const auto k = static_cast<std::int32_t>(offsets[v + 1] - offsets[v]);  // a fan's size
+        const std::int32_t r = rank(std::int32_t(v));
+        if (r < 0) continue;
+        const std::size_t begin = offsets[std::size_t(r)];
+        const auto k =
+            static_cast<std::int32_t>(offsets[std::size_t(r) + 1] - begin);  // a fan's size
         if (k < 2) continue;
         fans_of.reset(static_cast<std::size_t>(k));
         auto find = [&](std::int32_t x) { return fans_of.find(x); };

@@ -7,6 +7,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -188,8 +189,12 @@ std::vector<std::uint32_t> first_edge_slots(const TriangleMesh& mesh);
 // largest fan (ties: the one with the lowest triangle) keeps it, each other fan gets a copy
 // appended at the end (vertex_pixel copied too). Returns the number of vertices split and
 // stores the first one in *first_pinched when given. Call before finish_mesh.
+// `may_pinch` (when given) names the only vertices that can be pinched: the others are not
+// looked at, and their incident triangles are not listed (dem_to_mesh: the vertices next to a
+// missing pixel or the grid's edge; a full grid lists almost none, 24 bytes a pixel less).
 std::size_t split_pinched_vertices(TriangleMesh& mesh, std::int32_t* first_pinched = nullptr,
-                                   const ProgressFn& progress = {});
+                                   const ProgressFn& progress = {},
+                                   const std::function<bool(std::size_t)>& may_pinch = {});
 
 // Removes vertices that are in no triangle, keeping the order of the others (and their
 // vertex_pixel). Returns the number removed.
