@@ -28,15 +28,17 @@ MemoryPlan memory_plan(const std::string& field, std::uint64_t limit) {
     // DEMs: the grids (the values as doubles, the pixels' vertices, the labels) cost 16 to 24
     // bytes a pixel; the rest goes with the valid pixels. Measured on fully valid grids
     // (global synthetic grids of 1 to 66 M pixels): 80 bytes a pixel for reading and
-    // meshing, 110 to 116 for segmenting with the shape index or the height (whose preview,
-    // encoded after the large data are freed, makes a floor of about 146 MB), 545 with the SDF.
+    // meshing, 79 to 81 for segmenting with the shape index or the height from 16.6 M pixels
+    // on (the large arrays the Reeb graph and the simplification do not read parked on disk;
+    // below that the process's own memory and the preview, encoded after the large data are
+    // freed, make a floor of about 176 MB), 545 with the SDF.
     if (field.empty()) {
         plan.bytes_per_pixel = 16;
         plan.bytes_per_valid_pixel = 84;
     } else {
-        plan.floor_bytes = 160 * MB;
+        plan.floor_bytes = 200 * MB;
         plan.bytes_per_pixel = 24;
-        plan.bytes_per_valid_pixel = sdf ? 656 : 116;
+        plan.bytes_per_valid_pixel = sdf ? 656 : 66;
     }
     return plan;
 }
