@@ -37,7 +37,7 @@ int run_segment(int argc, char** argv) {
 
         const auto progress = terminal_progress(common.quiet);
         auto input = load_input(common.input, input_values, field_values.name,
-                                scaled_progress(progress, 0, 0.15));
+                                scaled_progress(progress, 0, 0.15), true);
         check_field_limits(field_values.options, input.mesh);  // --radius against the mesh
         print_input_warnings("segment", input);
         auto result = pipeline::segment(std::move(input), segment_options,

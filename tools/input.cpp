@@ -17,11 +17,13 @@ void add_input_options(po::options_description& options, InputOptionValues& valu
 }
 
 Input load_input(const std::string& path, const InputOptionValues& values, const std::string& field,
-                 const ProgressFn& progress) {
+                 const ProgressFn& progress, bool segment) {
     pipeline::InputOptions options;
     options.dem = to_read_options(values.dem);  // checks the values
-    // The pipeline's memory plan for the field computed next, with --max-memory.
+    // The pipeline's memory plan for the field computed next (segment: pipeline::segment's),
+    // with --max-memory.
     options.planned_field = field;
+    options.planned_segment = segment;
     if (!values.dem.max_memory.empty())
         options.max_memory = parse_memory_size(values.dem.max_memory);
     options.repair = values.repair;

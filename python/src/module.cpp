@@ -290,9 +290,10 @@ std::uint64_t memory_limit_argument(const py::object& max_memory) {
 pipeline::InputOptions input_options(int band, const std::string& elevation, bool nan_nodata,
                                      std::optional<double> pixel_size, const std::string& frame,
                                      bool repair, const py::object& max_memory,
-                                     const std::string& field) {
+                                     const std::string& field, bool segment = false) {
     pipeline::InputOptions o;
     o.planned_field = field;
+    o.planned_segment = segment;  // pipeline::segment's own plan
     o.max_memory = memory_limit_argument(max_memory);
     o.dem.band = band;
     o.dem.elevation = parse_elevation(elevation);
@@ -508,7 +509,7 @@ PYBIND11_MODULE(_terrain, m) {
            const py::object& max_memory) {
             pipeline::check_options(options);
             const auto in = input_options(band, elevation, nan_nodata, pixel_size, frame, repair,
-                                          max_memory, options.field);
+                                          max_memory, options.field, true);
             const Source s = to_source(source);
             return run(progress, [&](const ProgressFn& fn) {
                 auto input = load(s, in, scaled_progress(fn, 0, 0.2));

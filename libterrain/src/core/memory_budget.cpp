@@ -80,14 +80,15 @@ std::string bytes_text(double bytes) {
 }
 }  // namespace
 
-void check_memory(const std::string& what, double bytes, std::uint64_t limit) {
+void check_memory(const std::string& what, double bytes, std::uint64_t limit, double held) {
     if (limit == 0) limit = limit_bytes;
     if (limit > 0 && bytes > double(limit))
         throw Error("memory", what + " needs about " + bytes_text(bytes) +
                                   " but the memory limit is " + bytes_text(double(limit)));
-    if (const auto available = available_memory(); available && bytes > double(*available))
+    // What the process holds already is part of `bytes` and not of the memory available.
+    if (const auto available = available_memory(); available && bytes > double(*available) + held)
         throw Error("memory", what + " needs about " + bytes_text(bytes) + " but only " +
-                                  bytes_text(double(*available)) +
+                                  bytes_text(double(*available) + held) +
                                   " are available; use a smaller input or free memory");
 }
 

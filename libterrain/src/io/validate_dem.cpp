@@ -89,8 +89,10 @@ void check_dem_valid_pixels(const std::string& path, const Dem& dem, std::size_t
                             const MemoryPlan* plan) {
     if (!plan || !plan->checked) return;
     const double pixels = double(dem.width) * double(dem.height);
+    // (The values just read are resident already: the memory available no longer has them.)
     check_memory(grid_name(path, dem) + " with " + std::to_string(valid) + " valid pixels",
-                 plan->dem_bytes(pixels, double(valid)), plan->limit);
+                 plan->dem_bytes(pixels, double(valid)), plan->limit,
+                 double(dem.values.capacity() * sizeof(double)));
 }
 
 void check_dem_size(const std::string& path, const Dem& dem, GDALRasterBand& band,

@@ -48,7 +48,8 @@ std::optional<MeshFrame> parse_frame(const std::string& name) {
 
 Input load_input(const std::string& path, const InputOptions& options, const ProgressFn& progress) {
     const auto t0 = clock::now();
-    const MemoryPlan plan = memory_plan(options.planned_field, options.max_memory);
+    const MemoryPlan plan =
+        memory_plan(options.planned_field, options.max_memory, options.planned_segment);
     if (io::is_mesh_file(path)) {
         io::ReadMeshOptions read_options;
         read_options.repair = options.repair;
@@ -554,6 +555,7 @@ SegmentResult segment_to_directory(const std::string& input_path, const std::str
     OutputDirectory dir(output_dir, overwrite);
     InputOptions planned = input_options;
     planned.planned_field = options.field;  // the plan of the field segmented
+    planned.planned_segment = true;
     auto input = load_input(input_path, planned, scaled_progress(progress, 0, 0.15));
     auto result = segment(std::move(input), options, scaled_progress(progress, 0.15, 0.7));
     WriteOptions write;

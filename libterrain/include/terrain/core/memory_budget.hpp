@@ -54,6 +54,8 @@ struct MemoryPlan {
 // process-wide one of set_memory_limit, if any. The one line names the bytes needed and
 // the bytes the limit or the system allows, rounded and exact:
 //   "... needs about 152 MB (159383552 bytes) but the memory limit is 140 MB (146800640 bytes)"
-void check_memory(const std::string& what, double bytes, std::uint64_t limit = 0);
+// `held`: bytes of `bytes` the process holds already (a DEM read before its valid pixels
+// are counted), which the memory available no longer includes.
+void check_memory(const std::string& what, double bytes, std::uint64_t limit = 0, double held = 0);
 
 }  // namespace terrain

@@ -14,7 +14,10 @@ namespace terrain::pipeline {
 
 // The plan of reading an input and working on it with `field` ("shape-index", "height",
 // "sdf"; "" for reading and meshing only, as `terrain mesh` does), with the caller's limit
-// in bytes (0: the memory available only). Throws terrain::Error for an unknown field.
-MemoryPlan memory_plan(const std::string& field, std::uint64_t limit = 0);
+// in bytes (0: the memory available only). `segment`: the work is pipeline::segment (one
+// scale), which frees and parks on disk what its stages do not read, so a DEM costs less
+// than the field, the Reeb graph or a sweep over scales, which hold them. Throws
+// terrain::Error for an unknown field.
+MemoryPlan memory_plan(const std::string& field, std::uint64_t limit = 0, bool segment = false);
 
 }  // namespace terrain::pipeline

@@ -50,6 +50,9 @@ struct InputOptions {
     // dem.memory.
     std::string planned_field = "shape-index";
     std::uint64_t max_memory = 0;
+    // The work is pipeline::segment, one scale, which frees and parks what its stages do not
+    // read: its own, lower plan (memory_plan's `segment`).
+    bool planned_segment = false;
 };
 
 // The frame named by InputOptions::frame; throws terrain::Error (stage "mesh") otherwise.
