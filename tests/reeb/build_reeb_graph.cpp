@@ -24,6 +24,12 @@ using terrain::reeb::NodeKind;
 
 namespace {
 
+// Noise on four levels: noise_field's values (in [0, 100)) by quarters, which makes plateaus.
+std::vector<float> quantized(std::vector<float> f) {
+    for (float& x : f) x = std::floor(x / 25);
+    return f;
+}
+
 std::vector<float> coordinate_field(const TriangleMesh& mesh, std::array<double, 3> w) {
     std::vector<float> f(mesh.vertex_count());
     for (std::size_t v = 0; v < f.size(); ++v) {
@@ -276,11 +282,8 @@ TEST_CASE("The contour tree and the sweep give the same graph on disks and spher
     CHECK_THROWS_WITH(reeb::build_reeb_graph(holed, test::noise_field(holed.vertex_count(), 1),
                                              {reeb::ReebAlgorithm::contour_tree}),
                       Catch::Contains("disks or spheres"));
-    // Noise on four levels: plateaus of every shape, degenerate saddles and boundary runs.
-    auto quantized = [](std::vector<float> f) {
-        for (float& x : f) x = std::floor(x / 25);  // noise_field is in [0, 100)
-        return f;
-    };
+    // Noise on four levels (quantized): plateaus of every shape, degenerate saddles and
+    // boundary runs.
     const std::vector<std::pair<const TriangleMesh*, std::vector<float>>> cases = {
         {&disk, field::shape_index_field(disk)},
         {&disk, field::height_field(disk, &dem)},
@@ -323,10 +326,6 @@ TEST_CASE("A DEM mesh's Reeb graph is the same with its triangles released", "[r
         return c == 4 && r != 4 ? std::nan("") : std::sin(0.9 * c) * std::cos(0.7 * r);
     }));
     REQUIRE(pinched.pinched_vertices == 1);
-    auto quantized = [](std::vector<float> f) {
-        for (float& x : f) x = std::floor(x / 25);  // noise_field is in [0, 100): plateaus
-        return f;
-    };
     const std::vector<std::pair<const TriangleMesh*, std::vector<float>>> cases = {
         {&disk, field::shape_index_field(disk)},
         {&disk, quantized(test::noise_field(disk.vertex_count(), 3))},

@@ -336,7 +336,7 @@ void restore_positions(const Dem& dem, TriangleMesh& mesh, const ProgressFn& pro
     for (std::size_t v = 0; v < n; ++v) {
         copies.at(v, n);
         const std::int32_t first = mesh.pixel_vertex[std::size_t(mesh.vertex_pixel[v])];
-        if (first != std::int32_t(v) && !mesh.is_pole(v))
+        if (first != std::int32_t(v))  // (a pole's pixel names the pole itself)
             positions[v] = positions[std::size_t(first)];
     }
     mesh.set_restored_positions(std::move(positions));

@@ -54,11 +54,16 @@ void TriangleMesh::release_adjacency() {
     grid_edges = 0;
 }
 
-bool TriangleMesh::triangles_releasable() const {
-    return !triangles.empty() && grid_width >= 1 && vertex_pixel.size() == vertex_count() &&
+bool TriangleMesh::grid_describes_it() const {
+    return frame != MeshFrame::file && grid_width >= 1 && grid_height >= 1 &&
+           vertex_pixel.size() == vertex_count() &&
            pixel_vertex.size() == std::size_t(grid_width) * std::size_t(grid_height) &&
            block_diagonals.size() ==
-               std::size_t(grid_height - 1) * ((std::size_t(grid_width) + 63) / 64);
+               std::size_t(grid_height - 1) * detail::diagonal_words(grid_width);
+}
+
+bool TriangleMesh::triangles_releasable() const {
+    return !triangles.empty() && grid_describes_it();
 }
 
 bool TriangleMesh::release_triangles() {
@@ -71,11 +76,7 @@ bool TriangleMesh::release_triangles() {
 
 bool TriangleMesh::release_positions() {
     if (positions_released()) return true;
-    const bool grid = frame != MeshFrame::file && !positions.empty() &&
-                      vertex_pixel.size() == positions.size() &&
-                      pixel_vertex.size() == std::size_t(grid_width) * std::size_t(grid_height) &&
-                      (grid_height < 2 || !block_diagonals.empty());
-    if (!grid) return false;
+    if (positions.empty() || !grid_describes_it()) return false;
     released_vertices_ = positions.size();
     detail::release(positions);
     return true;

@@ -105,9 +105,6 @@ struct TriangleMesh {
     bool positions_released() const { return released_vertices_ > 0; }
     // For mesh::restore_positions: the positions placed again (one a vertex).
     void set_restored_positions(std::vector<std::array<float, 3>>&& placed);
-    bool is_pole(std::size_t v) const {
-        return std::int32_t(v) == pole_vertices[0] || std::int32_t(v) == pole_vertices[1];
-    }
     std::size_t triangle_count() const {
         return triangles_released() ? released_triangles_ : triangles.size();
     }
@@ -150,6 +147,8 @@ struct TriangleMesh {
 
   private:
     VertexNeighbors irregular_neighbors_of(std::size_t v) const;
+    // A DEM mesh whose triangles the grid makes again (its pixel maps and recorded diagonals).
+    bool grid_describes_it() const;
     std::size_t released_triangles_ = 0;
     std::size_t released_vertices_ = 0;
 };
