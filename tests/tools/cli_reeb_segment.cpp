@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "support/test_support.hpp"
+#include "terrain/core/huge_pages.hpp"
 
 using Catch::Matchers::Contains;
 using Catch::Matchers::StartsWith;
@@ -155,6 +156,45 @@ TEST_CASE("terrain segment writes every output, complete or not at all", "[cli][
     // No temporary directories left behind.
     for (const auto& e : fs::directory_iterator(dir))
         CHECK(e.path().filename().string().find(".tmp") == std::string::npos);
+}
+
+TEST_CASE("terrain segment asks for huge pages when the kernel gives them on request",
+          "[cli][segment]") {
+    const auto dir = terrain::test::scratch_dir("cli_huge_pages");
+    const auto dem = vesta_crop(dir);
+    const auto mode = terrain::transparent_huge_page_mode();
+    const auto pages = [](const fs::path& out) {
+        CPLJSONDocument run;
+        REQUIRE(run.Load((out / "run.json").string()));
+        return run.GetRoot().GetString("pages");
+    };
+    // Started again with the tunable: its arguments (a space in a path) reach it unchanged.
+    const auto asked = dir / "huge pages";
+    fs::remove_all(asked);
+    auto r = run_cli({"segment", dem, "-o", asked.string(), "-q"});
+    INFO(r.err);
+    REQUIRE(r.status == 0);
+    CHECK(pages(asked) == (mode == "always" || mode == "madvise" ? "huge" : "normal"));
+    // TERRAIN_HUGE_PAGES=0, or the caller's own tunable, keep the pages normal (unless the
+    // kernel makes every large mapping huge).
+    const std::string kept = mode == "always" ? "huge" : "normal";
+    const auto normal = dir / "normal";
+    fs::remove_all(normal);
+    r = terrain::test::run_program(TERRAIN_CLI, {"segment", dem, "-o", normal.string(), "-q"},
+                                   {"TERRAIN_HUGE_PAGES=0"});
+    REQUIRE(r.status == 0);
+    CHECK(pages(normal) == kept);
+    const auto own = dir / "own";
+    fs::remove_all(own);
+    r = terrain::test::run_program(TERRAIN_CLI, {"segment", dem, "-o", own.string(), "-q"},
+                                   {"GLIBC_TUNABLES=glibc.malloc.hugetlb=0"});
+    REQUIRE(r.status == 0);
+    CHECK(pages(own) == kept);
+    // The same outputs, byte for byte.
+    for (const char* name : {"labels.tif", "regions.geojson", "adjacency.json", "preview.png"}) {
+        CHECK(slurp(asked / name) == slurp(normal / name));
+        CHECK(slurp(asked / name) == slurp(own / name));
+    }
 }
 
 TEST_CASE("terrain segment on a constant field, a mostly-NoData DEM and a mesh file",

@@ -15,6 +15,7 @@
 #include "../core/release.hpp"
 #include "parked_arrays.hpp"
 #include "terrain/core/error.hpp"
+#include "terrain/core/huge_pages.hpp"
 #include "terrain/core/json_writer.hpp"
 #include "terrain/core/version.hpp"
 #include "terrain/io/dependency_versions.hpp"
@@ -540,6 +541,7 @@ void write_run_json(const SegmentResult& result, const std::string& input_path,
     for (const auto& f : files) j.value(f);
     j.end_array();
     for (const auto& [k, v] : extra) j.key(k).raw(v);
+    j.field("pages", huge_page_use());  // huge or normal pages for the arrays (speed only)
     j.key("versions").begin_object().field("terrain", version());
     for (const auto& [name, v] : dependency_versions()) j.field(name, v);
     j.end_object();
