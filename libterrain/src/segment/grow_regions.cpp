@@ -168,34 +168,57 @@ class Grower {
 
     void push(i32 n, i32 r, bool relaxed) { heap_.push({cost(n, r, relaxed), n, r}); }
 
+    // Calls f(v) for each vertex v of node n. A node's list is in the order the simplification
+    // gathered it (by value, scattered over the surface); a node with a large share of the
+    // vertices is walked in vertex order instead, by a pass over vertex_nodes: the vertices
+    // around each one are then next to those of the last (on a global grid, one such node
+    // held 99 % of the vertices and its walk in list order waited on memory at every step).
+    // The callers push candidates, a set: the order does not change what the growing does.
+    // `assigning`: n is being assigned (its vertices count towards the progress).
+    template <class F>
+    void for_each_vertex(i32 n, bool assigning, F&& f) {
+        const i32 first = g_.node_vertex_offsets[idx(n)], last = g_.node_vertex_offsets[idx(n) + 1];
+        const std::size_t count = idx(last - first), nv = g_.vertex_nodes.size();
+        if (count * kWalkShare >= nv) {
+            std::size_t seen = 0;
+            for (std::size_t v = 0; v < nv && seen < count; ++v)
+                if (g_.vertex_nodes[v] == n) {
+                    tick(assigning ? seen : 0);
+                    ++seen;
+                    f(v);
+                }
+            return;
+        }
+        for (i32 i = first; i < last; ++i) {
+            tick(assigning ? idx(i - first) : 0);
+            f(idx(g_.node_vertices[idx(i)]));
+        }
+    }
+    static constexpr std::size_t kWalkShare = 64;  // walked in vertex order from 1/64 of them
+
     // Candidates (u, r) for the unassigned nodes u touching node n (in region r) on the mesh.
     void push_mesh_candidates(i32 n, bool relaxed) {
         const i32 r = node_region_[idx(n)];
         i32 last = kNone;
-        const i32 first = g_.node_vertex_offsets[idx(n)];
-        for (i32 i = first; i < g_.node_vertex_offsets[idx(n) + 1]; ++i) {
-            tick(idx(i - first));
-            const i32 v = g_.node_vertices[idx(i)];
-            for (const i32 w : mesh_.neighbors_of(idx(v))) {
+        for_each_vertex(n, true, [&](std::size_t v) {
+            for (const i32 w : mesh_.neighbors_of(v)) {
                 const i32 u = g_.vertex_nodes[idx(w)];
                 if (u == last || node_region_[idx(u)] != kNone) continue;
                 last = u;
                 if (!relaxed && options_.cost == GrowCost::graph && !reeb_eligible(u)) continue;
                 push(u, r, relaxed);
             }
-        }
+        });
     }
 
     // Candidates for node u against every region it touches on the mesh.
     void push_all_regions(i32 u) {
-        for (i32 i = g_.node_vertex_offsets[idx(u)]; i < g_.node_vertex_offsets[idx(u) + 1]; ++i) {
-            tick(0);
-            const i32 v = g_.node_vertices[idx(i)];
-            for (const i32 w : mesh_.neighbors_of(idx(v))) {
+        for_each_vertex(u, false, [&](std::size_t v) {
+            for (const i32 w : mesh_.neighbors_of(v)) {
                 const i32 r = node_region_[idx(g_.vertex_nodes[idx(w)])];
                 if (r != kNone) push(u, r, false);
             }
-        }
+        });
     }
 
     void assign(i32 n, i32 r) {
