@@ -319,7 +319,11 @@ TEST_CASE("dem_to_mesh: the adjacency on the grid is the triangles' adjacency", 
     SECTION("a full tile: no vertex needs its own list") {
         const Dem dem =
             grid_dem(40, 30, 10.0, [](int c, int r) { return 5.0 * std::sin(0.3 * c + 0.2 * r); });
-        CHECK(check_grid_adjacency(mesh::dem_to_mesh(dem), dem) == 0);
+        const auto mesh = mesh::dem_to_mesh(dem);
+        CHECK(check_grid_adjacency(mesh, dem) == 0);
+        // One range whose neighbours are read off the vertex numbers: rows 2 to 27.
+        REQUIRE(mesh.uniform_ranges.size() == 1);
+        CHECK(mesh.uniform_ranges[0] == std::array<std::int32_t, 2>{2 * 40, 28 * 40});
     }
     SECTION("NoData speckle: holes, pinches and isolated pixels") {
         std::uint32_t state = 12345;
@@ -339,6 +343,11 @@ TEST_CASE("dem_to_mesh: the adjacency on the grid is the triangles' adjacency", 
         const auto mesh = mesh::dem_to_mesh(dem);
         REQUIRE(mesh.seam_closed);
         REQUIRE(mesh.pole_vertices[0] >= 0);
+        // The rows between the poles' (collapsed) rows are one range: rows 3 to 176 (the
+        // north pole's row is one vertex, so a vertex is its pixel less 359).
+        REQUIRE(mesh.uniform_ranges.size() == 1);
+        CHECK(mesh.uniform_ranges[0] ==
+              std::array<std::int32_t, 2>{3 * 360 - 359, 177 * 360 - 359});
         const auto irregular = check_grid_adjacency(mesh, dem);
         // The two seam columns, the poles and the rows next to them at most.
         CHECK(irregular >= 2);
@@ -349,7 +358,10 @@ TEST_CASE("dem_to_mesh: the adjacency on the grid is the triangles' adjacency", 
         for (int r = 40; r < 60; ++r)
             for (int c : {0, 1, 358, 359}) dem.values[dem.index(c, r)] = kNaN;
         dem.values[dem.index(0, 100)] = kNaN;
-        check_grid_adjacency(mesh::dem_to_mesh(dem), dem);
+        const auto mesh = mesh::dem_to_mesh(dem);
+        // Ranges above, between and below the holes, each with its own numbering.
+        CHECK(mesh.uniform_ranges.size() == 3);
+        check_grid_adjacency(mesh, dem);
     }
     SECTION("rows growing northwards: the triangles turn the other way") {
         Dem dem = grid_dem(30, 20, 10.0, [](int c, int r) { return std::cos(0.4 * c) * r; });

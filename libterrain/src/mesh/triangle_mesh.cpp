@@ -41,7 +41,8 @@ std::size_t TriangleMesh::memory_bytes() const {
            irregular_offsets.capacity() * sizeof(std::uint32_t) +
            irregular_neighbors.capacity() * sizeof(std::int32_t) +
            pinch_triangles.capacity() * sizeof(pinch_triangles[0]) +
-           block_diagonals.capacity() * sizeof(std::uint64_t);
+           block_diagonals.capacity() * sizeof(std::uint64_t) +
+           uniform_ranges.capacity() * sizeof(uniform_ranges[0]);
 }
 
 void TriangleMesh::release_adjacency() {
@@ -51,6 +52,7 @@ void TriangleMesh::release_adjacency() {
     detail::release(irregular_vertices);
     detail::release(irregular_offsets);
     detail::release(irregular_neighbors);
+    detail::release(uniform_ranges);
     grid_edges = 0;
 }
 
@@ -231,6 +233,45 @@ void finish_mesh(TriangleMesh& mesh, const ProgressFn& progress) {
                            detail::PassProgress(progress, 0.9, 1, "mesh"));
 }
 
+namespace {
+
+// The longest runs of rows whose pixels each have their own vertex, numbered as the pixels
+// (vertex = pixel + the same shift along the run), as vertex ranges less two rows at each end:
+// any pixel within one row and one column of a vertex there is in the run, so its vertex is
+// the vertex's plus the pixels' offset (TriangleMesh::uniform_ranges).
+std::vector<std::array<std::int32_t, 2>> uniform_ranges(const TriangleMesh& mesh) {
+    const std::int64_t W = mesh.grid_width, H = mesh.grid_height;
+    struct Run {
+        std::int64_t first_row, rows, shift;
+    };
+    std::vector<Run> runs;
+    for (std::int64_t r = 0; r < H; ++r) {
+        const std::int64_t p0 = r * W,
+                           shift = std::int64_t(mesh.pixel_vertex[std::size_t(p0)]) - p0;
+        bool dense = mesh.pixel_vertex[std::size_t(p0)] >= 0;
+        for (std::int64_t c = 1; dense && c < W; ++c)
+            dense = std::int64_t(mesh.pixel_vertex[std::size_t(p0 + c)]) == p0 + c + shift;
+        if (!dense) continue;
+        if (!runs.empty() && runs.back().first_row + runs.back().rows == r &&
+            runs.back().shift == shift)
+            ++runs.back().rows;
+        else
+            runs.push_back({r, 1, shift});
+    }
+    std::erase_if(runs, [](const Run& run) { return run.rows < 5; });
+    std::stable_sort(runs.begin(), runs.end(),
+                     [](const Run& a, const Run& b) { return a.rows > b.rows; });
+    if (runs.size() > TriangleMesh::kUniformRanges) runs.resize(TriangleMesh::kUniformRanges);
+    std::vector<std::array<std::int32_t, 2>> out;
+    for (const auto& run : runs)
+        out.push_back({static_cast<std::int32_t>((run.first_row + 2) * W + run.shift),
+                       static_cast<std::int32_t>((run.first_row + run.rows - 2) * W + run.shift)});
+    std::sort(out.begin(), out.end());
+    return out;
+}
+
+}  // namespace
+
 void finish_grid_mesh(TriangleMesh& mesh, const ProgressFn& progress) {
     const std::int64_t W = mesh.grid_width;
     const std::size_t n = mesh.positions.size(), nt = mesh.triangles.size();
@@ -246,6 +287,7 @@ void finish_grid_mesh(TriangleMesh& mesh, const ProgressFn& progress) {
     mesh.release_adjacency();
     set_vertex_areas(mesh, detail::PassProgress(progress, 0, 0.3, "mesh"));
     mesh.direction_offsets = {-W - 1, -W, -W + 1, -1, 1, W - 1, W, W + 1};
+    mesh.uniform_ranges = uniform_ranges(mesh);
     // The direction of the pixel dp away (-1: not one of the 8 around, or across the seam,
     // which comes out of order and is left to the explicit lists).
     const auto direction = [W](std::int64_t dp) -> int {

@@ -67,6 +67,12 @@ struct TriangleMesh {
     std::vector<std::int32_t> irregular_vertices;
     std::vector<std::uint32_t> irregular_offsets;
     std::vector<std::int32_t> irregular_neighbors;
+    // - uniform_ranges: vertex ranges [first, end) where each vertex's neighbours in the grid
+    //   are v + direction_offsets[d] (the rows around it have a vertex for every pixel, all
+    //   numbered alike); neighbors_of reads no pixel map there (a whole global grid without
+    //   NoData is one range). At most kUniformRanges, ascending.
+    std::vector<std::array<std::int32_t, 2>> uniform_ranges;
+    static constexpr std::size_t kUniformRanges = 8;
     std::size_t grid_edges = 0;  // the edges of a grid adjacency
     // DEM meshes: the triangles can be made again from the grid (release_triangles): their
     // orientation, and those that name a split pinch's copy (index, corners), in order.
@@ -129,6 +135,13 @@ struct TriangleMesh {
             return out;
         }
         if (const unsigned bits = neighbor_directions[v]; bits != 0) {
+            if (in_uniform_range(v)) {
+                for (unsigned b = bits; b != 0; b &= b - 1)
+                    out.own_[out.size_++] = static_cast<std::int32_t>(
+                        std::int64_t(v) +
+                        direction_offsets[static_cast<std::size_t>(__builtin_ctz(b))]);
+                return out;
+            }
             const std::int64_t p = vertex_pixel[v];
             for (unsigned b = bits; b != 0; b &= b - 1)
                 out.own_[out.size_++] = pixel_vertex[static_cast<std::size_t>(
@@ -147,6 +160,11 @@ struct TriangleMesh {
 
   private:
     VertexNeighbors irregular_neighbors_of(std::size_t v) const;
+    bool in_uniform_range(std::size_t v) const {
+        for (const auto& r : uniform_ranges)
+            if (v < std::size_t(r[1])) return v >= std::size_t(r[0]);
+        return false;
+    }
     // A DEM mesh whose triangles the grid makes again (its pixel maps and recorded diagonals).
     bool grid_describes_it() const;
     std::size_t released_triangles_ = 0;
