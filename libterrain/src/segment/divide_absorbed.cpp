@@ -54,16 +54,31 @@ float field_spread(const std::vector<float>& field) {
     return *hi > *lo ? *hi - *lo : 1.0f;
 }
 
+// A vertex's state while the regions are divided, in one array so that the flooding reads one
+// place a vertex: its path cost (for a vertex without a region, its best offer so far), its
+// field value, and its region: the region it is in once kFinal is set, before that the region
+// of its best offer (0 for none).
+struct Site {
+    float cost;
+    float field;
+    std::uint32_t label;
+};
+constexpr std::uint32_t kFinal = 0x80000000u;
+
+std::uint32_t region_of(const Site& s) {
+    return s.label & ~kFinal;
+}
+
 // Each finer region's region here: the one most of its vertices that kept a region are in
 // (ties to the lower id; 0 when none kept one).
 std::vector<std::uint32_t> finer_to_here(const std::vector<std::uint32_t>& finer,
-                                         const std::vector<std::uint32_t>& labels) {
+                                         const std::vector<Site>& sites) {
     std::uint32_t top = 0;
     for (const auto f : finer) top = std::max(top, f);
     std::vector<std::uint64_t> pairs;  // (finer region, region here), for kept vertices
-    for (std::size_t v = 0; v < labels.size(); ++v)
-        if (labels[v] != 0 && finer[v] != 0)
-            pairs.push_back(std::uint64_t{finer[v]} << 32 | labels[v]);
+    for (std::size_t v = 0; v < sites.size(); ++v)
+        if (sites[v].label != 0 && finer[v] != 0)
+            pairs.push_back(std::uint64_t{finer[v]} << 32 | sites[v].label);
     std::sort(pairs.begin(), pairs.end());
     std::vector<std::uint32_t> out(std::size_t{top} + 1, 0);
     std::vector<std::size_t> best(out.size(), 0);
@@ -109,79 +124,90 @@ DivideCounts divide_absorbed(const TriangleMesh& mesh, const reeb::ReebGraph& gr
     const std::size_t n = mesh.vertex_count();
     if (finer && finer->size() != n)
         throw Error("segment", "divide_absorbed: the finer labels do not match the mesh");
-    auto& labels = segmentation.labels;
+    auto& labels = segmentation.labels;  // as grown until the end, then as divided
     if (field.size() != n || absorbed.size() != n || labels.size() != n ||
         graph.vertex_nodes.size() != n)
         throw Error("segment", "divide_absorbed: the field, flags, labels and mesh disagree");
     DivideCounts counts;
-    const std::vector<std::uint32_t> before = labels;
-    for (std::size_t v = 0; v < n; ++v)
-        if (absorbed[v]) {
-            labels[v] = 0;
-            ++counts.absorbed;
-        }
+    for (std::size_t v = 0; v < n; ++v) counts.absorbed += absorbed[v] != 0;
     if (counts.absorbed == 0) {
         report_progress(progress, 1, "divide");
         return counts;
     }
+    // (Passes over every vertex, the large blocks made a slice at a time: their first touch
+    // is slow, docs/performance.md.)
+    const auto pass = [&](double from) {
+        return detail::PassProgress(progress, from, from + 0.015, "divide");
+    };
+    // 1. Absorbed vertices leave their regions: the sites' labels are the regions left.
+    std::vector<Site> sites;
+    detail::assign_in_slices(sites, n, Site{0.0f, 0.0f, 0}, pass(0));
+    const auto copied = pass(0.015);
+    for (std::size_t v = 0; v < n; ++v) {
+        copied.at(v, n);
+        sites[v].field = field[v];
+        sites[v].label = absorbed[v] ? 0 : labels[v];
+    }
     // 1b. With a finer scale's labels: absorbed vertices first go with their finer region.
     if (finer) {
-        const auto here = finer_to_here(*finer, labels);
+        const auto here = finer_to_here(*finer, sites);
         for (std::size_t v = 0; v < n; ++v)
-            if (absorbed[v]) labels[v] = here[(*finer)[v]];
+            if (absorbed[v]) sites[v].label = here[(*finer)[v]];
     }
     const auto neighbours = [&](std::size_t v, auto&& f) {
         for (const i32 w : mesh.neighbors_of(v)) f(idx(w));
     };
     // 2. The part of each region connected to its seed's own vertices.
-    std::vector<std::uint8_t> kept(n, 0);
-    std::vector<std::size_t> stack;
-    for (std::size_t r = 0; r < segmentation.seeds.size(); ++r) {
-        const i32 s = segmentation.seeds[r];
-        const auto label = static_cast<std::uint32_t>(r + 1);
-        for (i32 i = graph.node_vertex_offsets[idx(s)]; i < graph.node_vertex_offsets[idx(s) + 1];
-             ++i) {
-            const std::size_t v = idx(graph.node_vertices[idx(i)]);
-            if (labels[v] != label || kept[v]) continue;
-            kept[v] = 1;
-            stack.push_back(v);
+    {
+        std::vector<std::uint8_t> kept(n, 0);
+        std::vector<std::size_t> stack;
+        for (std::size_t r = 0; r < segmentation.seeds.size(); ++r) {
+            const i32 s = segmentation.seeds[r];
+            const auto label = static_cast<std::uint32_t>(r + 1);
+            for (i32 i = graph.node_vertex_offsets[idx(s)];
+                 i < graph.node_vertex_offsets[idx(s) + 1]; ++i) {
+                const std::size_t v = idx(graph.node_vertices[idx(i)]);
+                if (sites[v].label != label || kept[v]) continue;
+                kept[v] = 1;
+                stack.push_back(v);
+            }
+            while (!stack.empty()) {
+                const std::size_t v = stack.back();
+                stack.pop_back();
+                neighbours(v, [&](std::size_t u) {
+                    if (sites[u].label != label || kept[u]) return;
+                    kept[u] = 1;
+                    stack.push_back(u);
+                });
+            }
         }
-        while (!stack.empty()) {
-            const std::size_t v = stack.back();
-            stack.pop_back();
-            neighbours(v, [&](std::size_t u) {
-                if (labels[u] != label || kept[u]) return;
-                kept[u] = 1;
-                stack.push_back(u);
-            });
-        }
+        for (std::size_t v = 0; v < n; ++v)
+            if (sites[v].label != 0 && !kept[v]) {
+                sites[v].label = 0;
+                ++counts.detached;
+            }
     }
-    for (std::size_t v = 0; v < n; ++v)
-        if (labels[v] != 0 && !kept[v]) {
-            labels[v] = 0;
-            ++counts.detached;
-        }
     report_progress(progress, 0.2, "divide");
     // 3. Flooding from the regions' edges: the shortest paths in the metric where a step
     // into u for region r costs |field(u) - mean(r)| plus a constant per mean edge length.
     const float step = kStepShare * field_spread(field);
     const double mean_edge =
-        mean_edge_length(mesh, detail::PassProgress(progress, 0.2, 0.2, "divide"));
-    // cost: a labelled vertex's path cost; for the others, the best offer so far (from
-    // `offer`), so that only better offers are queued (the same result as queuing every
-    // one: costs grow along a path, so a vertex's first offer taken is its cheapest).
-    // (Passes over every vertex from 0.2 to 0.3 of the progress, the large blocks made a slice
-    // at a time: their first touch is slow, docs/performance.md.)
-    const auto pass = [&](double from) {
-        return detail::PassProgress(progress, from, from + 0.015, "divide");
-    };
-    std::vector<float> cost;
-    std::vector<std::uint32_t> offer;
-    detail::assign_in_slices(cost, n, 0.0f, pass(0.2));
-    detail::assign_in_slices(offer, n, std::uint32_t{0}, pass(0.215));
+        mean_edge_length(mesh, detail::PassProgress(progress, 0.2, 0.23, "divide"));
+    // cost: a labelled vertex's path cost; for the others, the best offer so far (with the
+    // offer's region in the label), so that only better offers are queued (the same result as
+    // queuing every one: costs grow along a path, so a vertex's first offer taken is its
+    // cheapest).
+    std::size_t to_label = 0, labelled = 0;  // (the absorbed and detached, less those kept)
     const auto unlabelled = pass(0.23);
-    for (std::size_t v = 0; v < n; ++v)
-        if (unlabelled.at(v, n); labels[v] == 0) cost[v] = std::numeric_limits<float>::infinity();
+    for (std::size_t v = 0; v < n; ++v) {
+        unlabelled.at(v, n);
+        if (sites[v].label == 0) {
+            sites[v].cost = std::numeric_limits<float>::infinity();
+            ++to_label;
+        } else {
+            sites[v].label |= kFinal;
+        }
+    }
     // Each region's mean of the field over the vertices it kept (area-weighted), fixed for
     // the flooding.
     std::vector<double> sum(segmentation.seeds.size() + 1, 0.0),
@@ -189,59 +215,57 @@ DivideCounts divide_absorbed(const TriangleMesh& mesh, const reeb::ReebGraph& gr
     const auto summed = pass(0.245);
     for (std::size_t v = 0; v < n; ++v) {
         summed.at(v, n);
-        if (labels[v] == 0) continue;
+        if (sites[v].label == 0) continue;
         const double a = mesh.vertex_areas.empty() ? 1.0 : mesh.vertex_areas[v];
-        sum[labels[v]] += a * field[v];
-        weight[labels[v]] += a;
+        sum[region_of(sites[v])] += a * sites[v].field;
+        weight[region_of(sites[v])] += a;
     }
     std::vector<float> mean(sum.size(), 0.0f);
     for (std::size_t r = 1; r < mean.size(); ++r)
         mean[r] = weight[r] > 0 ? static_cast<float>(sum[r] / weight[r]) : 0.0f;
     std::priority_queue<Step, std::vector<Step>, std::greater<Step>> heap;
+    // Offers from w (in a region) to the vertices around it without one.
     const auto push_around = [&](std::size_t w) {
+        const std::uint32_t region = region_of(sites[w]);
+        const float from = sites[w].cost, centre = mean[region];
         neighbours(w, [&](std::size_t u) {
-            if (labels[u] != 0) return;
+            Site& site = sites[u];
+            if (site.label & kFinal) return;
             const double len = edge_length(mesh, u, w);
-            const float c = cost[w] + std::fabs(field[u] - mean[labels[w]]) +
-                            step * static_cast<float>(len / mean_edge);
-            if (c > cost[u] || (c == cost[u] && labels[w] >= offer[u])) return;
-            cost[u] = c;
-            offer[u] = labels[w];
-            heap.push({c, static_cast<i32>(u), labels[w]});
+            const float c =
+                from + std::fabs(site.field - centre) + step * static_cast<float>(len / mean_edge);
+            if (c > site.cost || (c == site.cost && region >= site.label)) return;
+            site.cost = c;
+            site.label = region;
+            heap.push({c, static_cast<i32>(u), region});
         });
     };
     const auto fronts = pass(0.26);
     for (std::size_t w = 0; w < n; ++w)
-        if (fronts.at(w, n); labels[w] != 0) {
+        if (fronts.at(w, n); sites[w].label & kFinal) {
             bool edge = false;
-            neighbours(w, [&](std::size_t u) { edge |= labels[u] == 0; });
+            neighbours(w, [&](std::size_t u) { edge |= !(sites[u].label & kFinal); });
             if (edge) push_around(w);
         }
-    // (the vertices to label: the absorbed ones and those detached, less those kept)
-    std::size_t to_label = 0, labelled = 0;
-    const auto counted = pass(0.275);
-    for (std::size_t v = 0; v < n; ++v) {
-        counted.at(v, n);
-        to_label += labels[v] == 0;
-    }
     report_progress(progress, 0.3, "divide");
     while (!heap.empty()) {
         const Step s = heap.top();
         heap.pop();
-        const std::size_t u = idx(s.vertex);
-        if (labels[u] != 0 || s.cost != cost[u] || s.label != offer[u]) continue;
-        labels[u] = s.label;
-        cost[u] = s.cost;
-        push_around(u);
+        Site& site = sites[idx(s.vertex)];
+        if ((site.label & kFinal) || s.cost != site.cost || s.label != site.label) continue;
+        site.label |= kFinal;
+        push_around(idx(s.vertex));
         if ((++labelled & 0xffff) == 0)
             report_progress(progress, 0.3 + 0.7 * double(labelled) / double(to_label), "divide");
     }
     report_progress(progress, 1, "divide");
     for (std::size_t v = 0; v < n; ++v) {
-        if (labels[v] == 0)
+        if (!(sites[v].label & kFinal))
             throw Error("segment", "divide_absorbed: vertex " + std::to_string(v) +
                                        " is in no region (no region in its mesh component)");
-        counts.relabelled += labels[v] != before[v];
+        const std::uint32_t region = region_of(sites[v]);
+        counts.relabelled += region != labels[v];
+        labels[v] = region;
     }
     return counts;
 }
