@@ -30,21 +30,22 @@ struct Command {
     const char* name;
     const char* summary;
     int (*run)(int, char**);
+    bool large_arrays = false;  // works on the whole grid: started again with huge pages
 };
 
 constexpr Command kCommands[] = {
     {"info", "describe a DEM: size, pixel size, CRS, body, elevation kind and range",
      terrain::cli::run_info},
     {"mesh", "triangulate a DEM on its body (or check a mesh file) into a binary PLY",
-     terrain::cli::run_mesh},
+     terrain::cli::run_mesh, true},
     {"field", "the scalar field (shape index, SDF, height) on a DEM's grid or a mesh's vertices",
-     terrain::cli::run_field},
+     terrain::cli::run_field, true},
     {"reeb", "the Reeb graph of the field, simplified by persistence and area ratio",
-     terrain::cli::run_reeb},
+     terrain::cli::run_reeb, true},
     {"segment", "the main job: regions from the Reeb graph, as rasters, polygons and graphs",
-     terrain::cli::run_segment},
+     terrain::cli::run_segment, true},
     {"sweep", "segmentations at several area ratios from one Reeb graph, with their lineage",
-     terrain::cli::run_sweep},
+     terrain::cli::run_sweep, true},
     {"synth", "generate a synthetic cratered DEM tile (the Vesta sample)", terrain::cli::run_synth},
 };
 
@@ -59,21 +60,24 @@ void print_usage(std::ostream& out) {
 
 // Huge pages (docs/performance.md): glibc reads GLIBC_TUNABLES once, at start-up, so the
 // program starts itself again with glibc.malloc.hugetlb=1 added when the kernel gives huge
-// pages on request only. About twice as fast on whole grids; the outputs are the same.
+// pages on request only; for the commands that work on whole grids (`info`, `synth`, --help
+// and --version start once: the second start costs about 0.1 s). About twice as fast on
+// whole grids; the outputs are the same.
 // TERRAIN_HUGE_PAGES=0, or a GLIBC_TUNABLES that sets the tunable already, keeps things
 // as they are; so does an exec that fails.
 void start_again_with_huge_pages(char** argv) {
     const char* choice = std::getenv("TERRAIN_HUGE_PAGES");
     if (choice && std::strcmp(choice, "0") == 0) return;
     if (terrain::transparent_huge_page_mode() != "madvise") return;
-    const char* current = std::getenv("GLIBC_TUNABLES");
-    const std::string tunables = terrain::tunables_with_huge_pages(current ? current : "");
+    const char* set = std::getenv("GLIBC_TUNABLES");
+    const std::string current = set ? set : "";
+    const std::string tunables = terrain::tunables_with_huge_pages(current);
     if (tunables.empty()) return;
     if (::setenv("GLIBC_TUNABLES", tunables.c_str(), 1) != 0) return;
     ::execv("/proc/self/exe", argv);
-    // Still here: carry on with normal pages, and say so in run.json.
-    if (current)
-        ::setenv("GLIBC_TUNABLES", current, 1);
+    // Still here: carry on with normal pages (run.json says which ran).
+    if (set)
+        ::setenv("GLIBC_TUNABLES", current.c_str(), 1);
     else
         ::unsetenv("GLIBC_TUNABLES");
 }
@@ -81,7 +85,10 @@ void start_again_with_huge_pages(char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
-    start_again_with_huge_pages(argv);
+    // First of all: the program may start again.
+    for (const auto& c : kCommands)
+        if (argc >= 2 && c.large_arrays && std::strcmp(argv[1], c.name) == 0)
+            start_again_with_huge_pages(argv);
     // The commands allocate a few arrays of megabytes each. glibc raises its mmap threshold
     // after such an array is freed, so later ones come from the heap and stay resident after
     // being freed; a fixed threshold gives them back at once (about 16 MB less peak memory

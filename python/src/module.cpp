@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "terrain/core/error.hpp"
+#include "terrain/core/huge_pages.hpp"
 #include "terrain/core/memory_budget.hpp"
 #include "terrain/core/version.hpp"
 #include "terrain/field/vertex_field.hpp"
@@ -376,6 +377,10 @@ PYBIND11_MODULE(_terrain, m) {
         },
         py::arg("path"), py::arg("band") = 1, py::arg("elevation") = "auto",
         py::arg("nan_nodata") = false, py::arg("pixel_size") = py::none());
+    m.def("page_use", &huge_page_use,
+          "How this process's large arrays are paged: 'huge' (transparent huge pages: the kernel "
+          "gives them to every large mapping, or Python was started with "
+          "GLIBC_TUNABLES=glibc.malloc.hugetlb=1) or 'normal'. Speed only: results are the same.");
     m.def("dem_from_array", &dem_from_array, py::arg("values"),
           py::arg("geotransform") = py::none(), py::arg("crs") = "", py::arg("elevation") = "auto");
 

@@ -21,7 +21,7 @@ import tempfile
 import numpy as np
 
 from . import _terrain
-from ._terrain import Dem, Error, __version__
+from ._terrain import Dem, Error, __version__, page_use
 
 __all__ = [
     "Dem",
@@ -30,6 +30,7 @@ __all__ = [
     "RegionGraph",
     "SegmentResult",
     "SweepResult",
+    "page_use",
     "read_dem",
     "reeb_graph",
     "segment",
