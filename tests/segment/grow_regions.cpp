@@ -66,6 +66,31 @@ TEST_CASE("Regions: one per extremum, every vertex labelled, every region connec
     }
 }
 
+TEST_CASE("The order a node's vertices are visited in does not change the regions", "[segment]") {
+    // Nodes walked by their lists (never in vertex order), from 1/64 of the vertices (the
+    // default), and every node walked in vertex order: the candidates are sets either way.
+    const auto c = vesta_case(0.5);
+    std::size_t biggest = 0;
+    for (std::size_t n = 0; n < c.graph.node_count(); ++n)
+        biggest = std::max<std::size_t>(biggest, std::size_t(c.graph.node_vertex_offsets[n + 1] -
+                                                             c.graph.node_vertex_offsets[n]));
+    REQUIRE(biggest * 64 >= c.mesh.vertex_count());  // the default walks one node at least
+    for (auto cost : {segment::GrowCost::graph, segment::GrowCost::standard}) {
+        INFO(segment::to_string(cost));
+        segment::GrowOptions o;
+        o.cost = cost;
+        const auto by_default = segment::grow_regions(c.mesh, c.graph, o);
+        o.walk_share = 0;
+        const auto by_lists = segment::grow_regions(c.mesh, c.graph, o);
+        o.walk_share = c.mesh.vertex_count();
+        const auto all_walked = segment::grow_regions(c.mesh, c.graph, o);
+        CHECK(by_default.labels == by_lists.labels);
+        CHECK(all_walked.labels == by_lists.labels);
+        CHECK(by_default.seeds == by_lists.seeds);
+        CHECK(by_default.relaxed_nodes == by_lists.relaxed_nodes);
+    }
+}
+
 TEST_CASE("Region growing is deterministic across runs and thread counts", "[segment]") {
     // The pipeline before it runs in parallel (the mesh, the shape index over blocks of 512
     // vertices, the join and split trees side by side): on the 512 x 512 Vesta tile two

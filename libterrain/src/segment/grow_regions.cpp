@@ -179,7 +179,7 @@ class Grower {
     void for_each_vertex(i32 n, bool assigning, F&& f) {
         const i32 first = g_.node_vertex_offsets[idx(n)], last = g_.node_vertex_offsets[idx(n) + 1];
         const std::size_t count = idx(last - first), nv = g_.vertex_nodes.size();
-        if (count * kWalkShare >= nv) {
+        if (options_.walk_share > 0 && count * options_.walk_share >= nv) {
             std::size_t seen = 0;
             for (std::size_t v = 0; v < nv && seen < count; ++v)
                 if (g_.vertex_nodes[v] == n) {
@@ -194,7 +194,6 @@ class Grower {
             f(idx(g_.node_vertices[idx(i)]));
         }
     }
-    static constexpr std::size_t kWalkShare = 64;  // walked in vertex order from 1/64 of them
 
     // Candidates (u, r) for the unassigned nodes u touching node n (in region r) on the mesh.
     void push_mesh_candidates(i32 n, bool relaxed) {

@@ -24,6 +24,10 @@ const char* to_string(GrowCost cost);
 struct GrowOptions {
     GrowCost cost = GrowCost::graph;
     double saddle_penalty = 20;  // lambda, in field units
+    // A node holding at least 1/walk_share of the vertices has them visited in vertex order
+    // (a pass over vertex_nodes) rather than in its list's order (docs/segment.md); 0: never.
+    // Speed only: the regions are the same whatever it is.
+    std::size_t walk_share = 64;
 };
 
 struct Segmentation {
