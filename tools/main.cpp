@@ -73,8 +73,14 @@ void start_again_with_huge_pages(char** argv) {
     const std::string current = set ? set : "";
     const std::string tunables = terrain::tunables_with_huge_pages(current);
     if (tunables.empty()) return;
+    // The program's own path, so that the process keeps its name ("terrain", not "exe") in
+    // ps and top.
+    char self[4096];
+    const ssize_t length = ::readlink("/proc/self/exe", self, sizeof self - 1);
+    if (length <= 0) return;
+    self[length] = '\0';
     if (::setenv("GLIBC_TUNABLES", tunables.c_str(), 1) != 0) return;
-    ::execv("/proc/self/exe", argv);
+    ::execv(self, argv);
     // Still here: carry on with normal pages (run.json says which ran).
     if (set)
         ::setenv("GLIBC_TUNABLES", current.c_str(), 1);
