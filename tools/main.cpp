@@ -58,13 +58,12 @@ void print_usage(std::ostream& out) {
            "  --help      show this help\n";
 }
 
-// Huge pages (docs/performance.md): glibc reads GLIBC_TUNABLES once, at start-up, so the
-// program starts itself again with glibc.malloc.hugetlb=1 added when the kernel gives huge
-// pages on request only; for the commands that work on whole grids (`info`, `synth`, --help
-// and --version start once: the second start costs about 0.1 s). About twice as fast on
-// whole grids; the outputs are the same.
-// TERRAIN_HUGE_PAGES=0, or a GLIBC_TUNABLES that sets the tunable already, keeps things
-// as they are; so does an exec that fails.
+// Huge pages (docs/performance.md): glibc reads GLIBC_TUNABLES once, at start-up, so a
+// command that works on whole grids starts itself again with glibc.malloc.hugetlb=1 added
+// when the kernel gives huge pages on request only. About twice as fast on whole grids; the
+// outputs are the same. (`info`, `synth`, --help and --version start once: the second start
+// costs about 0.1 s.) TERRAIN_HUGE_PAGES=0, or a GLIBC_TUNABLES that sets the tunable
+// already, keeps things as they are; so does an exec that fails.
 void start_again_with_huge_pages(char** argv) {
     const char* choice = std::getenv("TERRAIN_HUGE_PAGES");
     if (choice && std::strcmp(choice, "0") == 0) return;

@@ -178,22 +178,19 @@ TEST_CASE("terrain segment asks for huge pages when the kernel gives them on req
     // TERRAIN_HUGE_PAGES=0, or the caller's own tunable, keep the pages normal (unless the
     // kernel makes every large mapping huge).
     const std::string kept = mode == "always" ? "huge" : "normal";
-    const auto normal = dir / "normal";
-    fs::remove_all(normal);
-    r = terrain::test::run_program(TERRAIN_CLI, {"segment", dem, "-o", normal.string(), "-q"},
-                                   {"TERRAIN_HUGE_PAGES=0"});
-    REQUIRE(r.status == 0);
-    CHECK(pages(normal) == kept);
-    const auto own = dir / "own";
-    fs::remove_all(own);
-    r = terrain::test::run_program(TERRAIN_CLI, {"segment", dem, "-o", own.string(), "-q"},
-                                   {"GLIBC_TUNABLES=glibc.malloc.hugetlb=0"});
-    REQUIRE(r.status == 0);
-    CHECK(pages(own) == kept);
-    // The same outputs, byte for byte.
-    for (const char* name : {"labels.tif", "regions.geojson", "adjacency.json", "preview.png"}) {
-        CHECK(slurp(asked / name) == slurp(normal / name));
-        CHECK(slurp(asked / name) == slurp(own / name));
+    for (const auto& [name, setting] :
+         {std::pair<const char*, const char*>{"normal", "TERRAIN_HUGE_PAGES=0"},
+          {"own", "GLIBC_TUNABLES=glibc.malloc.hugetlb=0"}}) {
+        INFO(setting);
+        const auto out = dir / name;
+        fs::remove_all(out);
+        r = terrain::test::run_program(TERRAIN_CLI, {"segment", dem, "-o", out.string(), "-q"},
+                                       {setting});
+        REQUIRE(r.status == 0);
+        CHECK(pages(out) == kept);
+        // The same outputs, byte for byte.
+        for (const char* file : {"labels.tif", "regions.geojson", "adjacency.json", "preview.png"})
+            CHECK(slurp(asked / file) == slurp(out / file));
     }
 }
 

@@ -30,9 +30,10 @@ std::string huge_page_use() {
     const char* tunables = std::getenv("GLIBC_TUNABLES");
     const std::string t = tunables ? tunables : "";
     // glibc.malloc.hugetlb=1 (madvise) or =2 (reserved huge pages); 0 asks for none.
-    const auto at = t.find(std::string(kTunable) + "=");
+    const std::string key = std::string(kTunable) + "=";
+    const auto at = t.find(key);
     if (at == std::string::npos) return "normal";
-    const auto value = at + std::string(kTunable).size() + 1;
+    const auto value = at + key.size();
     return value < t.size() && (t[value] == '1' || t[value] == '2') ? "huge" : "normal";
 }
 
