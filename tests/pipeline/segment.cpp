@@ -17,6 +17,7 @@
 #include "terrain/mesh/dem_to_mesh.hpp"
 #include "terrain/pipeline/segment.hpp"
 #include "terrain/pipeline/sweep.hpp"
+#include "terrain/reeb/reeb_graph.hpp"
 #include "terrain/reeb/simplify.hpp"
 #include "terrain/segment/lineage.hpp"
 
@@ -63,6 +64,11 @@ TEST_CASE("pipeline::segment gives labels, regions and the files of terrain segm
     // same floats as those of the mesh made of the DEM.
     CHECK_FALSE(result.input.mesh.positions_released());
     CHECK(result.input.mesh.positions == mesh::dem_to_mesh(*result.dem()).positions);
+    // The critical nodes before the simplification, counted from the node kinds: those of the
+    // graph's summary.
+    CHECK(result.critical_before ==
+          reeb::summarize(reeb::build_reeb_graph(result.input.mesh, result.field)).critical);
+    CHECK(result.critical_before > result.after.critical);
 
     // The directory: labels.tif holds label_pixels(); run.json is listed last.
     const auto dir = test::scratch_dir("pipeline_segment");
@@ -103,7 +109,8 @@ TEST_CASE("pipeline::segment gives the DEM back bit for bit, floats or not", "[p
         REQUIRE(back.size() == dem.values.size());
         CHECK(std::memcmp(back.data(), dem.values.data(), back.size() * sizeof(double)) == 0);
         CHECK(result.segmentation.region_count > 1);
-        // Parked: the DEM's values (as floats when they all are), the field, the pixel maps.
+        // Parked at the simplification: the DEM's values (as floats when they all are), the
+        // field, the pixel maps.
         const std::size_t n = dem.values.size(), nv = result.input.mesh.vertex_count();
         CHECK(result.parked_bytes == (step == 0.5 ? 4 : 8) * n + 4 * nv + 4 * n + 4 * nv + nv);
         const auto held = pipeline::segment(pipeline::input_from_dem(dem, "map"), holding);
@@ -115,6 +122,11 @@ TEST_CASE("pipeline::segment gives the DEM back bit for bit, floats or not", "[p
         CHECK(m.vertex_pixel == h.vertex_pixel);
         CHECK(m.neighbor_directions == h.neighbor_directions);
         CHECK(m.positions == h.positions);
+        // (The vertices' areas are parked through the Reeb graph, back for the simplification.)
+        CHECK(!m.vertex_areas.empty());
+        CHECK(m.vertex_areas == h.vertex_areas);
+        CHECK(result.after.critical == held.after.critical);
+        CHECK(result.critical_before == held.critical_before);
         CHECK(held.parked_bytes == 0);
         CHECK(std::distance(fs::directory_iterator(parking.park_directory), {}) == 0);
     }
