@@ -109,10 +109,11 @@ TEST_CASE("pipeline::segment gives the DEM back bit for bit, floats or not", "[p
         REQUIRE(back.size() == dem.values.size());
         CHECK(std::memcmp(back.data(), dem.values.data(), back.size() * sizeof(double)) == 0);
         CHECK(result.segmentation.region_count > 1);
-        // Parked at the simplification: the DEM's values (as floats when they all are), the
-        // field, the pixel maps.
+        // Parked at the simplification's peak: the DEM's values (as floats when they all
+        // are), the field, the pixel maps, the directions, the vertices' areas.
         const std::size_t n = dem.values.size(), nv = result.input.mesh.vertex_count();
-        CHECK(result.parked_bytes == (step == 0.5 ? 4 : 8) * n + 4 * nv + 4 * n + 4 * nv + nv);
+        CHECK(result.parked_bytes ==
+              (step == 0.5 ? 4 : 8) * n + 4 * nv + 4 * n + 4 * nv + nv + 4 * nv);
         const auto held = pipeline::segment(pipeline::input_from_dem(dem, "map"), holding);
         CHECK(result.label_pixels() == held.label_pixels());
         CHECK(result.field == held.field);

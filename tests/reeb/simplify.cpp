@@ -466,3 +466,47 @@ TEST_CASE("A graph handed over gives the result of the same graph lent, plateaus
         CHECK(g.vertex_nodes.capacity() == 0);
     }
 }
+
+TEST_CASE("A graph handed over lets its caller set the mesh's areas aside once they are read",
+          "[simplify]") {
+    // The callback comes once, before the cancellations; what the caller then does to the
+    // areas changes nothing: taken away (a mesh without areas counts 1 a vertex), or scrambled
+    // (a factor of 1 to 97 a vertex: had anything read them after, the area ratios, and so
+    // the result, would differ).
+    const auto& s = vesta();
+    reeb::SimplifyOptions o;
+    o.persistence = 10;
+    o.area_ratio = 0.5;
+    const auto lent = reeb::simplify(s.mesh, reeb::build_reeb_graph(s.mesh, s.si), o);
+    for (const bool scramble : {false, true}) {
+        INFO((scramble ? "scrambled" : "taken away"));
+        TriangleMesh mesh = s.mesh;
+        REQUIRE(!mesh.vertex_areas.empty());
+        std::vector<float> aside;
+        int calls = 0;
+        double last = 0;
+        const auto given = reeb::simplify(
+            mesh, reeb::build_reeb_graph(mesh, s.si), o,
+            [&](double f, std::string_view) {
+                last = f;
+                return true;
+            },
+            [&] {
+                ++calls;
+                CHECK(last < 0.5);  // before the cancellations
+                if (!scramble) {
+                    aside.swap(mesh.vertex_areas);
+                    return;
+                }
+                for (std::size_t v = 0; v < mesh.vertex_areas.size(); ++v)
+                    mesh.vertex_areas[v] *= static_cast<float>(1 + (v * 2654435761u) % 97);
+            });
+        CHECK(calls == 1);
+        CHECK(mesh.vertex_areas.empty() == !scramble);
+        CHECK(given.field == lent.field);
+        CHECK(given.absorbed == lent.absorbed);
+        CHECK(given.graph.node_values == lent.graph.node_values);
+        CHECK(given.graph.vertex_nodes == lent.graph.vertex_nodes);
+        CHECK(given.graph.arcs == lent.graph.arcs);
+    }
+}

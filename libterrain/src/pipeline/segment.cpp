@@ -387,11 +387,18 @@ SegmentResult segment(Input input, const SegmentOptions& options, const Progress
     result.parked_bytes = parked.parked_bytes();
     const auto thresholds = simplify_options(options, result.input.mesh);
     result.area_ratio_percent = thresholds.area_ratio;
+    // The areas wait on disk again once the simplification has read them (before its peak
+    // of memory, the end of its copy of the arcs). (Parked without progress: the
+    // simplification reports around it.)
     const auto simplified = reeb::simplify(result.input.mesh, std::move(graph), thresholds,
-                                           scaled_progress(progress, 0.41, 0.6));
+                                           scaled_progress(progress, 0.41, 0.6), [&] {
+                                               if (parked.park(mesh.vertex_areas, {}, 0, 0))
+                                                   result.parked_bytes = parked.parked_bytes();
+                                           });
     const double seconds = since(t0);
     // (Counted with the growing, which it precedes: the stages' times stay in run order.)
     const auto t2 = clock::now();
+    parked.restore(mesh.vertex_areas, progress, 0.6, 0.6);
     parked.restore(mesh.neighbor_directions, progress, 0.6, 0.601);
     parked.restore(mesh.vertex_pixel, progress, 0.601, 0.602);
     parked.restore(mesh.pixel_vertex, progress, 0.602, 0.603);

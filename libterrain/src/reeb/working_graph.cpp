@@ -156,7 +156,8 @@ double node_area(const TriangleMesh& mesh, const ReebGraph& g, std::size_t n,
 }  // namespace
 
 WorkingGraph::WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big_degree,
-                           const ProgressFn& progress, ReebGraph* owned)
+                           const ProgressFn& progress, ReebGraph* owned,
+                           const std::function<void()>& areas_read)
     : g_(g),
       input_nodes_(g.node_count()),
       input_vertices_(g.vertex_nodes.size()),
@@ -221,7 +222,8 @@ WorkingGraph::WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big
         }
     }
     total_area_ = mesh_area_or_one(total_area_);
-    if (owned) {  // the nodes are copied
+    if (areas_read) areas_read();  // (before the arcs: their copy's end is the peak)
+    if (owned) {                   // the nodes are copied
         detail::release(owned->node_values);
         detail::release(owned->node_kinds);
         // The vertex lists or the vertices' nodes, whichever write_result will not read.

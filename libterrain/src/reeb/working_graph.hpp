@@ -20,6 +20,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <set>
 #include <unordered_map>
 #include <utility>
@@ -53,9 +54,11 @@ class WorkingGraph {
     // `owned` (g itself, handed over: simplify(ReebGraph&&)) the copy frees g's arrays as it
     // reads them for the last time (its values, kinds, vertex nodes and arcs), so that they
     // are not held beside the working graph at the peak of the simplification's memory; the
-    // vertex lists and links stay for write_result.
+    // vertex lists and links stay for write_result. `areas_read` is called once the nodes'
+    // areas are summed, before the arcs are copied: the mesh's areas are read no more.
     WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big_degree = kBigDegree,
-                 const ProgressFn& progress = {}, ReebGraph* owned = nullptr);
+                 const ProgressFn& progress = {}, ReebGraph* owned = nullptr,
+                 const std::function<void()>& areas_read = {});
 
     // The simplified graph and the rewritten field (simplify_output.cpp). The working graph is
     // freed as it goes: nothing else may be asked of it after.

@@ -9,6 +9,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "terrain/core/progress.hpp"
@@ -60,8 +61,13 @@ SimplifyResult simplify(const TriangleMesh& mesh, const ReebGraph& graph,
 // lists and links, about 18 bytes per vertex) once the result is written: the graph is left
 // empty, and what follows the simplification (growing, dividing, the region graph) runs
 // without it.
+// `areas_read`, when given, is called once, as soon as the mesh's vertex areas have been read
+// for the last time (once the working copy has summed its nodes' areas, before it copies the
+// arcs: the copy's end is the simplification's peak of memory): the caller may set them
+// aside, parked or freed, until this returns (pipeline::segment parks them).
 SimplifyResult simplify(const TriangleMesh& mesh, ReebGraph&& graph, const SimplifyOptions& options,
-                        const ProgressFn& progress = {});
+                        const ProgressFn& progress = {},
+                        const std::function<void()>& areas_read = {});
 
 // Persistence and area ratio (a fraction, not percent) of each arc of a graph on its mesh.
 struct ArcMetrics {
