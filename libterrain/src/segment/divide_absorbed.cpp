@@ -16,13 +16,14 @@
 #include "terrain/segment/divide_absorbed.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <limits>
-#include <queue>
 #include <string>
 
 #include "../core/indices.hpp"
 #include "../core/pass_progress.hpp"
+#include "../core/radix_heap.hpp"
 #include "terrain/core/error.hpp"
 
 namespace terrain::segment {
@@ -32,14 +33,17 @@ namespace {
 using detail::i32;
 using detail::idx;
 
+// An offer of `label` to `vertex` at path cost `cost`. Taken in order of (cost, vertex): costs
+// are never negative, so their bits order as the costs do. Offers of equal cost and vertex
+// differ by label; only the latest (the lowest label) is still the vertex's offer when taken,
+// so their order does not matter.
 struct Step {
     float cost;
     i32 vertex;
     std::uint32_t label;
-    bool operator>(const Step& o) const {
-        if (cost != o.cost) return cost > o.cost;
-        if (vertex != o.vertex) return vertex > o.vertex;
-        return label > o.label;
+    std::uint64_t key() const {
+        return std::uint64_t{std::bit_cast<std::uint32_t>(cost)} << 32 |
+               static_cast<std::uint32_t>(vertex);
     }
 };
 
@@ -223,7 +227,9 @@ DivideCounts divide_absorbed(const TriangleMesh& mesh, const reeb::ReebGraph& gr
     std::vector<float> mean(sum.size(), 0.0f);
     for (std::size_t r = 1; r < mean.size(); ++r)
         mean[r] = weight[r] > 0 ? static_cast<float>(sum[r] / weight[r]) : 0.0f;
-    std::priority_queue<Step, std::vector<Step>, std::greater<Step>> heap;
+    // (A path's cost never falls below the cost of the vertex it leaves, so the offers wait in
+    // a monotone queue: core/radix_heap.hpp.)
+    detail::RadixHeap<Step> heap;
     // Offers from w (in a region) to the vertices around it without one.
     const auto push_around = [&](std::size_t w) {
         const std::uint32_t region = region_of(sites[w]);
@@ -249,8 +255,7 @@ DivideCounts divide_absorbed(const TriangleMesh& mesh, const reeb::ReebGraph& gr
         }
     report_progress(progress, 0.3, "divide");
     while (!heap.empty()) {
-        const Step s = heap.top();
-        heap.pop();
+        const Step s = heap.pop();
         Site& site = sites[idx(s.vertex)];
         if ((site.label & kFinal) || s.cost != site.cost || s.label != site.label) continue;
         site.label |= kFinal;
