@@ -19,3 +19,20 @@ TEST_CASE("check_memory counts what the process holds already as available", "[m
     // The caller's limit is on the whole, held or not.
     CHECK_THROWS_AS(check_memory("a test", 3e9, std::uint64_t(2e9), 2e9), Error);
 }
+
+namespace {
+int releases = 0;
+}
+
+TEST_CASE("release_free_memory calls the release a program registered", "[memory]") {
+    releases = 0;
+    release_free_memory();  // none registered in the tests: glibc's trim alone
+    CHECK(releases == 0);
+    set_free_memory_release([] { ++releases; });
+    release_free_memory();
+    release_free_memory();
+    CHECK(releases == 2);
+    set_free_memory_release(nullptr);
+    release_free_memory();
+    CHECK(releases == 2);
+}

@@ -1,5 +1,7 @@
 #include "terrain/core/memory_budget.hpp"
 
+#include <malloc.h>
+
 #include <atomic>
 #include <cmath>
 #include <cstdio>
@@ -11,7 +13,17 @@
 namespace terrain {
 namespace {
 std::atomic<std::uint64_t> limit_bytes{0};
+std::atomic<void (*)()> free_memory_release{nullptr};
 }  // namespace
+
+void set_free_memory_release(void (*release)()) {
+    free_memory_release = release;
+}
+
+void release_free_memory() {
+    if (const auto release = free_memory_release.load()) release();
+    malloc_trim(0);
+}
 
 std::optional<std::uint64_t> available_memory() {
     std::ifstream in("/proc/meminfo");

@@ -1,7 +1,5 @@
 #include "terrain/pipeline/segment.hpp"
 
-#include <malloc.h>
-
 #include <algorithm>
 #include <cctype>
 #include <chrono>
@@ -17,6 +15,7 @@
 #include "terrain/core/error.hpp"
 #include "terrain/core/huge_pages.hpp"
 #include "terrain/core/json_writer.hpp"
+#include "terrain/core/memory_budget.hpp"
 #include "terrain/core/version.hpp"
 #include "terrain/io/dependency_versions.hpp"
 #include "terrain/io/mesh_files.hpp"
@@ -441,7 +440,7 @@ void release_large_data(SegmentResult& result) {
     drop(result.field);
     drop(result.segmentation.labels);
     drop(result.segmentation.seeds);
-    malloc_trim(0);
+    release_free_memory();
 }
 
 std::vector<std::string> write_segment_directory(SegmentResult& result,
@@ -450,6 +449,7 @@ std::vector<std::string> write_segment_directory(SegmentResult& result,
                                                  const std::string& dir, const WriteOptions& write,
                                                  const ProgressFn& progress) {
     const auto t0 = clock::now();
+    release_free_memory();  // (freed blocks a program keeps: GDAL's block cache comes next)
     io::SegmentOutputOptions out;
     out.polygons.driver = options.format;
     out.preview_caption.input = fs::path(input_path).filename().string();

@@ -12,6 +12,7 @@
 
 #include "terrain/core/error.hpp"
 #include "terrain/core/json_writer.hpp"
+#include "terrain/core/memory_budget.hpp"
 #include "terrain/io/write_adjacency.hpp"
 #include "terrain/io/write_label_stack.hpp"
 #include "terrain/io/write_mesh_labels.hpp"
@@ -224,6 +225,7 @@ std::vector<std::string> write_sweep_directory(SweepResult& result, const Segmen
     const auto& scales = result.scales;
     const std::string d = dir_path + "/";
     const auto w0 = clock::now();
+    release_free_memory();  // (freed blocks a program keeps: GDAL's block cache comes next)
     std::vector<std::string> files;
     const Dem* dem = base.dem();
     const bool by_area = !scales.empty() && scales.front().min_area_m2 > 0;

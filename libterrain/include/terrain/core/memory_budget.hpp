@@ -16,6 +16,14 @@ std::optional<std::uint64_t> available_memory();
 void set_memory_limit(std::uint64_t bytes);
 std::uint64_t memory_limit();
 
+// Memory the process keeps freed for reuse, given back to the system: glibc's free pages
+// (malloc_trim) and what the program registered here (the terrain program keeps its large
+// freed blocks for the next large allocation, tools/big_blocks.cpp). The pipeline calls it
+// before writing outputs, whose libraries allocate on their own, and once its large arrays
+// are freed.
+void set_free_memory_release(void (*release)());
+void release_free_memory();
+
 // Parses "512M", "4G", "1.5GB", "100000" (bytes); throws terrain::Error on anything else.
 std::uint64_t parse_memory_size(const std::string& text);
 
