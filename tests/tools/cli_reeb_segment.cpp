@@ -194,6 +194,26 @@ TEST_CASE("terrain segment asks for huge pages when the kernel gives them on req
     }
 }
 
+TEST_CASE("terrain segment keeps its large blocks for reuse with the same outputs",
+          "[cli][segment]") {
+    // The whole 512 x 512 tile: its per-vertex positions (6 MiB) and several other arrays
+    // are large blocks, freed and taken again from stage to stage.
+    const auto dir = terrain::test::scratch_dir("cli_large_blocks");
+    const auto dem = terrain::test::sample("vesta_hamo_tile.lbl");
+    const auto kept = dir / "kept";
+    const auto malloced = dir / "malloc";
+    fs::remove_all(kept);
+    fs::remove_all(malloced);
+    auto r = run_cli({"segment", dem, "-o", kept.string(), "-q"});
+    INFO(r.err);
+    REQUIRE(r.status == 0);
+    r = terrain::test::run_program(TERRAIN_CLI, {"segment", dem, "-o", malloced.string(), "-q"},
+                                   {"TERRAIN_LARGE_BLOCKS=0"});
+    REQUIRE(r.status == 0);
+    for (const char* file : {"labels.tif", "regions.geojson", "adjacency.json", "preview.png"})
+        CHECK(slurp(kept / file) == slurp(malloced / file));
+}
+
 TEST_CASE("terrain segment on a constant field, a mostly-NoData DEM and a mesh file",
           "[cli][segment]") {
     const auto dir = terrain::test::scratch_dir("cli_segment_edge");
