@@ -150,7 +150,8 @@ TEST_CASE("Disk-like DEMs give a tree, a hole in the DEM can give a loop", "[ree
     const auto disks_mesh = mesh::dem_to_mesh(disks);
     CHECK(reeb::reeb_is_tree(disks_mesh));
     const auto f = test::noise_field(disks_mesh.vertex_count(), 11);
-    const auto forest = reeb::build_reeb_graph(disks_mesh, f, {reeb::ReebAlgorithm::contour_tree});
+    const auto forest =
+        reeb::build_reeb_graph(disks_mesh, f, {reeb::ReebAlgorithm::contour_tree, false, {}});
     REQUIRE(reeb::check_reeb_graph(forest, f).empty());
     CHECK(reeb::summarize(forest).components == 2);
     CHECK(reeb::summarize(forest).loops == 0);
@@ -280,7 +281,7 @@ TEST_CASE("The contour tree and the sweep give the same graph on disks and spher
     CHECK_FALSE(reeb::reeb_is_tree(holed));
     CHECK_FALSE(reeb::reeb_is_tree(test::torus_mesh(3, 1, 12, 8, true)));
     CHECK_THROWS_WITH(reeb::build_reeb_graph(holed, test::noise_field(holed.vertex_count(), 1),
-                                             {reeb::ReebAlgorithm::contour_tree}),
+                                             {reeb::ReebAlgorithm::contour_tree, false, {}}),
                       Catch::Contains("disks or spheres"));
     // Noise on four levels (quantized): plateaus of every shape, degenerate saddles and
     // boundary runs.
@@ -293,8 +294,9 @@ TEST_CASE("The contour tree and the sweep give the same graph on disks and spher
         {&sphere, quantized(test::noise_field(sphere.vertex_count(), 7))},
     };
     for (const auto& [mesh, f] : cases) {
-        const auto a = reeb::build_reeb_graph(*mesh, f, {reeb::ReebAlgorithm::sweep});
-        const auto b = reeb::build_reeb_graph(*mesh, f, {reeb::ReebAlgorithm::contour_tree});
+        const auto a = reeb::build_reeb_graph(*mesh, f, {reeb::ReebAlgorithm::sweep, false, {}});
+        const auto b =
+            reeb::build_reeb_graph(*mesh, f, {reeb::ReebAlgorithm::contour_tree, false, {}});
         REQUIRE(reeb::check_reeb_graph(b, f).empty());
         CHECK(a.node_vertices == b.node_vertices);
         CHECK(a.node_kinds == b.node_kinds);
@@ -350,6 +352,45 @@ TEST_CASE("A DEM mesh's Reeb graph is the same with its triangles released", "[r
         CHECK(a.arcs == b.arcs);
         CHECK(a.arc_nodes == b.arc_nodes);
     }
+}
+
+TEST_CASE("A tree's field may be taken away once the events are ordered", "[reeb]") {
+    // pipeline::segment parks the field on disk while the contour tree runs.
+    const auto globe_dem = io::read_dem(test::sample("moon_ldem1_global.tif"));
+    const auto sphere = mesh::dem_to_mesh(globe_dem);
+    const auto f = quantized(test::noise_field(sphere.vertex_count(), 7));
+    const auto held = reeb::build_reeb_graph(sphere, f);
+    auto field = f;
+    int calls = 0;
+    reeb::ReebOptions options;
+    options.known_tree = true;
+    options.field_read = [&] {
+        ++calls;
+        std::vector<float>().swap(field);  // read any further, it would be out of bounds
+    };
+    const auto taken = reeb::build_reeb_graph(sphere, field, options);
+    CHECK(calls == 1);
+    CHECK(field.empty());
+    CHECK(taken.node_values == held.node_values);
+    CHECK(taken.node_kinds == held.node_kinds);
+    CHECK(taken.vertex_nodes == held.vertex_nodes);
+    CHECK(taken.arcs == held.arcs);
+    CHECK(taken.arc_nodes == held.arc_nodes);
+    // Not known to be a tree, or no callback: the field is not asked for.
+    field = f;
+    options.known_tree = false;
+    calls = 0;
+    CHECK(reeb::build_reeb_graph(sphere, field, options).arcs == held.arcs);
+    CHECK(calls == 0);
+    CHECK(field.size() == f.size());
+    // A mesh said to be a tree that has a loop: an error, not a read of the field taken away.
+    const auto torus = test::torus_mesh(3, 1, 12, 8, true);
+    auto torus_field = test::noise_field(torus.vertex_count(), 2);
+    reeb::ReebOptions wrong;
+    wrong.known_tree = true;
+    wrong.field_read = [&] { std::vector<float>().swap(torus_field); };
+    CHECK_THROWS_WITH(reeb::build_reeb_graph(torus, torus_field, wrong),
+                      Catch::Contains("said to be a tree"));
 }
 
 TEST_CASE("The Reeb graph's progress is monotone, on the caller's thread, whatever the threads",

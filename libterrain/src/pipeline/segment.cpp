@@ -205,17 +205,24 @@ void compute_field(SegmentResult& result, const SegmentOptions& options,
     result.add_time("field", since(t0));
 }
 
-reeb::ReebGraph compute_reeb(SegmentResult& result, const ProgressFn& progress) {
+reeb::ReebGraph compute_reeb(SegmentResult& result, const ProgressFn& progress, bool known_tree,
+                             const std::function<void()>& field_read) {
     const auto t0 = clock::now();
     auto& mesh = result.input.mesh;
     // A DEM mesh frees its triangles (24 bytes a pixel) once no stage needs them at random,
     // and the stages after make them again from the grid, in order. When the Reeb graph is a
     // tree (every component a disk or a sphere: the contour tree makes it) that is before it;
     // with loops the contour-tracking sweep walks them at random, so after.
-    if (mesh.triangles_releasable() && reeb::reeb_is_tree(mesh, scaled_progress(progress, 0, 0.1)))
+    if (!known_tree && mesh.triangles_releasable() &&
+        reeb::reeb_is_tree(mesh, scaled_progress(progress, 0, 0.1))) {
         mesh.release_triangles();
-    auto graph =
-        reeb::build_reeb_graph(mesh, result.field, {}, scaled_progress(progress, 0.1, 0.95));
+        known_tree = true;
+    }
+    reeb::ReebOptions reeb_options;
+    reeb_options.known_tree = known_tree;
+    reeb_options.field_read = field_read;
+    auto graph = reeb::build_reeb_graph(mesh, result.field, reeb_options,
+                                        scaled_progress(progress, 0.1, 0.95));
     // Only the count of critical nodes is reported: summarize() would also count the graph's
     // components and loops, a union-find over every node (about 1.5 % of a whole run).
     result.critical_before = static_cast<std::size_t>(
@@ -341,9 +348,10 @@ SegmentResult segment(Input input, const SegmentOptions& options, const Progress
     // field, which it precedes.)
     auto& mesh = result.input.mesh;
     const auto tf = clock::now();
-    if (field::parse_field_kind(options.field) != field::FieldKind::sdf &&
-        mesh.triangles_releasable() && reeb::reeb_is_tree(mesh, scaled_progress(progress, 0, 0.02)))
-        mesh.release_triangles();
+    const bool tree = field::parse_field_kind(options.field) != field::FieldKind::sdf &&
+                      mesh.triangles_releasable() &&
+                      reeb::reeb_is_tree(mesh, scaled_progress(progress, 0, 0.02));
+    if (tree) mesh.release_triangles();
     result.add_time("field", since(tf));
     compute_field(result, options, scaled_progress(progress, 0.02, 0.2));
     // A DEM mesh frees its positions (12 bytes a vertex) while the Reeb graph and the
@@ -370,7 +378,10 @@ SegmentResult segment(Input input, const SegmentOptions& options, const Progress
         parked.park(mesh.vertex_areas, progress, 0.208, 0.21);
     }
     result.add_time("reeb", since(tp));  // (which it precedes: the times stay in run order)
-    auto graph = compute_reeb(result, scaled_progress(progress, 0.21, 0.4));
+    // The field waits on disk too once the Reeb graph's events are ordered (the contour tree
+    // does not read it): the Reeb graph's peak of memory is in the contour tree.
+    auto graph = compute_reeb(result, scaled_progress(progress, 0.21, 0.4), tree,
+                              [&] { parked.park(result.field, {}, 0, 0); });
     const auto ta = clock::now();
     parked.restore(mesh.vertex_areas, progress, 0.4, 0.4);
     result.add_time("reeb", since(ta));
@@ -378,7 +389,7 @@ SegmentResult segment(Input input, const SegmentOptions& options, const Progress
     // which lowers the peak memory.
     const auto t0 = clock::now();
     if (parked.on()) {
-        parked.park(result.field, progress, 0.4, 0.403);
+        if (!result.field.empty()) parked.park(result.field, progress, 0.4, 0.403);
         parked.park(mesh.pixel_vertex, progress, 0.403, 0.406);
         parked.park(mesh.vertex_pixel, progress, 0.406, 0.409);
         parked.park(mesh.neighbor_directions, progress, 0.409, 0.41);

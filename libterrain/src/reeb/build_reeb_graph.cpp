@@ -42,10 +42,14 @@ ReebGraph build_reeb_graph(const TriangleMesh& mesh, const std::vector<float>& f
         return g;
     }
     internal::order_events(mesh, field, g, scaled_progress(progress, 0, 0.2));
+    const bool given_away = options.known_tree && options.field_read;
+    if (given_away) options.field_read();  // (the contour tree does not read the field)
     if (internal::contour_tree(mesh, g, progress)) {
         report_progress(progress, 1.0, "reeb");
         return g;
     }
+    if (given_away)
+        throw Error("reeb", "the mesh was said to be a tree (known_tree) but has handles or holes");
     if (options.algorithm == ReebAlgorithm::contour_tree)
         throw Error("reeb",
                     "the contour-tree algorithm needs a mesh whose components are disks "

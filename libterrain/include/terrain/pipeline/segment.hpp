@@ -13,6 +13,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <utility>
@@ -159,8 +160,12 @@ struct SegmentResult {
 void compute_field(SegmentResult& result, const SegmentOptions& options,
                    const ProgressFn& progress = {});
 // The unsimplified Reeb graph of result.field (stage "reeb"); sets critical_before. A DEM
-// mesh's triangles are released after it (TriangleMesh::release_triangles).
-reeb::ReebGraph compute_reeb(SegmentResult& result, const ProgressFn& progress = {});
+// mesh's triangles are released after it (TriangleMesh::release_triangles). `known_tree`:
+// the caller has found the mesh a tree (reeb::reeb_is_tree); then, or when this finds it,
+// `field_read` is called once the graph reads result.field no more (reeb::ReebOptions), and
+// the caller may take the field away until this returns.
+reeb::ReebGraph compute_reeb(SegmentResult& result, const ProgressFn& progress = {},
+                             bool known_tree = false, const std::function<void()>& field_read = {});
 
 // One scale: the graph simplified with options.simplify and the regions grown on it.
 struct ScaleResult {

@@ -13,6 +13,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -110,6 +111,13 @@ enum class ReebAlgorithm {
 
 struct ReebOptions {
     ReebAlgorithm algorithm = ReebAlgorithm::automatic;
+    // For a caller that would rather not hold the field while the graph is made: when the mesh
+    // is known to be a tree (`known_tree`: reeb_is_tree said so) and the contour tree makes the
+    // graph, `field_read` is called once the field will be read no more (the events ordered).
+    // The caller may then take the field's values away until build_reeb_graph returns. A mesh
+    // said to be a tree that has handles or holes is then an error.
+    bool known_tree = false;
+    std::function<void()> field_read;
 };
 
 // True when every connected component of the mesh is a disk or a sphere, so that the Reeb
