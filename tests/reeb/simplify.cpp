@@ -510,3 +510,50 @@ TEST_CASE("A graph handed over lets its caller set the mesh's areas aside once t
         CHECK(given.graph.arcs == lent.graph.arcs);
     }
 }
+
+TEST_CASE("A graph handed over lets its caller park the vertices' nodes until the output",
+          "[simplify]") {
+    const auto& s = vesta();
+    reeb::SimplifyOptions o;
+    o.persistence = 10;
+    o.area_ratio = 0.5;
+    const auto lent = reeb::simplify(s.mesh, reeb::build_reeb_graph(s.mesh, s.si), o);
+    std::vector<std::int32_t> aside;
+    int parks = 0, restores = 0;
+    double last = 0;
+    std::size_t parked_size = 0;
+    reeb::VertexNodesParking parking;
+    parking.park = [&](std::vector<std::int32_t>& v) {
+        ++parks;
+        CHECK(last < 0.5);  // before the cancellations
+        parked_size = v.size();
+        aside.swap(v);  // read while away, they would be empty
+    };
+    parking.restore = [&](std::vector<std::int32_t>& v) {
+        ++restores;
+        CHECK(last > 0.5);  // after the cancellations
+        CHECK(v.empty());
+        v.swap(aside);
+    };
+    const auto progress = [&](double f, std::string_view) {
+        last = f;
+        return true;
+    };
+    const auto given =
+        reeb::simplify(s.mesh, reeb::build_reeb_graph(s.mesh, s.si), o, progress, {}, parking);
+    CHECK(parks == 1);
+    CHECK(restores == 1);
+    CHECK(parked_size == s.mesh.vertex_count());
+    CHECK(given.field == lent.field);
+    CHECK(given.absorbed == lent.absorbed);
+    CHECK(given.graph.node_values == lent.graph.node_values);
+    CHECK(given.graph.vertex_nodes == lent.graph.vertex_nodes);
+    CHECK(given.graph.node_vertices == lent.graph.node_vertices);
+    CHECK(given.graph.arcs == lent.graph.arcs);
+    // Given back wrong: one error, not a read out of bounds.
+    last = 0;
+    parking.restore = [&](std::vector<std::int32_t>& v) { v.assign(3, 0); };
+    CHECK_THROWS_WITH(
+        reeb::simplify(s.mesh, reeb::build_reeb_graph(s.mesh, s.si), o, {}, {}, parking),
+        Catch::Contains("wrong size"));
+}

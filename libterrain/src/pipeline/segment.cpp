@@ -397,14 +397,22 @@ SegmentResult segment(Input input, const SegmentOptions& options, const Progress
     result.parked_bytes = parked.parked_bytes();
     const auto thresholds = simplify_options(options, result.input.mesh);
     result.area_ratio_percent = thresholds.area_ratio;
-    // The areas wait on disk again once the simplification has read them (before its peak
-    // of memory, the end of its copy of the arcs). (Parked without progress: the
-    // simplification reports around it.)
-    const auto simplified = reeb::simplify(result.input.mesh, std::move(graph), thresholds,
-                                           scaled_progress(progress, 0.41, 0.6), [&] {
-                                               if (parked.park(mesh.vertex_areas, {}, 0, 0))
-                                                   result.parked_bytes = parked.parked_bytes();
-                                           });
+    // The areas wait on disk again once the simplification has read them, and the graph's
+    // vertices' nodes until its output reads them (both before its peak of memory, the end
+    // of its copy of the arcs). (Parked without progress: the simplification reports around
+    // it.)
+    reeb::VertexNodesParking vertex_nodes;
+    vertex_nodes.park = [&](std::vector<std::int32_t>& v) {
+        if (parked.park(v, {}, 0, 0)) result.parked_bytes = parked.parked_bytes();
+    };
+    vertex_nodes.restore = [&](std::vector<std::int32_t>& v) { parked.restore(v, {}, 0, 0); };
+    const auto simplified = reeb::simplify(
+        result.input.mesh, std::move(graph), thresholds, scaled_progress(progress, 0.41, 0.6),
+        [&] {
+            if (parked.park(mesh.vertex_areas, {}, 0, 0))
+                result.parked_bytes = parked.parked_bytes();
+        },
+        vertex_nodes);
     const double seconds = since(t0);
     // (Counted with the growing, which it precedes: the stages' times stay in run order.)
     const auto t2 = clock::now();

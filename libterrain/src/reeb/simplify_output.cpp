@@ -11,6 +11,7 @@
 #include "../core/disjoint_sets.hpp"
 #include "../core/pass_progress.hpp"
 #include "../core/release.hpp"
+#include "terrain/core/error.hpp"
 #include "working_graph.hpp"
 
 namespace terrain::reeb::internal {
@@ -61,16 +62,8 @@ void WorkingGraph::write_result(SimplifyResult& result, const ProgressFn& progre
         node_map_[n] = -2 - c;
     }
     const std::size_t count = kept.size();
-    std::vector<i32> size(count + 1, 0);
     for (std::size_t n = 0; n < nn; ++n)
         if (node_map_[n] < 0) node_map_[n] = -2 - code[idx(-2 - node_map_[n])];
-    if (lists_from_vertex_nodes_) {
-        for (const i32 n : owned_->vertex_nodes) ++size[idx(node_map_[idx(n)]) + 1];
-    } else {
-        for (std::size_t n = 0; n < nn; ++n)
-            size[idx(node_map_[n]) + 1] +=
-                g_.node_vertex_offsets[n + 1] - g_.node_vertex_offsets[n];
-    }
     ReebGraph& out = result.graph;
     out.node_values.resize(count);
     out.node_kinds.assign(count, NodeKind::regular);
@@ -118,6 +111,20 @@ void WorkingGraph::write_result(SimplifyResult& result, const ProgressFn& progre
     detail::release(kept);
     release_working_graph();
     const std::size_t nv = input_vertices_;
+    if (parked_.restore) {
+        parked_.restore(owned_->vertex_nodes);
+        if (owned_->vertex_nodes.size() != nv)
+            throw Error("simplify", "the vertices' nodes came back with the wrong size");
+    }
+    // Each new node's vertex count.
+    std::vector<i32> size(count + 1, 0);
+    if (lists_from_vertex_nodes_) {
+        for (const i32 n : owned_->vertex_nodes) ++size[idx(node_map_[idx(n)]) + 1];
+    } else {
+        for (std::size_t n = 0; n < nn; ++n)
+            size[idx(node_map_[n]) + 1] +=
+                g_.node_vertex_offsets[n + 1] - g_.node_vertex_offsets[n];
+    }
     if (lists_from_vertex_nodes_) {
         // The input's vertex lists again, each ascending (a counting sort of the vertices by
         // node): what the graph handed over held.

@@ -157,7 +157,8 @@ double node_area(const TriangleMesh& mesh, const ReebGraph& g, std::size_t n,
 
 WorkingGraph::WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big_degree,
                            const ProgressFn& progress, ReebGraph* owned,
-                           const std::function<void()>& areas_read)
+                           const std::function<void()>& areas_read,
+                           const VertexNodesParking& parking)
     : g_(g),
       input_nodes_(g.node_count()),
       input_vertices_(g.vertex_nodes.size()),
@@ -233,6 +234,11 @@ WorkingGraph::WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big
             detail::release(owned->node_vertex_offsets);
         } else {
             detail::release(owned->vertex_nodes);
+        }
+        // Read again only by write_result: they may wait elsewhere through the peak.
+        if (lists_from_vertex_nodes_ && parking.park && parking.restore) {
+            parked_ = parking;
+            parked_.park(owned->vertex_nodes);
         }
     }
     // Arc a joins its lower then its upper end, a in order.

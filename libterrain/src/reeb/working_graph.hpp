@@ -56,9 +56,12 @@ class WorkingGraph {
     // are not held beside the working graph at the peak of the simplification's memory; the
     // vertex lists and links stay for write_result. `areas_read` is called once the nodes'
     // areas are summed, before the arcs are copied: the mesh's areas are read no more.
+    // `parking` (simplify(ReebGraph&&)): owned's vertex nodes, when write_result makes the
+    // vertex lists again from them, are parked then too and restored in write_result.
     WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big_degree = kBigDegree,
                  const ProgressFn& progress = {}, ReebGraph* owned = nullptr,
-                 const std::function<void()>& areas_read = {});
+                 const std::function<void()>& areas_read = {},
+                 const VertexNodesParking& parking = {});
 
     // The simplified graph and the rewritten field (simplify_output.cpp). The working graph is
     // freed as it goes: nothing else may be asked of it after.
@@ -371,6 +374,7 @@ class WorkingGraph {
     // vertex_nodes (4 bytes a vertex): write_result makes the same lists again from them, once
     // the working graph is freed.
     bool lists_from_vertex_nodes_ = false;
+    VertexNodesParking parked_;  // set when owned's vertex nodes are parked
     // Frees the records, runs, arcs, sets and big nodes (write_result, once the arcs are out).
     void release_working_graph();
     std::size_t moves_ = 0;  // link() calls

@@ -65,9 +65,19 @@ SimplifyResult simplify(const TriangleMesh& mesh, const ReebGraph& graph,
 // for the last time (once the working copy has summed its nodes' areas, before it copies the
 // arcs: the copy's end is the simplification's peak of memory): the caller may set them
 // aside, parked or freed, until this returns (pipeline::segment parks them).
+// `vertex_nodes`, when both its functions are given: the graph's vertices' nodes (4 bytes a
+// vertex), which the output reads to make the nodes' vertex lists again (when the graph's lists
+// were ascending, as build_reeb_graph makes them), wait unread from the working copy's nodes to
+// the output. `park` is called with them then (before the copy of the arcs, the peak) and may
+// take them away; `restore` is called with that vector before they are read again and must put
+// back the same values (pipeline::segment parks them on disk).
+struct VertexNodesParking {
+    std::function<void(std::vector<std::int32_t>&)> park, restore;
+};
 SimplifyResult simplify(const TriangleMesh& mesh, ReebGraph&& graph, const SimplifyOptions& options,
                         const ProgressFn& progress = {},
-                        const std::function<void()>& areas_read = {});
+                        const std::function<void()>& areas_read = {},
+                        const VertexNodesParking& vertex_nodes = {});
 
 // Persistence and area ratio (a fraction, not percent) of each arc of a graph on its mesh.
 struct ArcMetrics {
