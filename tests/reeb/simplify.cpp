@@ -467,6 +467,27 @@ TEST_CASE("A graph handed over gives the result of the same graph lent, plateaus
     }
 }
 
+namespace {
+
+// The Vesta tile's graph with the paper's thresholds, and a check that a result given the
+// graph handed over is the one it gives lent.
+reeb::SimplifyOptions paper_thresholds() {
+    reeb::SimplifyOptions o;
+    o.persistence = 10;
+    o.area_ratio = 0.5;
+    return o;
+}
+void check_same_result(const reeb::SimplifyResult& given, const reeb::SimplifyResult& lent) {
+    CHECK(given.field == lent.field);
+    CHECK(given.absorbed == lent.absorbed);
+    CHECK(given.graph.node_values == lent.graph.node_values);
+    CHECK(given.graph.vertex_nodes == lent.graph.vertex_nodes);
+    CHECK(given.graph.node_vertices == lent.graph.node_vertices);
+    CHECK(given.graph.arcs == lent.graph.arcs);
+}
+
+}  // namespace
+
 TEST_CASE("A graph handed over lets its caller set the mesh's areas aside once they are read",
           "[simplify]") {
     // The callback comes once, before the cancellations; what the caller then does to the
@@ -474,9 +495,7 @@ TEST_CASE("A graph handed over lets its caller set the mesh's areas aside once t
     // (a factor of 1 to 97 a vertex: had anything read them after, the area ratios, and so
     // the result, would differ).
     const auto& s = vesta();
-    reeb::SimplifyOptions o;
-    o.persistence = 10;
-    o.area_ratio = 0.5;
+    const auto o = paper_thresholds();
     const auto lent = reeb::simplify(s.mesh, reeb::build_reeb_graph(s.mesh, s.si), o);
     for (const bool scramble : {false, true}) {
         INFO((scramble ? "scrambled" : "taken away"));
@@ -503,20 +522,14 @@ TEST_CASE("A graph handed over lets its caller set the mesh's areas aside once t
             });
         CHECK(calls == 1);
         CHECK(mesh.vertex_areas.empty() == !scramble);
-        CHECK(given.field == lent.field);
-        CHECK(given.absorbed == lent.absorbed);
-        CHECK(given.graph.node_values == lent.graph.node_values);
-        CHECK(given.graph.vertex_nodes == lent.graph.vertex_nodes);
-        CHECK(given.graph.arcs == lent.graph.arcs);
+        check_same_result(given, lent);
     }
 }
 
 TEST_CASE("A graph handed over lets its caller park the vertices' nodes until the output",
           "[simplify]") {
     const auto& s = vesta();
-    reeb::SimplifyOptions o;
-    o.persistence = 10;
-    o.area_ratio = 0.5;
+    const auto o = paper_thresholds();
     const auto lent = reeb::simplify(s.mesh, reeb::build_reeb_graph(s.mesh, s.si), o);
     std::vector<std::int32_t> aside;
     int parks = 0, restores = 0;
@@ -544,12 +557,7 @@ TEST_CASE("A graph handed over lets its caller park the vertices' nodes until th
     CHECK(parks == 1);
     CHECK(restores == 1);
     CHECK(parked_size == s.mesh.vertex_count());
-    CHECK(given.field == lent.field);
-    CHECK(given.absorbed == lent.absorbed);
-    CHECK(given.graph.node_values == lent.graph.node_values);
-    CHECK(given.graph.vertex_nodes == lent.graph.vertex_nodes);
-    CHECK(given.graph.node_vertices == lent.graph.node_vertices);
-    CHECK(given.graph.arcs == lent.graph.arcs);
+    check_same_result(given, lent);
     // Given back wrong: one error, not a read out of bounds.
     last = 0;
     parking.restore = [&](std::vector<std::int32_t>& v) { v.assign(3, 0); };
