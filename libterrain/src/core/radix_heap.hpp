@@ -39,7 +39,7 @@ class RadixHeap {
             std::push_heap(below_.begin(), below_.end(), greater);
             return;
         }
-        buckets_[bucket_of(k)].push_back(item);
+        put(bucket_of(k), item);
     }
 
     // The least item (of the items with the least key, any); the heap must not be empty.
@@ -57,6 +57,15 @@ class RadixHeap {
         return top;
     }
 
+    // The item pop() would return now (nullptr when empty), without taking it: for fetching
+    // its memory early. (May move items between buckets, as pop() would next.)
+    const Item* peek() {
+        if (size_ == 0) return nullptr;
+        if (!below_.empty()) return &below_.front();
+        if (buckets_[0].empty()) refill();
+        return &buckets_[0].back();
+    }
+
   private:
     static bool greater(const Item& a, const Item& b) { return a.key() > b.key(); }
 
@@ -64,20 +73,26 @@ class RadixHeap {
         return k == last_ ? 0 : 64 - static_cast<std::size_t>(std::countl_zero(k ^ last_));
     }
 
+    void put(std::size_t b, const Item& item) {
+        buckets_[b].push_back(item);
+        if (b > 0) filled_ |= std::uint64_t{1} << (b - 1);
+    }
+
     // Bucket 0 empty: the lowest non-empty bucket's least key becomes last_, its items move down.
     void refill() {
-        std::size_t b = 1;
-        while (buckets_[b].empty()) ++b;
+        const auto b = 1 + static_cast<std::size_t>(std::countr_zero(filled_));
         auto& from = buckets_[b];
         std::uint64_t least = from.front().key();
         for (const Item& item : from) least = std::min(least, item.key());
         last_ = least;
-        for (const Item& item : from) buckets_[bucket_of(item.key())].push_back(item);
+        filled_ &= ~(std::uint64_t{1} << (b - 1));
+        for (const Item& item : from) put(bucket_of(item.key()), item);
         from.clear();
     }
 
     std::uint64_t last_ = 0;
     std::size_t size_ = 0;
+    std::uint64_t filled_ = 0;  // bit b - 1: bucket b (1 to 64) holds items
     std::array<std::vector<Item>, 65> buckets_;
     std::vector<Item> below_;  // keys below last_, as a binary heap (least on top)
 };

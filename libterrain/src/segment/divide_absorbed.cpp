@@ -24,6 +24,7 @@
 #include "../core/indices.hpp"
 #include "../core/pass_progress.hpp"
 #include "../core/radix_heap.hpp"
+#include "../mesh/prefetch_around.hpp"
 #include "terrain/core/error.hpp"
 
 namespace terrain::segment {
@@ -165,16 +166,17 @@ DivideCounts divide_absorbed(const TriangleMesh& mesh, const reeb::ReebGraph& gr
     {
         std::vector<std::uint8_t> kept(n, 0);
         std::vector<std::size_t> stack;
-        for (std::size_t r = 0; r < segmentation.seeds.size(); ++r) {
-            const i32 s = segmentation.seeds[r];
-            const auto label = static_cast<std::uint32_t>(r + 1);
-            for (i32 i = graph.node_vertex_offsets[idx(s)];
-                 i < graph.node_vertex_offsets[idx(s) + 1]; ++i) {
-                const std::size_t v = idx(graph.node_vertices[idx(i)]);
-                if (sites[v].label != label || kept[v]) continue;
-                kept[v] = 1;
-                stack.push_back(v);
-            }
+        // (The seeds' vertices found in one pass in vertex order: a seed node's list holds
+        // the vertices absorbed into it too, most of the surface, in an order scattered over
+        // it. The parts kept are the same in any order.)
+        const auto& seeds = segmentation.seeds;
+        for (std::size_t seed = 0; seed < n; ++seed) {
+            const std::uint32_t label = sites[seed].label;
+            if (label == 0 || kept[seed] || label > seeds.size() ||
+                graph.vertex_nodes[seed] != seeds[label - 1])
+                continue;
+            kept[seed] = 1;
+            stack.push_back(seed);
             while (!stack.empty()) {
                 const std::size_t v = stack.back();
                 stack.pop_back();
@@ -256,6 +258,10 @@ DivideCounts divide_absorbed(const TriangleMesh& mesh, const reeb::ReebGraph& gr
     report_progress(progress, 0.3, "divide");
     while (!heap.empty()) {
         const Step s = heap.pop();
+        // (The next vertex's memory is asked for while this one is handled: popped in cost
+        // order, the vertices are scattered over the surface.)
+        if (const Step* next = heap.peek())
+            detail::prefetch_around(mesh, idx(next->vertex), sites, mesh.positions);
         Site& site = sites[idx(s.vertex)];
         if ((site.label & kFinal) || s.cost != site.cost || s.label != site.label) continue;
         site.label |= kFinal;

@@ -1,0 +1,108 @@
+// Benchmark: the growing stage of `terrain segment` (single-threaded, as it is): the regions
+// grown on the simplified Reeb graph, the absorbed vertices divided among them by the
+// flooding, and the region graph. On a DEM given (a global grid of tests/bench/
+// make_global_dem.py) or a synthetic Vesta tile of the size given; the stages before it run
+// once, each step of the growing three times (best wall time, and its CPU time).
+//   build/tests/bench/bench_grow [DEM | size]
+#include <time.h>
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+
+#include "terrain/field/shape_index.hpp"
+#include "terrain/geo/georeference.hpp"
+#include "terrain/io/read_dem.hpp"
+#include "terrain/mesh/dem_to_mesh.hpp"
+#include "terrain/reeb/reeb_graph.hpp"
+#include "terrain/reeb/simplify.hpp"
+#include "terrain/segment/divide_absorbed.hpp"
+#include "terrain/segment/grow_regions.hpp"
+#include "terrain/segment/regions.hpp"
+#include "terrain/synth/crater_field.hpp"
+
+using namespace terrain;
+
+namespace {
+
+double thread_cpu_seconds() {
+    timespec ts{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
+template <class F>
+double best_of(int runs, F&& f, double* cpu) {
+    double best = 1e300;
+    for (int i = 0; i < runs; ++i) {
+        const auto t0 = std::chrono::steady_clock::now();
+        const double c0 = thread_cpu_seconds();
+        f();
+        const double wall =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        if (wall < best) {
+            best = wall;
+            *cpu = thread_cpu_seconds() - c0;
+        }
+    }
+    return best;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    const std::string arg = argc > 1 ? argv[1] : "1000";
+    Dem dem;
+    if (arg.find_first_not_of("0123456789") == std::string::npos) {
+        synth::VestaTileOptions options;
+        options.width = options.height = std::atoi(arg.c_str());
+        dem = synth::generate_vesta_tile(options);
+        geo::georeference(dem);
+    } else {
+        dem = io::read_dem(arg);
+    }
+    const auto mesh = mesh::dem_to_mesh(dem);
+    const auto field = field::shape_index_field(mesh);
+    reeb::SimplifyOptions thresholds;  // the defaults of `terrain segment`
+    thresholds.persistence = 10;
+    thresholds.area_ratio = 0.5;
+    const auto simplified = reeb::simplify(mesh, reeb::build_reeb_graph(mesh, field), thresholds);
+    const double nv = static_cast<double>(mesh.vertex_count());
+    std::printf("bench_grow: %s, %zu vertices, %zu nodes after the simplification\n", arg.c_str(),
+                mesh.vertex_count(), simplified.graph.node_count());
+
+    segment::Segmentation grown;
+    double cpu = 0;
+    double t = best_of(
+        3, [&] { grown = segment::grow_regions(mesh, simplified.graph, {}); }, &cpu);
+    std::printf("grow regions     %7.3f s (CPU %7.3f)  %6.2f M vertices/s  %zu regions\n", t, cpu,
+                nv / t / 1e6, std::size_t{grown.region_count});
+    segment::Segmentation divided;
+    segment::DivideCounts counts;
+    t = best_of(
+        3,
+        [&] {
+            divided = grown;
+            counts = segment::divide_absorbed(mesh, simplified.graph, field, simplified.absorbed,
+                                              divided, nullptr, {});
+        },
+        &cpu);
+    // (Site: cost, field and region, 12 bytes a vertex; the labels 4, the flags read 1.)
+    std::printf(
+        "divide absorbed  %7.3f s (CPU %7.3f)  %6.2f M vertices/s  %zu absorbed, %.0f "
+        "bytes/vertex of its own\n",
+        t, cpu, nv / t / 1e6, counts.absorbed, 12.0 + 1.0);
+    segment::RegionGraph regions;
+    t = best_of(
+        3,
+        [&] {
+            regions =
+                segment::region_graph(mesh, field, divided.labels, divided.region_count, &dem, {});
+        },
+        &cpu);
+    std::printf(
+        "region graph     %7.3f s (CPU %7.3f)  %6.2f M vertices/s  %zu regions, %zu edges\n", t,
+        cpu, nv / t / 1e6, regions.regions.size(), regions.edges.size());
+    return 0;
+}
