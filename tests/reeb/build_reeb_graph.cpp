@@ -11,10 +11,12 @@
 
 #include <tbb/task_arena.h>
 
+#include "../../libterrain/src/reeb/contour_tree.hpp"
 #include "support/test_meshes.hpp"
 #include "support/test_support.hpp"
 #include "terrain/core/error.hpp"
 #include "terrain/field/vertex_field.hpp"
+#include "terrain/geo/georeference.hpp"
 #include "terrain/io/read_dem.hpp"
 #include "terrain/mesh/dem_to_mesh.hpp"
 #include "terrain/reeb/reeb_graph.hpp"
@@ -426,5 +428,59 @@ TEST_CASE("The Reeb graph's progress is monotone, on the caller's thread, whatev
         CHECK(sweeps >= 1);
         CHECK(elsewhere == 0);
         CHECK(seen.back() == 1.0);
+    }
+}
+
+TEST_CASE("The loop check reads a whole grid from its counts, as the count by components does",
+          "[reeb]") {
+    const auto dem = io::read_dem(test::sample("vesta_hamo_tile.lbl"));
+    const auto globe_dem = io::read_dem(test::sample("moon_ldem1_global.tif"));
+    // The global grid without its polar caps: the seam closed, no pole: a cylinder.
+    Dem band = globe_dem;
+    const int skip = 20;
+    band.height = globe_dem.height - 2 * skip;
+    band.values.assign(globe_dem.values.begin() + std::ptrdiff_t(skip) * globe_dem.width,
+                       globe_dem.values.end() - std::ptrdiff_t(skip) * globe_dem.width);
+    band.transform[3] += skip * globe_dem.transform[5];
+    geo::georeference(band);
+    struct Case {
+        const char* name;
+        TriangleMesh mesh;
+        bool whole, tree;
+    };
+    std::vector<Case> cases;
+    cases.push_back({"a tile", mesh::dem_to_mesh(dem), true, true});
+    cases.push_back({"the globe", mesh::dem_to_mesh(globe_dem), true, true});
+    cases.push_back({"a band round the globe", mesh::dem_to_mesh(band), true, false});
+    cases.push_back({"a grid with a hole",
+                     mesh::dem_to_mesh(test::grid_dem(20, 20,
+                                                      [](int c, int r) {
+                                                          return (c > 8 && c < 12 && r > 8 &&
+                                                                  r < 12)
+                                                                     ? std::nan("")
+                                                                     : double(c + r);
+                                                      })),
+                     false, false});
+    cases.push_back(
+        {"two disks at a pinch",
+         mesh::dem_to_mesh(test::grid_dem(
+             9, 9, [](int c, int r) { return c == 4 && r != 4 ? std::nan("") : double(c * r); })),
+         false, true});
+    cases.push_back({"a torus from a file", test::torus_mesh(3, 1, 12, 8, true), false, false});
+    REQUIRE(cases[2].mesh.seam_closed);
+    REQUIRE(cases[2].mesh.pole_vertices[0] < 0);
+    for (const auto& c : cases) {
+        INFO(c.name);
+        // The counts alone: one report, at the end; the count by components reports its passes.
+        int reports = 0;
+        const ProgressFn count = [&](double, std::string_view) {
+            ++reports;
+            return true;
+        };
+        CHECK(reeb::internal::loop_free(c.mesh, count) == c.tree);
+        CHECK((reports == 1) == c.whole);
+        CHECK(reeb::internal::loop_free_by_components(c.mesh) == c.tree);
+        TriangleMesh released = c.mesh;
+        if (released.release_triangles()) CHECK(reeb::internal::loop_free(released) == c.tree);
     }
 }
