@@ -105,6 +105,7 @@ case "$mode" in
     "$build_dir/tests/bench/bench_field"
     "$build_dir/tests/bench/bench_sdf" "${meshes[@]}"
     "$build_dir/tests/bench/bench_reeb"
+    "$build_dir/tests/bench/bench_grow"
     "$build_dir/tests/bench/bench_outputs"
     tests/bench/bench_segment.sh "$build_dir"
     ;;
