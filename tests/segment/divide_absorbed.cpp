@@ -163,3 +163,50 @@ TEST_CASE("Dividing with nothing absorbed changes nothing, mismatched sizes thro
         segment::divide_absorbed(mesh, simplified.graph, short_field, simplified.absorbed, s),
         Error);
 }
+
+TEST_CASE("Dividing absorbed vertices counts the parts of regions cut off from their seeds",
+          "[segment][divide]") {
+    // The parts kept, found here from each seed node's vertex list: the vertices connected to
+    // one of them through vertices of the same region that were not absorbed.
+    const auto dem = io::read_dem(test::sample("vesta_hamo_tile.lbl"));
+    const auto mesh = mesh::dem_to_mesh(dem);
+    const auto field = field::shape_index_field(mesh);
+    reeb::SimplifyOptions o;
+    o.persistence = 10;
+    o.area_ratio = 0.5;
+    const auto simplified = reeb::simplify(mesh, reeb::build_reeb_graph(mesh, field), o);
+    const auto& g = simplified.graph;
+    const auto grown = segment::grow_regions(mesh, g);
+    const std::size_t n = mesh.vertex_count();
+    const auto left = [&](std::size_t v) { return simplified.absorbed[v] != 0; };
+    std::vector<char> kept(n, 0);
+    std::vector<std::size_t> stack;
+    for (std::size_t r = 0; r < grown.seeds.size(); ++r) {
+        const auto s = static_cast<std::size_t>(grown.seeds[r]);
+        for (auto i = g.node_vertex_offsets[s]; i < g.node_vertex_offsets[s + 1]; ++i) {
+            const auto v = static_cast<std::size_t>(g.node_vertices[static_cast<std::size_t>(i)]);
+            if (left(v) || grown.labels[v] != r + 1 || kept[v]) continue;
+            kept[v] = 1;
+            stack.push_back(v);
+        }
+        while (!stack.empty()) {
+            const std::size_t v = stack.back();
+            stack.pop_back();
+            for (const auto w : mesh.neighbors_of(v)) {
+                const auto u = static_cast<std::size_t>(w);
+                if (left(u) || grown.labels[u] != r + 1 || kept[u]) continue;
+                kept[u] = 1;
+                stack.push_back(u);
+            }
+        }
+    }
+    std::size_t detached = 0;
+    for (std::size_t v = 0; v < n; ++v) detached += !left(v) && !kept[v];
+    auto divided = grown;
+    const auto counts = segment::divide_absorbed(mesh, g, field, simplified.absorbed, divided);
+    REQUIRE(detached > 0);  // the tile has such parts
+    CHECK(counts.detached == detached);
+    // A kept vertex stays in its region.
+    for (std::size_t v = 0; v < n; ++v)
+        if (kept[v] && divided.labels[v] != grown.labels[v]) FAIL("kept vertex " << v << " moved");
+}
