@@ -4,14 +4,12 @@
 // make_global_dem.py) or a synthetic Vesta tile of the size given; the stages before it run
 // once, each step of the growing three times (best wall time, and its CPU time).
 //   build/tests/bench/bench_grow [DEM | size]
-#include <time.h>
 
-#include <chrono>
 #include <cstdio>
 #include <cstdlib>
-#include <fstream>
 #include <string>
 
+#include "bench_measure.hpp"
 #include "terrain/field/shape_index.hpp"
 #include "terrain/geo/georeference.hpp"
 #include "terrain/io/read_dem.hpp"
@@ -25,41 +23,7 @@
 
 using namespace terrain;
 
-namespace {
-
-double thread_cpu_seconds() {
-    timespec ts{};
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-    return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
-
-// The process's peak resident set (VmHWM), bytes.
-double peak_resident_bytes() {
-    std::ifstream status("/proc/self/status");
-    std::string line;
-    while (std::getline(status, line))
-        if (line.rfind("VmHWM:", 0) == 0) return std::stod(line.substr(6)) * 1024.0;
-    return 0;
-}
-
-template <class F>
-double best_of(int runs, F&& f, double* cpu) {
-    double best = 1e300;
-    for (int i = 0; i < runs; ++i) {
-        const auto t0 = std::chrono::steady_clock::now();
-        const double c0 = thread_cpu_seconds();
-        f();
-        const double wall =
-            std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        if (wall < best) {
-            best = wall;
-            *cpu = thread_cpu_seconds() - c0;
-        }
-    }
-    return best;
-}
-
-}  // namespace
+using bench::best_of;
 
 int main(int argc, char** argv) {
     const std::string arg = argc > 1 ? argv[1] : "1000";
@@ -112,6 +76,6 @@ int main(int argc, char** argv) {
         "region graph     %7.3f s (CPU %7.3f)  %6.2f M vertices/s  %zu regions, %zu edges\n", t,
         cpu, nv / t / 1e6, regions.regions.size(), regions.edges.size());
     // The whole benchmark's peak: the mesh, the field, the graphs and the growing's arrays.
-    std::printf("peak resident set %.0f bytes/vertex\n", peak_resident_bytes() / nv);
+    std::printf("peak resident set %.0f bytes/vertex\n", bench::status_kb("VmHWM") * 1024.0 / nv);
     return 0;
 }

@@ -13,6 +13,7 @@
 #include <string>
 
 #include "bench_dem.hpp"
+#include "bench_measure.hpp"
 #include "terrain/field/vertex_field.hpp"
 #include "terrain/io/write_adjacency.hpp"
 #include "terrain/io/write_label_raster.hpp"
@@ -32,30 +33,15 @@ double seconds(const std::function<void()>& f) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-// kB of the process's resident set ("VmRSS") or of its peak ("VmHWM").
-double status_kb(const char* key) {
-    std::ifstream in("/proc/self/status");
-    std::string k;
-    double value = 0;
-    while (in >> k) {
-        if (k == std::string(key) + ":") {
-            in >> value;
-            return value;
-        }
-        std::getline(in, k);
-    }
-    return 0;
-}
-
 // Seconds of f, and the bytes its peak resident set rose above the set before it (the peak
 // is reset first, through /proc/self/clear_refs, and the heap's free pages given back, so
 // that what f allocates shows).
 std::array<double, 2> seconds_and_peak(const std::function<void()>& f) {
     malloc_trim(0);
     std::ofstream("/proc/self/clear_refs") << "5";
-    const double before = status_kb("VmRSS");
+    const double before = bench::status_kb("VmRSS");
     const double s = seconds(f);
-    return {s, (status_kb("VmHWM") - before) * 1024.0};
+    return {s, (bench::status_kb("VmHWM") - before) * 1024.0};
 }
 
 // A small deterministic hash in [0,1).

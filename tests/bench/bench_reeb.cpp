@@ -4,13 +4,12 @@
 //   build/tests/bench/bench_reeb [size]
 #include <tbb/global_control.h>
 #include <tbb/info.h>
-#include <time.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 
+#include "bench_measure.hpp"
 #include "terrain/field/shape_index.hpp"
 #include "terrain/geo/georeference.hpp"
 #include "terrain/mesh/dem_to_mesh.hpp"
@@ -20,34 +19,7 @@
 
 using namespace terrain;
 
-namespace {
-
-double thread_cpu_seconds() {
-    timespec ts{};
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-    return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
-
-// Best wall time of a few runs, and the CPU time of that run (on a busy machine the CPU time
-// is the better measure of a single-threaded step).
-template <class F>
-double best_of(int runs, F&& f, double* cpu) {
-    double best = 1e300;
-    for (int i = 0; i < runs; ++i) {
-        const auto t0 = std::chrono::steady_clock::now();
-        const double c0 = thread_cpu_seconds();
-        f();
-        const double wall =
-            std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        if (wall < best) {
-            best = wall;
-            *cpu = thread_cpu_seconds() - c0;
-        }
-    }
-    return best;
-}
-
-}  // namespace
+using bench::best_of;
 
 int main(int argc, char** argv) {
     synth::VestaTileOptions options;
