@@ -1,10 +1,9 @@
 #pragma once
-// Private: asks early for the memory a walk will read at a vertex's neighbours, for the
-// walks that go from vertex to vertex in an order scattered over the surface (a flooding by
-// cost, a breadth-first search from many fronts): each step would otherwise wait on a cache
-// miss for the vertex and then on more for the rows above and below it. Called for the
-// vertex a step or more ahead; only a hint (an index out of range is not fetched). Not
-// installed.
+// Private: asks early for the memory a walk will read at a vertex's neighbours, for a walk
+// that goes from vertex to vertex in an order scattered over the surface (the flooding by
+// cost of segment::divide_absorbed): each step would otherwise wait on a cache miss for the
+// vertex and then on more for the rows above and below it. Called for the vertex a step
+// ahead; only a hint (an index out of range is not fetched). Not installed.
 
 #include <cstddef>
 #include <vector>

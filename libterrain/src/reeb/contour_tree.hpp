@@ -9,12 +9,12 @@ namespace terrain::reeb::internal {
 
 // True when the Reeb graph of any field on the mesh is a tree: every connected component is
 // of genus 0 with at most one boundary loop (a disk or a sphere). Assumes a 2-manifold.
-// Reports its passes (triangles, vertices, triangles) through `progress`, 0 to 1.
-// A DEM mesh in which every pixel has its vertex is one component, read from its counts;
-// other meshes go through loop_free_by_components.
+// A DEM mesh in which every pixel has its vertex is one component, read from its counts
+// (one report, at the end); other meshes go through loop_free_by_components.
 bool loop_free(const TriangleMesh& mesh, const ProgressFn& progress = {});
 // The same from the components a union-find over the triangles finds, each one's Euler
-// characteristic counted over its vertices and triangles.
+// characteristic counted over its vertices and triangles. Reports its passes (triangles,
+// vertices, triangles) through `progress`, 0 to 1.
 bool loop_free_by_components(const TriangleMesh& mesh, const ProgressFn& progress = {});
 
 // The Reeb graph of the field whose events order_events put in g, when the mesh has no loops
