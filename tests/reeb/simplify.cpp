@@ -427,6 +427,30 @@ TEST_CASE("A moving degenerate extremum costs what changes, not its degree", "[s
     CHECK(big.result.field == scanned.result.field);
 }
 
+namespace {
+
+// The Vesta tile's graph with the paper's thresholds, and a check that a result given the
+// graph handed over is the one it gives lent.
+reeb::SimplifyOptions paper_thresholds() {
+    reeb::SimplifyOptions o;
+    o.persistence = 10;
+    o.area_ratio = 0.5;
+    return o;
+}
+void check_same_result(const reeb::SimplifyResult& given, const reeb::SimplifyResult& lent) {
+    CHECK(given.field == lent.field);
+    CHECK(given.absorbed == lent.absorbed);
+    CHECK(given.graph.node_values == lent.graph.node_values);
+    CHECK(given.graph.node_kinds == lent.graph.node_kinds);
+    CHECK(given.graph.node_vertex_offsets == lent.graph.node_vertex_offsets);
+    CHECK(given.graph.node_vertices == lent.graph.node_vertices);
+    CHECK(given.graph.vertex_nodes == lent.graph.vertex_nodes);
+    CHECK(given.graph.arcs == lent.graph.arcs);
+    CHECK(given.graph.arc_nodes == lent.graph.arc_nodes);
+}
+
+}  // namespace
+
 TEST_CASE("A graph handed over gives the result of the same graph lent, plateaus and all",
           "[simplify]") {
     // Handed over, a graph with ascending vertex lists (build_reeb_graph's) gives them up once
@@ -453,40 +477,11 @@ TEST_CASE("A graph handed over gives the result of the same graph lent, plateaus
                          g.node_vertices.begin() + g.node_vertex_offsets[plateau + 1]);
         const auto lent = reeb::simplify(s.mesh, g, o);
         const auto given = reeb::simplify(s.mesh, std::move(g), o);
-        CHECK(given.field == lent.field);
-        CHECK(given.absorbed == lent.absorbed);
-        CHECK(given.graph.node_values == lent.graph.node_values);
-        CHECK(given.graph.node_kinds == lent.graph.node_kinds);
-        CHECK(given.graph.node_vertex_offsets == lent.graph.node_vertex_offsets);
-        CHECK(given.graph.node_vertices == lent.graph.node_vertices);
-        CHECK(given.graph.vertex_nodes == lent.graph.vertex_nodes);
-        CHECK(given.graph.arcs == lent.graph.arcs);
-        CHECK(given.graph.arc_nodes == lent.graph.arc_nodes);
+        check_same_result(given, lent);
         CHECK(g.node_vertices.capacity() == 0);
         CHECK(g.vertex_nodes.capacity() == 0);
     }
 }
-
-namespace {
-
-// The Vesta tile's graph with the paper's thresholds, and a check that a result given the
-// graph handed over is the one it gives lent.
-reeb::SimplifyOptions paper_thresholds() {
-    reeb::SimplifyOptions o;
-    o.persistence = 10;
-    o.area_ratio = 0.5;
-    return o;
-}
-void check_same_result(const reeb::SimplifyResult& given, const reeb::SimplifyResult& lent) {
-    CHECK(given.field == lent.field);
-    CHECK(given.absorbed == lent.absorbed);
-    CHECK(given.graph.node_values == lent.graph.node_values);
-    CHECK(given.graph.vertex_nodes == lent.graph.vertex_nodes);
-    CHECK(given.graph.node_vertices == lent.graph.node_vertices);
-    CHECK(given.graph.arcs == lent.graph.arcs);
-}
-
-}  // namespace
 
 TEST_CASE("A graph handed over lets its caller set the mesh's areas aside once they are read",
           "[simplify]") {
