@@ -484,3 +484,37 @@ TEST_CASE("The loop check reads a whole grid from its counts, as the count by co
         if (released.release_triangles()) CHECK(reeb::internal::loop_free(released) == c.tree);
     }
 }
+
+TEST_CASE("The Reeb graph is the same at one and two threads, its triangles held or released",
+          "[reeb]") {
+    // The events are sorted, the links counted (a released grid's triangles in bands of rows)
+    // and the vertices read in parallel: the graph must not depend on the threads, nor on
+    // whether the triangles are read from memory (one pass in order) or made again by rows.
+    const auto globe_dem = io::read_dem(test::sample("moon_ldem1_global.tif"));
+    const auto sphere = mesh::dem_to_mesh(globe_dem);
+    TriangleMesh released = sphere;
+    REQUIRE(released.release_triangles());
+    const std::vector<std::vector<float>> fields = {
+        field::shape_index_field(sphere),                         // no plateau
+        quantized(test::noise_field(sphere.vertex_count(), 13)),  // plateaus everywhere
+    };
+    for (const auto& f : fields) {
+        const auto held = reeb::build_reeb_graph(sphere, f);
+        REQUIRE(reeb::check_reeb_graph(held, f).empty());
+        for (const int threads : {1, 2}) {
+            CAPTURE(threads);
+            reeb::ReebGraph g;
+            tbb::task_arena(threads).execute([&] { g = reeb::build_reeb_graph(released, f); });
+            CHECK(g.node_values == held.node_values);
+            CHECK(g.node_vertex_offsets == held.node_vertex_offsets);
+            CHECK(g.node_vertices == held.node_vertices);
+            CHECK(g.vertex_nodes == held.vertex_nodes);
+            CHECK(g.node_kinds == held.node_kinds);
+            CHECK(g.node_lower_links == held.node_lower_links);
+            CHECK(g.node_upper_links == held.node_upper_links);
+            CHECK(g.arcs == held.arcs);
+            CHECK(g.arc_offsets == held.arc_offsets);
+            CHECK(g.arc_nodes == held.arc_nodes);
+        }
+    }
+}

@@ -76,6 +76,33 @@ void block_row_triangles(const std::int32_t* top, const std::int32_t* bottom, in
     }
 }
 
+// The split of the blocks of row `row` as recorded in TriangleMesh::block_diagonals.
+inline auto recorded_split(const TriangleMesh& mesh, int row) {
+    const std::uint64_t* bits = mesh.block_diagonals.data() +
+                                static_cast<std::size_t>(row) * diagonal_words(mesh.grid_width);
+    return [bits](int col, std::int32_t, std::int32_t, std::int32_t, std::int32_t) {
+        return ((bits[static_cast<unsigned>(col) / 64] >> (static_cast<unsigned>(col) % 64)) & 1) !=
+               0;
+    };
+}
+
+// Whether the triangles of each row of blocks can be made alone, in any order
+// (for_each_row_triangle): a DEM mesh whose triangles were released and that has no split
+// pinch (whose triangles are patched in by their index in the whole order).
+inline bool rows_of_triangles(const TriangleMesh& mesh) {
+    return mesh.triangles_released() && mesh.pinch_triangles.empty();
+}
+
+// f(triangle) for each triangle of row `row` of blocks (between pixel rows row and row + 1),
+// in order; only where rows_of_triangles(mesh).
+template <class F>
+void for_each_row_triangle(const TriangleMesh& mesh, int row, F&& f) {
+    const std::size_t W = static_cast<std::size_t>(mesh.grid_width);
+    const std::int32_t* top = mesh.pixel_vertex.data() + static_cast<std::size_t>(row) * W;
+    block_row_triangles(top, top + W, mesh.grid_width, mesh.seam_closed, mesh.triangles_flipped,
+                        recorded_split(mesh, row), f);
+}
+
 // f(index, triangle) for each triangle of `mesh` in order: its stored triangles, or for a
 // DEM mesh whose triangles were released, the same made again from the grid (with the
 // diagonals recorded when it was made: no position is read).
@@ -88,17 +115,10 @@ void for_each_triangle(const TriangleMesh& mesh, F&& f) {
     const std::size_t W = static_cast<std::size_t>(mesh.grid_width);
     const auto& patches = mesh.pinch_triangles;
     std::size_t index = 0, patch = 0;
-    const std::size_t words = diagonal_words(mesh.grid_width);
     for (int row = 0; row + 1 < mesh.grid_height; ++row) {
         const std::int32_t* top = mesh.pixel_vertex.data() + static_cast<std::size_t>(row) * W;
-        const std::uint64_t* bits =
-            mesh.block_diagonals.data() + static_cast<std::size_t>(row) * words;
-        const auto split = [bits](int col, std::int32_t, std::int32_t, std::int32_t, std::int32_t) {
-            return ((bits[static_cast<unsigned>(col) / 64] >> (static_cast<unsigned>(col) % 64)) &
-                    1) != 0;
-        };
         block_row_triangles(top, top + W, mesh.grid_width, mesh.seam_closed, mesh.triangles_flipped,
-                            split, [&](const Triangle& t) {
+                            recorded_split(mesh, row), [&](const Triangle& t) {
                                 if (patch < patches.size() && patches[patch].first == index)
                                     f(index, patches[patch++].second);
                                 else

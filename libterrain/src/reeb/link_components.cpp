@@ -8,6 +8,8 @@
 
 #include "link_components.hpp"
 
+#include <tbb/blocked_range.h>
+
 #include <algorithm>
 
 #include "../core/pass_progress.hpp"
@@ -17,6 +19,10 @@ namespace terrain::reeb::internal {
 
 using detail::idx;
 using detail::kNone;
+
+namespace {
+constexpr int kBandRows = 8;  // rows of blocks in a band of the parallel triangle pass
+}  // namespace
 
 std::pair<int, int> LinkCounter::count(const TriangleMesh& mesh, const ReebGraph& g, i32 e,
                                        const std::vector<i32>& star) {
@@ -64,9 +70,8 @@ std::vector<LinkReps> link_components(const TriangleMesh& mesh, const ReebGraph&
                                       std::vector<LinkCounts>& vertex_links,
                                       std::vector<char>& general, const ProgressFn& progress) {
     const std::size_t nv = mesh.vertex_count(), nn = g.node_count();
-    // Its passes: the triangles (0 to 0.6), the vertices (to 1).
-    const detail::PassProgress by_triangle(progress, 0.2, 0.6, "reeb: links"),
-        by_vertex(progress, 0.65, 1, "reeb: links");
+    // Its passes: the triangles (0.2 to 0.6), the vertices (0.65 to 1).
+    const detail::PassProgress by_triangle(progress, 0.2, 0.6, "reeb: links");
     const std::size_t nt = mesh.triangle_count();
     const auto& node = g.vertex_nodes;
     // starts[0..1]: lower runs' first vertices, starts[2..3]: upper runs'; runs[0], runs[1]:
@@ -80,9 +85,7 @@ std::vector<LinkReps> link_components(const TriangleMesh& mesh, const ReebGraph&
     std::vector<Star> stars;
     detail::assign_in_slices(stars, nv, Star{{kNone, kNone, kNone, kNone}, 0, 0, 0, {0, 0}},
                              detail::PassProgress(progress, 0, 0.2, "reeb: links"));
-    // (Through for_each_triangle: a DEM mesh may have released its triangles.)
-    detail::for_each_triangle(mesh, [&](std::size_t ti, const std::array<i32, 3>& t) {
-        by_triangle.at(ti, nt);
+    const auto add = [&](const std::array<i32, 3>& t) {
         const std::array<i32, 3> n{node[idx(t[0])], node[idx(t[1])], node[idx(t[2])]};
         for (const i32 c : t) ++stars[idx(c)].triangles;
         if (n[0] != n[1] && n[1] != n[2] && n[0] != n[2]) {
@@ -108,16 +111,41 @@ std::vector<LinkReps> link_components(const TriangleMesh& mesh, const ReebGraph&
             stars[idx(t[idx(k)])].lower_edges += (m > p) & (m > q);
             stars[idx(t[idx(k)])].upper_edges += (m < p) & (m < q);
         }
-    });
+    };
+    // What a star gathers does not depend on the order of its triangles (counts, and the two
+    // runs' first vertices, read in increasing order). A grid made again from its rows of
+    // blocks is gone through in bands of rows in parallel: a vertex's triangles lie in the
+    // two rows of blocks around its row of pixels, so bands whose rows are at least two apart
+    // touch no common star. First each band's rows but its last, then the last rows.
+    if (detail::rows_of_triangles(mesh) && mesh.grid_height > 2 * kBandRows) {
+        const int rows = mesh.grid_height - 1, bands = (rows + kBandRows - 1) / kBandRows;
+        for (const bool last : {false, true})
+            detail::parallel_slices(bands, 1, progress, last ? 0.55 : 0.2, last ? 0.6 : 0.55,
+                                    "reeb: links", [&](const tbb::blocked_range<int>& r) {
+                                        for (int band = r.begin(); band < r.end(); ++band) {
+                                            const int end = std::min(rows, (band + 1) * kBandRows);
+                                            for (int row = last ? end - 1 : band * kBandRows;
+                                                 row < end - !last; ++row)
+                                                detail::for_each_row_triangle(mesh, row, add);
+                                        }
+                                    });
+    } else {
+        // (Through for_each_triangle: a DEM mesh may have released its triangles.)
+        detail::for_each_triangle(mesh, [&](std::size_t ti, const std::array<i32, 3>& t) {
+            by_triangle.at(ti, nt);
+            add(t);
+        });
+    }
     std::vector<LinkReps> reps;
     detail::assign_in_slices(reps, nn, LinkReps{},
                              detail::PassProgress(progress, 0.6, 0.65, "reeb: links"));
     general.assign(nn, 0);
     vertex_links.resize(nv);
+    // The vertices in parallel: each writes its own entries and its node's, and a node of
+    // several vertices (a plateau) is written from its first vertex only.
     constexpr std::size_t kAhead = 16;  // the nodes' entries are written in random order
-    for (std::size_t v = 0; v < nv; ++v) {
-        by_vertex.at(v, nv);
-        if (v + kAhead < nv) __builtin_prefetch(&reps[idx(node[v + kAhead])], 1);
+    const auto vertex = [&](std::size_t v, std::size_t end) {
+        if (v + kAhead < end) __builtin_prefetch(&reps[idx(node[v + kAhead])], 1);
         const i32 n = node[v];
         const auto neighbours = mesh.neighbors_of(v);
         const auto degree = static_cast<i32>(neighbours.size());
@@ -131,9 +159,10 @@ std::vector<LinkReps> link_components(const TriangleMesh& mesh, const ReebGraph&
             some_above = m < n ? some_above : m;
         }
         if (degree > 250 || same > 0) {
+            if (same > 0 && g.node_vertices[idx(g.node_vertex_offsets[idx(n)])] != i32(v)) return;
             general[idx(n)] = 1;
             reps[idx(n)] = {{kSeveral, kNone}, {kSeveral, kNone}};
-            continue;
+            return;
         }
         const int above = degree - below;
         const Star& s = stars[v];
@@ -141,14 +170,20 @@ std::vector<LinkReps> link_components(const TriangleMesh& mesh, const ReebGraph&
         const int lower = (above == 0 && interior && below > 0) ? 1 : below - s.lower_edges;
         const int upper = (below == 0 && interior && above > 0) ? 1 : above - s.upper_edges;
         vertex_links[v] = {static_cast<std::uint8_t>(lower), static_cast<std::uint8_t>(upper)};
-        auto side = [&](int count, i32 some, int runs, const std::array<i32, 2>& starts) {
+        auto side = [&](int count, i32 some, int runs, i32 first, i32 second) {
             if (count <= 1) return std::array<i32, 2>{count == 0 ? kNone : some, kNone};
-            if (count == 2 && runs == 2) return starts;
+            if (count == 2 && runs == 2)
+                return std::array<i32, 2>{std::min(first, second), std::max(first, second)};
             return std::array<i32, 2>{kSeveral, kNone};
         };
-        reps[idx(n)] = {side(lower, some_below, s.runs[0], {s.starts[0], s.starts[1]}),
-                        side(upper, some_above, s.runs[1], {s.starts[2], s.starts[3]})};
-    }
+        reps[idx(n)] = {side(lower, some_below, s.runs[0], s.starts[0], s.starts[1]),
+                        side(upper, some_above, s.runs[1], s.starts[2], s.starts[3])};
+    };
+    detail::parallel_slices(nv, std::size_t{1} << 14, progress, 0.65, 1.0, "reeb: links",
+                            [&](const tbb::blocked_range<std::size_t>& r) {
+                                for (std::size_t v = r.begin(); v < r.end(); ++v)
+                                    vertex(v, r.end());
+                            });
     return reps;
 }
 
