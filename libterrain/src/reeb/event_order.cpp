@@ -6,6 +6,9 @@
 
 #include "event_order.hpp"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <bit>
 #include <cstdint>
@@ -22,6 +25,9 @@ namespace {
 
 using detail::i32;
 using detail::idx;
+
+// The parallel passes' fixed chunks of the vertices.
+constexpr std::size_t kChunks = 64;
 
 // Sort key of a float: monotonic unsigned bits (-0 taken as +0).
 inline std::uint32_t float_key(float f) {
@@ -40,46 +46,66 @@ inline float key_float(std::uint32_t k) {
 void order_events(const TriangleMesh& mesh, const std::vector<float>& field, ReebGraph& g,
                   const ProgressFn& progress) {
     const std::size_t nv = field.size();
-    // Its passes: the keys (0 to 0.1), their counts (to 0.2), three radix passes (to 0.65),
-    // the plateaus (to 0.8), the nodes (to 1).
+    // Its passes: the keys (0 to 0.1), three radix passes (to 0.65), the plateaus (to 0.8),
+    // the nodes (to 1).
     using detail::PassProgress;
-    const PassProgress keyed(progress, 0.1, 0.15, "reeb: order"),
-        counted(progress, 0.15, 0.2, "reeb: order"), plateau(progress, 0.65, 0.8, "reeb: order"),
+    const PassProgress plateau(progress, 0.65, 0.8, "reeb: order"),
         noded(progress, 0.9, 1, "reeb: order");
     // Stable LSD radix sort of (value bits << 32 | vertex) on the value bits, 11 bits per
-    // pass: ties keep vertex order.
+    // pass: ties keep vertex order. Each pass in parallel over fixed chunks of the array: a
+    // chunk's items of a digit go after those of the chunks before it, so the result is the
+    // one sort's, whatever the threads.
     // (Large blocks made a slice at a time: their first touch is slow, docs/performance.md.)
     std::vector<std::uint64_t> keys, tmp;
     detail::assign_in_slices(keys, nv, std::uint64_t{0},
                              PassProgress(progress, 0, 0.05, "reeb: order"));
     detail::assign_in_slices(tmp, nv, std::uint64_t{0},
                              PassProgress(progress, 0.05, 0.1, "reeb: order"));
-    for (std::size_t v = 0; v < nv; ++v) {
-        keyed.at(v, nv);
-        keys[v] = (std::uint64_t{float_key(field[v])} << 32) | v;
-    }
+    const auto chunk_begin = [nv](std::size_t c) { return nv * c / kChunks; };
+    const auto each_chunk = [&](auto&& f) {
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, kChunks, 1),
+                          [&](const tbb::blocked_range<std::size_t>& r) {
+                              for (std::size_t c = r.begin(); c < r.end(); ++c)
+                                  f(c, chunk_begin(c), chunk_begin(c + 1));
+                          });
+    };
+    each_chunk([&](std::size_t, std::size_t first, std::size_t end) {
+        for (std::size_t v = first; v < end; ++v)
+            keys[v] = (std::uint64_t{float_key(field[v])} << 32) | v;
+    });
+    report_progress(progress, 0.15, "reeb: order");
     constexpr int kBits = 11;
     constexpr std::size_t kBuckets = std::size_t{1} << kBits;
-    std::vector<std::uint32_t> count(3 * kBuckets, 0u);
-    for (std::size_t i = 0; i < nv; ++i) {
-        counted.at(i, nv);
-        const std::uint64_t k = keys[i];
-        for (int p = 0; p < 3; ++p)
-            ++count[idx(p) * kBuckets + ((k >> (32 + kBits * p)) & (kBuckets - 1))];
-    }
+    std::vector<std::uint32_t> count(kChunks * kBuckets);
     for (int p = 0; p < 3; ++p) {
-        std::uint32_t* c = count.data() + idx(p) * kBuckets;
         const int shift = 32 + kBits * p;
-        if (nv == 0 || c[(keys[0] >> shift) & (kBuckets - 1)] == nv) continue;  // one bucket
+        const auto digit = [shift](std::uint64_t k) { return (k >> shift) & (kBuckets - 1); };
+        each_chunk([&](std::size_t c, std::size_t first, std::size_t end) {
+            std::uint32_t* mine = count.data() + c * kBuckets;
+            std::fill(mine, mine + kBuckets, 0u);
+            for (std::size_t i = first; i < end; ++i) ++mine[digit(keys[i])];
+        });
+        const double at = 0.2 + 0.15 * p;
+        report_progress(progress, at, "reeb: order");
+        // Each chunk's first place for each digit; none to move when one digit holds all.
         std::uint32_t sum = 0;
-        for (std::size_t b = 0; b < kBuckets; ++b) sum += std::exchange(c[b], sum);
-        const PassProgress moved(progress, 0.2 + 0.15 * p, 0.35 + 0.15 * p, "reeb: order");
-        for (std::size_t i = 0; i < nv; ++i) {
-            moved.at(i, nv);
-            const std::uint64_t k = keys[i];
-            tmp[c[(k >> shift) & (kBuckets - 1)]++] = k;
+        bool one_digit = false;
+        for (std::size_t b = 0; b < kBuckets; ++b) {
+            const std::uint32_t before = sum;
+            for (std::size_t c = 0; c < kChunks; ++c)
+                sum += std::exchange(count[c * kBuckets + b], sum);
+            one_digit |= sum - before == nv;
         }
+        if (nv == 0 || one_digit) continue;
+        each_chunk([&](std::size_t c, std::size_t first, std::size_t end) {
+            std::uint32_t* place = count.data() + c * kBuckets;
+            for (std::size_t i = first; i < end; ++i) {
+                const std::uint64_t k = keys[i];
+                tmp[place[digit(k)]++] = k;
+            }
+        });
         keys.swap(tmp);
+        report_progress(progress, at + 0.15, "reeb: order");
     }
     detail::release(tmp);
     auto same_value = [](std::uint64_t a, std::uint64_t b) { return (a >> 32) == (b >> 32); };
@@ -138,9 +164,30 @@ void order_events(const TriangleMesh& mesh, const std::vector<float>& field, Ree
         n_nodes = 0;
         for (std::size_t i = 0; i < nv; ++i) n_nodes += i == 0 || !same_event(keys[i], keys[i - 1]);
     }
+    constexpr std::size_t kAhead = 16;  // vertex_nodes is written in random order
+    if (!any_plateau) {
+        // Each vertex its own event: the nodes in parallel.
+        detail::assign_in_slices(g.node_vertex_offsets, nv + 1, i32{0},
+                                 PassProgress(progress, 0.9, 0.9, "reeb: order"));
+        detail::assign_in_slices(g.node_values, nv, 0.0f,
+                                 PassProgress(progress, 0.9, 0.9, "reeb: order"));
+        each_chunk([&](std::size_t, std::size_t first, std::size_t end) {
+            for (std::size_t i = first; i < end; ++i) {
+                if (i + kAhead < end)
+                    __builtin_prefetch(&g.vertex_nodes[idx(vertex(keys[i + kAhead]))], 1);
+                const i32 v = vertex(keys[i]);
+                g.node_vertex_offsets[i] = static_cast<i32>(i);
+                g.node_values[i] = key_float(static_cast<std::uint32_t>(keys[i] >> 32));
+                g.node_vertices[i] = v;
+                g.vertex_nodes[idx(v)] = static_cast<i32>(i);
+            }
+        });
+        g.node_vertex_offsets[nv] = static_cast<i32>(nv);
+        report_progress(progress, 1.0, "reeb: order");
+        return;
+    }
     g.node_vertex_offsets.reserve(n_nodes + 1);
     g.node_values.reserve(n_nodes);
-    constexpr std::size_t kAhead = 16;  // vertex_nodes is written in random order
     for (std::size_t i = 0; i < nv; ++i) {
         noded.at(i, nv);
         if (i + kAhead < nv) __builtin_prefetch(&g.vertex_nodes[idx(vertex(keys[i + kAhead]))], 1);
