@@ -7,6 +7,9 @@
 #include <random>
 #include <set>
 #include <string_view>
+#include <utility>
+
+#include <tbb/task_arena.h>
 
 #include "../../libterrain/src/reeb/simplifier.hpp"
 
@@ -559,4 +562,28 @@ TEST_CASE("A graph handed over lets its caller park the vertices' nodes until th
     CHECK_THROWS_WITH(
         reeb::simplify(s.mesh, reeb::build_reeb_graph(s.mesh, s.si), o, {}, {}, parking),
         Catch::Contains("wrong size"));
+}
+
+TEST_CASE("The simplification's output is the same at one and two threads", "[simplify]") {
+    // The output writes the vertices' nodes, flags and values in parallel over the old nodes
+    // while their lists are grouped beside: every array must be the same whatever the threads,
+    // with plateaus (nodes of many vertices) or without.
+    const auto& s = vesta();
+    std::vector<float> quantized(s.si.size());
+    for (std::size_t v = 0; v < quantized.size(); ++v)
+        quantized[v] = std::round(s.si[v] / 8.0f) * 8.0f + float((v * 2654435761u) % 3);
+    const auto o = paper_thresholds();
+    for (const std::vector<float>* f : {&s.si, &std::as_const(quantized)}) {
+        const auto g = reeb::build_reeb_graph(s.mesh, *f);
+        reeb::SimplifyResult one, two;
+        tbb::task_arena(1).execute([&] { one = reeb::simplify(s.mesh, g, o); });
+        tbb::task_arena(2).execute([&] { two = reeb::simplify(s.mesh, g, o); });
+        REQUIRE(one.graph.node_count() < g.node_count());
+        check_same_result(two, one);
+        // Handed over (its lists made again from its vertices' nodes), the same again.
+        auto given = g;
+        reeb::SimplifyResult handed;
+        tbb::task_arena(2).execute([&] { handed = reeb::simplify(s.mesh, std::move(given), o); });
+        check_same_result(handed, one);
+    }
 }

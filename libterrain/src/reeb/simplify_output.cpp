@@ -4,6 +4,9 @@
 // forward links and the union-find sets of absorbed lists), each vertex takes its node's
 // value, and the arcs that remain are listed with their regular nodes from the lower end up.
 
+#include <tbb/blocked_range.h>
+#include <tbb/task_group.h>
+
 #include <algorithm>
 #include <array>
 #include <numeric>
@@ -21,10 +24,10 @@ using detail::find_root;
 void WorkingGraph::write_result(SimplifyResult& result, const ProgressFn& progress) {
     const std::size_t nn = input_nodes_, nl = regular_.size();
     // Its passes: the fates (0 to 0.2), the new numbers (to 0.3), the arcs (to 0.4), the
-    // input's vertex lists made again (to 0.5), the vertices (to 0.8), the field (to 1).
+    // input's vertex lists made again (to 0.5), the vertices and their values (to 1).
     using detail::PassProgress;
     const PassProgress fates(progress, 0, 0.2, "simplify"), numbers(progress, 0.2, 0.3, "simplify"),
-        arcs(progress, 0.3, 0.4, "simplify"), vertices(progress, 0.5, 0.8, "simplify");
+        arcs(progress, 0.3, 0.4, "simplify");
     // code[i]: for an absorbed node, the critical node that finally took it (nodes are
     // only absorbed into critical nodes); for a remaining node, -2 - its new id.
     // A listed node's forward: the fate of its set's root (kNone for a list still there).
@@ -149,37 +152,47 @@ void WorkingGraph::write_result(SimplifyResult& result, const ProgressFn& progre
         detail::release(owned_->vertex_nodes);
     }
     report_progress(progress, 0.5, "simplify");
-    // Vertices: grouped by new node, in the order of their old nodes.
+    // Vertices: grouped by new node, in the order of their old nodes (one pass in order), and
+    // each vertex's new node, whether it was absorbed and its value (in parallel over the old
+    // nodes, each vertex in one: its own entries), both at once.
     for (std::size_t i = 1; i < size.size(); ++i) size[i] += size[i - 1];
     out.node_vertex_offsets = size;
     detail::assign_in_slices(out.node_vertices, g_.node_vertices.size(), i32{0}, made(0.5));
     detail::assign_in_slices(out.vertex_nodes, nv, i32{0}, made(0.5));
     detail::assign_in_slices(result.absorbed, nv, std::uint8_t{0}, made(0.5));
-    for (std::size_t n = 0; n < nn; ++n) {
-        vertices.at(n, nn);
-        if (n + kAhead < nn) {
-            const i32 i = g_.node_vertex_offsets[n + kAhead];
-            if (i < g_.node_vertex_offsets[n + kAhead + 1])
-                __builtin_prefetch(&out.vertex_nodes[idx(g_.node_vertices[idx(i)])], 1);
+    detail::assign_in_slices(result.field, nv, 0.0f, made(0.5));
+    tbb::task_group grouped;
+    grouped.run([&] {
+        for (std::size_t n = 0; n < nn; ++n) {
+            const i32 nid = node_map_[n];
+            for (i32 i = g_.node_vertex_offsets[n]; i < g_.node_vertex_offsets[n + 1]; ++i)
+                out.node_vertices[idx(size[idx(nid)]++)] = g_.node_vertices[idx(i)];
         }
-        const i32 nid = node_map_[n];
-        for (i32 i = g_.node_vertex_offsets[n]; i < g_.node_vertex_offsets[n + 1]; ++i) {
-            const i32 v = g_.node_vertices[idx(i)];
-            out.node_vertices[idx(size[idx(nid)]++)] = v;
-            out.vertex_nodes[idx(v)] = nid;
-            result.absorbed[idx(v)] = gone[n];
-        }
-    }
+    });
+    detail::parallel_slices(
+        nn, std::size_t{1} << 12, progress, 0.5, 1.0, "simplify",
+        [&](const tbb::blocked_range<std::size_t>& r) {
+            for (std::size_t n = r.begin(); n < r.end(); ++n) {
+                if (n + kAhead < r.end()) {
+                    const i32 i = g_.node_vertex_offsets[n + kAhead];
+                    if (i < g_.node_vertex_offsets[n + kAhead + 1])
+                        __builtin_prefetch(&out.vertex_nodes[idx(g_.node_vertices[idx(i)])], 1);
+                }
+                const i32 nid = node_map_[n];
+                const float value = out.node_values[idx(nid)];
+                for (i32 i = g_.node_vertex_offsets[n]; i < g_.node_vertex_offsets[n + 1]; ++i) {
+                    const i32 v = g_.node_vertices[idx(i)];
+                    out.vertex_nodes[idx(v)] = nid;
+                    result.absorbed[idx(v)] = gone[n];
+                    result.field[idx(v)] = value;
+                }
+            }
+        });
+    grouped.wait();
     detail::release(size);
     detail::release(gone);
     detail::release(node_map_);
     if (owned_) *owned_ = ReebGraph{};
-    detail::assign_in_slices(result.field, nv, 0.0f, made(0.8));
-    const PassProgress field(progress, 0.9, 1, "simplify");
-    for (std::size_t v = 0; v < result.field.size(); ++v) {
-        field.at(v, nv);
-        result.field[v] = out.node_values[idx(out.vertex_nodes[v])];
-    }
 }
 
 }  // namespace terrain::reeb::internal
