@@ -5,11 +5,14 @@
 // (TriangleMesh::release_triangles), in the same order and with the same corners. Not
 // installed.
 
+#include <algorithm>
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <string_view>
 #include <vector>
 
+#include "../core/pass_progress.hpp"
 #include "terrain/mesh/triangle_mesh.hpp"
 
 namespace terrain::detail {
@@ -126,6 +129,40 @@ void for_each_triangle(const TriangleMesh& mesh, F&& f) {
                                 ++index;
                             });
     }
+}
+
+// add(triangle) for each triangle of `mesh`, where what add gathers at a triangle's corners does
+// not depend on the order of the triangles. A DEM mesh whose rows of blocks can be made alone
+// (rows_of_triangles) goes in bands of rows in parallel: a vertex's triangles lie in the two
+// rows of blocks around its row of pixels, so bands whose rows are at least two apart touch
+// no common vertex. First each band's rows but its last, then the last rows; add is called
+// from several threads at once, never for two triangles with a common corner. Other meshes go
+// in order (for_each_triangle). Progress from `begin` to `end` under `message`.
+template <class Add>
+void for_each_triangle_by_bands(const TriangleMesh& mesh, const ProgressFn& progress, double begin,
+                                double end, std::string_view message, Add&& add) {
+    constexpr int kBandRows = 8;
+    if (!rows_of_triangles(mesh) || mesh.grid_height <= 2 * kBandRows) {
+        const PassProgress pass(progress, begin, end, message);
+        const std::size_t n = mesh.triangle_count();
+        for_each_triangle(mesh, [&](std::size_t i, const Triangle& t) {
+            pass.at(i, n);
+            add(t);
+        });
+        return;
+    }
+    const int rows = mesh.grid_height - 1, bands = (rows + kBandRows - 1) / kBandRows;
+    const double middle = begin + (end - begin) * (kBandRows - 1) / kBandRows;
+    for (const bool last : {false, true})
+        parallel_slices(bands, 1, progress, last ? middle : begin, last ? end : middle, message,
+                        [&](const tbb::blocked_range<int>& r) {
+                            for (int band = r.begin(); band < r.end(); ++band) {
+                                const int stop = std::min(rows, (band + 1) * kBandRows);
+                                for (int row = last ? stop - 1 : band * kBandRows;
+                                     row < stop - !last; ++row)
+                                    for_each_row_triangle(mesh, row, add);
+                            }
+                        });
 }
 
 }  // namespace terrain::detail

@@ -20,10 +20,6 @@ namespace terrain::reeb::internal {
 using detail::idx;
 using detail::kNone;
 
-namespace {
-constexpr int kBandRows = 8;  // rows of blocks in a band of the parallel triangle pass
-}  // namespace
-
 std::pair<int, int> LinkCounter::count(const TriangleMesh& mesh, const ReebGraph& g, i32 e,
                                        const std::vector<i32>& star) {
     return count_star(
@@ -71,8 +67,6 @@ std::vector<LinkReps> link_components(const TriangleMesh& mesh, const ReebGraph&
                                       std::vector<char>& general, const ProgressFn& progress) {
     const std::size_t nv = mesh.vertex_count(), nn = g.node_count();
     // Its passes: the triangles (0.2 to 0.6), the vertices (0.65 to 1).
-    const detail::PassProgress by_triangle(progress, 0.2, 0.6, "reeb: links");
-    const std::size_t nt = mesh.triangle_count();
     const auto& node = g.vertex_nodes;
     // starts[0..1]: lower runs' first vertices, starts[2..3]: upper runs'; runs[0], runs[1]:
     // how many lower and upper runs were seen.
@@ -113,29 +107,9 @@ std::vector<LinkReps> link_components(const TriangleMesh& mesh, const ReebGraph&
         }
     };
     // What a star gathers does not depend on the order of its triangles (counts, and the two
-    // runs' first vertices, read in increasing order). A grid made again from its rows of
-    // blocks is gone through in bands of rows in parallel: a vertex's triangles lie in the
-    // two rows of blocks around its row of pixels, so bands whose rows are at least two apart
-    // touch no common star. First each band's rows but its last, then the last rows.
-    if (detail::rows_of_triangles(mesh) && mesh.grid_height > 2 * kBandRows) {
-        const int rows = mesh.grid_height - 1, bands = (rows + kBandRows - 1) / kBandRows;
-        for (const bool last : {false, true})
-            detail::parallel_slices(bands, 1, progress, last ? 0.55 : 0.2, last ? 0.6 : 0.55,
-                                    "reeb: links", [&](const tbb::blocked_range<int>& r) {
-                                        for (int band = r.begin(); band < r.end(); ++band) {
-                                            const int end = std::min(rows, (band + 1) * kBandRows);
-                                            for (int row = last ? end - 1 : band * kBandRows;
-                                                 row < end - !last; ++row)
-                                                detail::for_each_row_triangle(mesh, row, add);
-                                        }
-                                    });
-    } else {
-        // (Through for_each_triangle: a DEM mesh may have released its triangles.)
-        detail::for_each_triangle(mesh, [&](std::size_t ti, const std::array<i32, 3>& t) {
-            by_triangle.at(ti, nt);
-            add(t);
-        });
-    }
+    // runs' first vertices, read in increasing order): a released grid goes in bands of rows in
+    // parallel. (Through grid_triangles.hpp: a DEM mesh may have released its triangles.)
+    detail::for_each_triangle_by_bands(mesh, progress, 0.2, 0.6, "reeb: links", add);
     std::vector<LinkReps> reps;
     detail::assign_in_slices(reps, nn, LinkReps{},
                              detail::PassProgress(progress, 0.6, 0.65, "reeb: links"));
