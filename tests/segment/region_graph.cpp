@@ -1,5 +1,8 @@
 #include <catch2/catch.hpp>
 
+#include <tbb/task_arena.h>
+
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -268,4 +271,54 @@ TEST_CASE("label_pixels: NoData pixels are 0, every valid pixel has its vertex's
     std::size_t counted = 0;
     for (const auto& r : t.graph.regions) counted += r.pixel_count;
     CHECK(counted == 30u * 24u - 6u * 7u);
+}
+
+TEST_CASE("Representative vertices are the deepest of one BFS, whatever the threads", "[regions]") {
+    // The distances from the regions' edges go level by level in parallel, and a grid's
+    // boundary is counted in bands of rows: each region's vertex must be the one a plain BFS
+    // gives (the largest distance through the region from its cut edges and the mesh's
+    // boundary, ties to the lowest index), at one and two threads, triangles held or released.
+    const auto dem = io::read_dem(test::sample("vesta_hamo_tile.lbl"));
+    const auto t = test::segment_tile(dem, test::voronoi_cells(dem, 7, 5));
+    const auto& mesh = t.mesh;
+    const std::size_t n = mesh.vertex_count();
+    // The reference: triangle counts per vertex, then one BFS queue.
+    std::vector<int> triangles(n, 0);
+    for (const auto& tri : mesh.triangles)
+        for (const auto v : tri) ++triangles[std::size_t(v)];
+    std::vector<int> depth(n, -1);
+    std::vector<std::size_t> queue;
+    for (std::size_t v = 0; v < n; ++v) {
+        bool source = std::size_t(triangles[v]) != mesh.degree(v);
+        for (const auto w : mesh.neighbors_of(v)) source |= t.labels[std::size_t(w)] != t.labels[v];
+        if (source) {
+            depth[v] = 0;
+            queue.push_back(v);
+        }
+    }
+    for (std::size_t head = 0; head < queue.size(); ++head)
+        for (const auto nb : mesh.neighbors_of(queue[head])) {
+            const auto w = std::size_t(nb);
+            if (depth[w] >= 0 || t.labels[w] != t.labels[queue[head]]) continue;
+            depth[w] = depth[queue[head]] + 1;
+            queue.push_back(w);
+        }
+    std::vector<std::int32_t> expected(t.region_count, -1);
+    for (std::size_t v = 0; v < n; ++v) {
+        auto& b = expected[t.labels[v] - 1];
+        if (b < 0 || depth[v] > depth[std::size_t(b)]) b = std::int32_t(v);
+    }
+    REQUIRE(t.region_count == 35);
+    REQUIRE(*std::max_element(depth.begin(), depth.end()) > 10);
+    TriangleMesh released = mesh;
+    REQUIRE(released.release_triangles());
+    for (const TriangleMesh* m : {&mesh, static_cast<const TriangleMesh*>(&released)})
+        for (const int threads : {1, 2}) {
+            CAPTURE(threads, m == &released);
+            segment::RegionGraph g;
+            tbb::task_arena(threads).execute(
+                [&] { g = segment::region_graph(*m, t.field, t.labels, t.region_count, &t.dem); });
+            for (std::uint32_t r = 0; r < t.region_count; ++r)
+                CHECK(g.regions[r].representative_vertex == expected[r]);
+        }
 }

@@ -1,6 +1,9 @@
 #include "terrain/segment/regions.hpp"
 
+#include <tbb/blocked_range.h>
+
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -54,54 +57,100 @@ void check_inputs(const TriangleMesh& mesh, const std::vector<float>& field,
 }
 
 // Vertices on the mesh's boundary: in a 2-manifold, fewer incident triangles than neighbours.
-std::vector<std::uint8_t> mesh_boundary(const TriangleMesh& mesh) {
+// (The triangles counted in bands of rows in parallel on a grid, the vertices in ranges.)
+std::vector<std::uint8_t> mesh_boundary(const TriangleMesh& mesh, const ProgressFn& progress) {
     std::vector<std::int32_t> triangles(mesh.vertex_count(), 0);
-    detail::for_each_triangle(mesh, [&](std::size_t, const std::array<std::int32_t, 3>& t) {
-        for (auto v : t) ++triangles[static_cast<std::size_t>(v)];
-    });
+    detail::for_each_triangle_by_bands(mesh, progress, 0, 0.7, "regions",
+                                       [&](const std::array<std::int32_t, 3>& t) {
+                                           for (auto v : t)
+                                               ++triangles[static_cast<std::size_t>(v)];
+                                       });
     std::vector<std::uint8_t> out(mesh.vertex_count(), 0);
-    for (std::size_t v = 0; v < out.size(); ++v)
-        out[v] = static_cast<std::size_t>(triangles[v]) != mesh.degree(v);
+    detail::parallel_slices(out.size(), std::size_t{1} << 14, progress, 0.7, 1.0, "regions",
+                            [&](const tbb::blocked_range<std::size_t>& r) {
+                                for (std::size_t v = r.begin(); v < r.end(); ++v)
+                                    out[v] =
+                                        static_cast<std::size_t>(triangles[v]) != mesh.degree(v);
+                            });
     return out;
 }
 
 // For each region the vertex with the largest BFS distance (in mesh edges, through the
 // region) from the region's boundary: its cut edges and the mesh boundary. Ties: lowest index.
+// The distances level by level, each level's vertices in parallel: a vertex reached from
+// several takes the same distance (the first claim wins), so the distances, and the vertex
+// chosen, are those of one BFS whatever the threads.
 std::vector<std::int32_t> representative_vertices(const TriangleMesh& mesh,
                                                   const std::vector<std::uint32_t>& labels,
                                                   std::uint32_t region_count,
                                                   const ProgressFn& progress) {
     const std::size_t n = mesh.vertex_count();
-    // Its passes: the boundary (0 to 0.2), the sources (to 0.5), the distances (to 0.9), the
+    // Its passes: the boundary (0 to 0.2), the sources (to 0.3), the distances (to 0.9), the
     // deepest (to 1).
-    using detail::PassProgress;
-    const PassProgress sources(progress, 0.2, 0.5, "regions"),
-        distances(progress, 0.5, 0.9, "regions"), deepest(progress, 0.9, 1, "regions");
-    const auto on_boundary = mesh_boundary(mesh);
-    report_progress(progress, 0.2, "regions");
-    std::vector<std::int32_t> depth(n, -1), queue;
-    queue.reserve(n);
-    for (std::size_t v = 0; v < n; ++v) {
-        sources.at(v, n);
-        bool source = on_boundary[v];
-        const auto nb = mesh.neighbors_of(v);
-        for (auto w = nb.begin(); !source && w != nb.end(); ++w)
-            source = labels[static_cast<std::size_t>(*w)] != labels[v];
-        if (source) {
-            depth[v] = 0;
-            queue.push_back(static_cast<std::int32_t>(v));
-        }
+    const auto on_boundary = mesh_boundary(mesh, scaled_progress(progress, 0, 0.2));
+    std::vector<std::int32_t> depth(n, -1);
+    // Level 0: the sources; `level` holds a level's vertices, found chunk by chunk in order.
+    constexpr std::size_t kGrain = std::size_t{1} << 12;
+    std::vector<std::int32_t> level;
+    // visit(first, end, out) over [0, count) in chunks, their finds joined in order; with
+    // progress from `from` to `to` between slices (else one parallel loop: a level is short).
+    const auto gather = [&](std::size_t count, const auto& visit, const ProgressFn& sliced,
+                            double from, double to) {
+        std::vector<std::vector<std::int32_t>> parts((count + kGrain - 1) / kGrain);
+        detail::parallel_slices(parts.size(), std::size_t{1}, sliced, from, to, "regions",
+                                [&](const tbb::blocked_range<std::size_t>& r) {
+                                    for (std::size_t k = r.begin(); k < r.end(); ++k)
+                                        visit(k * kGrain, std::min(count, (k + 1) * kGrain),
+                                              parts[k]);
+                                });
+        std::size_t total = 0;
+        for (const auto& p : parts) total += p.size();
+        std::vector<std::int32_t> next;
+        next.reserve(total);
+        for (const auto& p : parts) next.insert(next.end(), p.begin(), p.end());
+        return next;
+    };
+    level = gather(
+        n,
+        [&](std::size_t first, std::size_t end, std::vector<std::int32_t>& out) {
+            for (std::size_t v = first; v < end; ++v) {
+                bool source = on_boundary[v];
+                const auto nb = mesh.neighbors_of(v);
+                for (auto w = nb.begin(); !source && w != nb.end(); ++w)
+                    source = labels[static_cast<std::size_t>(*w)] != labels[v];
+                if (source) {
+                    depth[v] = 0;
+                    out.push_back(static_cast<std::int32_t>(v));
+                }
+            }
+        },
+        progress, 0.2, 0.3);
+    std::size_t reached = level.size();
+    for (std::int32_t d = 1; !level.empty(); ++d) {
+        level = gather(
+            level.size(),
+            [&](std::size_t first, std::size_t end, std::vector<std::int32_t>& out) {
+                for (std::size_t i = first; i < end; ++i) {
+                    const auto v = static_cast<std::size_t>(level[i]);
+                    for (const auto nb : mesh.neighbors_of(v)) {
+                        const auto w = static_cast<std::size_t>(nb);
+                        if (labels[w] != labels[v]) continue;
+                        std::atomic_ref<std::int32_t> claim(depth[w]);
+                        std::int32_t unset = -1;
+                        if (claim.load(std::memory_order_relaxed) >= 0 ||
+                            !claim.compare_exchange_strong(unset, d, std::memory_order_relaxed))
+                            continue;
+                        out.push_back(static_cast<std::int32_t>(w));
+                    }
+                }
+            },
+            {}, 0, 0);
+        reached += level.size();
+        report_progress(progress, 0.3 + 0.6 * double(reached) / double(std::max<std::size_t>(n, 1)),
+                        "regions");
     }
-    for (std::size_t head = 0; head < queue.size(); ++head) {
-        distances.at(head, n);  // each vertex of a region's pixels once
-        const auto v = static_cast<std::size_t>(queue[head]);
-        for (const auto nb : mesh.neighbors_of(v)) {
-            const auto w = static_cast<std::size_t>(nb);
-            if (depth[w] >= 0 || labels[w] != labels[v]) continue;
-            depth[w] = depth[v] + 1;
-            queue.push_back(static_cast<std::int32_t>(w));
-        }
-    }
+    report_progress(progress, 0.9, "regions");
+    const detail::PassProgress deepest(progress, 0.9, 1, "regions");
     std::vector<std::int32_t> best(region_count, -1);
     for (std::size_t v = 0; v < n; ++v) {
         deepest.at(v, n);
