@@ -320,17 +320,23 @@ bool contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& prog
     const auto pass = [&](int k) {
         return detail::PassProgress(progress, 0.75 + 0.025 * k, 0.775 + 0.025 * k, "reeb: arcs");
     };
-    const auto p0 = pass(0), p1 = pass(1), p2 = pass(2), p3 = pass(3), p4 = pass(4), p5 = pass(5);
+    const auto p1 = pass(1), p3 = pass(3), p4 = pass(4), p5 = pass(5);
+    constexpr std::size_t kGrain = std::size_t{1} << 14;  // the passes in parallel
     auto edge = [&](std::size_t x) {
         const i32 y = attach[x] >> 1, self = static_cast<i32>(x);
         return (attach[x] & 1) ? std::pair{self, y} : std::pair{y, self};
     };
-    for (std::size_t x = 0; x < nn; ++x)
-        if (p0.at(x, nn); attach[x] != kNone) {
-            const auto [lo, hi] = edge(x);
-            ++up_off[idx(lo) + 1];
-            ++down_deg[idx(hi)];
-        }
+    // (The counts in parallel: increments, the same in any order.)
+    detail::parallel_slices(
+        nn, kGrain, progress, 0.75, 0.775, "reeb: arcs",
+        [&](const tbb::blocked_range<std::size_t>& r) {
+            for (std::size_t x = r.begin(); x < r.end(); ++x)
+                if (attach[x] != kNone) {
+                    const auto [lo, hi] = edge(x);
+                    std::atomic_ref(up_off[idx(lo) + 1]).fetch_add(1, std::memory_order_relaxed);
+                    std::atomic_ref(down_deg[idx(hi)]).fetch_add(1, std::memory_order_relaxed);
+                }
+        });
     std::partial_sum(up_off.begin(), up_off.end(), up_off.begin());
     {
         std::vector<i32> fill(up_off.begin(), up_off.end() - 1);
@@ -341,18 +347,23 @@ bool contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& prog
             }
     }
     g.node_kinds.assign(nn, NodeKind::regular);
-    for (std::size_t n = 0; n < nn; ++n) {
-        p2.at(n, nn);
-        const int d = down_deg[n], u = up_off[n + 1] - up_off[n];
-        if (d == 1 && u == 1) continue;  // Reeb-regular, whatever its link (links stay 1, 1)
-        g.node_kinds[n] = d == 0   ? NodeKind::minimum
-                          : u == 0 ? NodeKind::maximum
-                                   : NodeKind::saddle;
-        if (general[n]) continue;  // counted below
-        const auto links = vertex_links[idx(g.node_vertices[idx(g.node_vertex_offsets[n])])];
-        g.node_lower_links[n] = links[0];
-        g.node_upper_links[n] = links[1];
-    }
+    // (Each node its own entries: in parallel.)
+    detail::parallel_slices(
+        nn, kGrain, progress, 0.8, 0.825, "reeb: arcs",
+        [&](const tbb::blocked_range<std::size_t>& r) {
+            for (std::size_t n = r.begin(); n < r.end(); ++n) {
+                const int d = down_deg[n], u = up_off[n + 1] - up_off[n];
+                if (d == 1 && u == 1) continue;  // Reeb-regular, whatever its link (links 1, 1)
+                g.node_kinds[n] = d == 0   ? NodeKind::minimum
+                                  : u == 0 ? NodeKind::maximum
+                                           : NodeKind::saddle;
+                if (general[n]) continue;  // counted below
+                const auto links =
+                    vertex_links[idx(g.node_vertices[idx(g.node_vertex_offsets[n])])];
+                g.node_lower_links[n] = links[0];
+                g.node_upper_links[n] = links[1];
+            }
+        });
     detail::release(vertex_links);
     // Arcs in the order of their lower nodes, then of their up-edges. A regular node takes the
     // arc of the edge below it; `below` holds that edge as the regular node under it, or as
