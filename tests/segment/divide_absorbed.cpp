@@ -143,6 +143,11 @@ TEST_CASE("Dividing absorbed vertices on the Vesta tile: connected, deterministi
     CHECK(moved_kept == run.counts.relabelled);
     CHECK(run.counts.relabelled <= run.counts.absorbed + run.counts.detached);
     CHECK(segment_both(mesh, field).divided.labels == run.divided.labels);
+    // Its passes over the vertices run in parallel: one thread gives the same division.
+    const auto one = test::with_threads(1, [&] { return segment_both(mesh, field); });
+    CHECK(one.divided.labels == run.divided.labels);
+    CHECK(one.counts.relabelled == run.counts.relabelled);
+    CHECK(one.counts.detached == run.counts.detached);
 }
 
 TEST_CASE("Dividing with nothing absorbed changes nothing, mismatched sizes throw",

@@ -15,7 +15,10 @@
 
 #include "terrain/segment/divide_absorbed.hpp"
 
+#include <tbb/blocked_range.h>
+
 #include <algorithm>
+#include <atomic>
 #include <bit>
 #include <cmath>
 #include <limits>
@@ -147,12 +150,14 @@ DivideCounts divide_absorbed(const TriangleMesh& mesh, const reeb::ReebGraph& gr
     // 1. Absorbed vertices leave their regions: the sites' labels are the regions left.
     std::vector<Site> sites;
     detail::assign_in_slices(sites, n, Site{0.0f, 0.0f, 0}, pass(0));
-    const auto copied = pass(0.015);
-    for (std::size_t v = 0; v < n; ++v) {
-        copied.at(v, n);
-        sites[v].field = field[v];
-        sites[v].label = absorbed[v] ? 0 : labels[v];
-    }
+    constexpr std::size_t kGrain = std::size_t{1} << 14;  // (passes of each vertex its own)
+    detail::parallel_slices(n, kGrain, progress, 0.015, 0.03, "divide",
+                            [&](const tbb::blocked_range<std::size_t>& r) {
+                                for (std::size_t v = r.begin(); v < r.end(); ++v) {
+                                    sites[v].field = field[v];
+                                    sites[v].label = absorbed[v] ? 0 : labels[v];
+                                }
+                            });
     // 1b. With a finer scale's labels: absorbed vertices first go with their finer region.
     if (finer) {
         const auto here = finer_to_here(*finer, sites);
@@ -203,17 +208,22 @@ DivideCounts divide_absorbed(const TriangleMesh& mesh, const reeb::ReebGraph& gr
     // offer's region in the label), so that only better offers are queued (the same result as
     // queuing every one: costs grow along a path, so a vertex's first offer taken is its
     // cheapest).
-    std::size_t to_label = 0, labelled = 0;  // (the absorbed and detached, less those kept)
-    const auto unlabelled = pass(0.23);
-    for (std::size_t v = 0; v < n; ++v) {
-        unlabelled.at(v, n);
-        if (sites[v].label == 0) {
-            sites[v].cost = std::numeric_limits<float>::infinity();
-            ++to_label;
-        } else {
-            sites[v].label |= kFinal;
-        }
-    }
+    std::atomic<std::size_t> unlabelled{0};  // (the absorbed and detached, less those kept)
+    detail::parallel_slices(n, kGrain, progress, 0.23, 0.245, "divide",
+                            [&](const tbb::blocked_range<std::size_t>& r) {
+                                std::size_t here = 0;
+                                for (std::size_t v = r.begin(); v < r.end(); ++v) {
+                                    if (sites[v].label == 0) {
+                                        sites[v].cost = std::numeric_limits<float>::infinity();
+                                        ++here;
+                                    } else {
+                                        sites[v].label |= kFinal;
+                                    }
+                                }
+                                unlabelled += here;
+                            });
+    const std::size_t to_label = unlabelled.load();
+    std::size_t labelled = 0;
     // Each region's mean of the field over the vertices it kept (area-weighted), fixed for
     // the flooding.
     std::vector<double> sum(segmentation.seeds.size() + 1, 0.0),
