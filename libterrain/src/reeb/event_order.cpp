@@ -26,8 +26,8 @@ namespace {
 using detail::i32;
 using detail::idx;
 
-// The parallel passes' fixed chunks of the vertices.
-constexpr std::size_t kChunks = 64;
+// The parallel passes' fixed chunks of the vertices, run kGroup at a time.
+constexpr std::size_t kChunks = 64, kGroup = 8;
 
 // Sort key of a float: monotonic unsigned bits (-0 taken as +0).
 inline std::uint32_t float_key(float f) {
@@ -46,8 +46,8 @@ inline float key_float(std::uint32_t k) {
 void order_events(const TriangleMesh& mesh, const std::vector<float>& field, ReebGraph& g,
                   const ProgressFn& progress) {
     const std::size_t nv = field.size();
-    // Its passes: the keys (0 to 0.1), three radix passes (to 0.65), the plateaus (to 0.8),
-    // the nodes (to 1).
+    // Its passes: the keys (0 to 0.15), three radix passes (to 0.6), the ties (to 0.65), the
+    // plateaus (to 0.8), the nodes (to 1).
     using detail::PassProgress;
     const PassProgress plateau(progress, 0.65, 0.8, "reeb: order"),
         noded(progress, 0.9, 1, "reeb: order");
@@ -62,31 +62,35 @@ void order_events(const TriangleMesh& mesh, const std::vector<float>& field, Ree
     detail::assign_in_slices(tmp, nv, std::uint64_t{0},
                              PassProgress(progress, 0.05, 0.1, "reeb: order"));
     const auto chunk_begin = [nv](std::size_t c) { return nv * c / kChunks; };
-    const auto each_chunk = [&](auto&& f) {
-        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, kChunks, 1),
-                          [&](const tbb::blocked_range<std::size_t>& r) {
-                              for (std::size_t c = r.begin(); c < r.end(); ++c)
-                                  f(c, chunk_begin(c), chunk_begin(c + 1));
-                          });
+    // f(chunk, first, end) for every chunk, kGroup chunks at a time in parallel; the progress
+    // from `from` to `to` after each group (a pass over a global grid takes seconds).
+    const auto each_chunk = [&](double from, double to, auto&& f) {
+        for (std::size_t group = 0; group < kChunks; group += kGroup) {
+            tbb::parallel_for(tbb::blocked_range<std::size_t>(group, group + kGroup, 1),
+                              [&](const tbb::blocked_range<std::size_t>& r) {
+                                  for (std::size_t c = r.begin(); c < r.end(); ++c)
+                                      f(c, chunk_begin(c), chunk_begin(c + 1));
+                              });
+            report_progress(progress, from + (to - from) * double(group + kGroup) / kChunks,
+                            "reeb: order");
+        }
     };
-    each_chunk([&](std::size_t, std::size_t first, std::size_t end) {
+    each_chunk(0.1, 0.15, [&](std::size_t, std::size_t first, std::size_t end) {
         for (std::size_t v = first; v < end; ++v)
             keys[v] = (std::uint64_t{float_key(field[v])} << 32) | v;
     });
-    report_progress(progress, 0.15, "reeb: order");
     constexpr int kBits = 11;
     constexpr std::size_t kBuckets = std::size_t{1} << kBits;
     std::vector<std::uint32_t> count(kChunks * kBuckets);
     for (int p = 0; p < 3; ++p) {
         const int shift = 32 + kBits * p;
         const auto digit = [shift](std::uint64_t k) { return (k >> shift) & (kBuckets - 1); };
-        each_chunk([&](std::size_t c, std::size_t first, std::size_t end) {
+        const double at = 0.15 + 0.15 * p;
+        each_chunk(at, at + 0.05, [&](std::size_t c, std::size_t first, std::size_t end) {
             std::uint32_t* mine = count.data() + c * kBuckets;
             std::fill(mine, mine + kBuckets, 0u);
             for (std::size_t i = first; i < end; ++i) ++mine[digit(keys[i])];
         });
-        const double at = 0.2 + 0.15 * p;
-        report_progress(progress, at, "reeb: order");
         // Each chunk's first place for each digit; none to move when one digit holds all.
         std::uint32_t sum = 0;
         bool one_digit = false;
@@ -97,7 +101,7 @@ void order_events(const TriangleMesh& mesh, const std::vector<float>& field, Ree
             one_digit |= sum - before == nv;
         }
         if (nv == 0 || one_digit) continue;
-        each_chunk([&](std::size_t c, std::size_t first, std::size_t end) {
+        each_chunk(at + 0.05, at + 0.15, [&](std::size_t c, std::size_t first, std::size_t end) {
             std::uint32_t* place = count.data() + c * kBuckets;
             for (std::size_t i = first; i < end; ++i) {
                 const std::uint64_t k = keys[i];
@@ -105,7 +109,6 @@ void order_events(const TriangleMesh& mesh, const std::vector<float>& field, Ree
             }
         });
         keys.swap(tmp);
-        report_progress(progress, at + 0.15, "reeb: order");
     }
     detail::release(tmp);
     auto same_value = [](std::uint64_t a, std::uint64_t b) { return (a >> 32) == (b >> 32); };
@@ -113,8 +116,9 @@ void order_events(const TriangleMesh& mesh, const std::vector<float>& field, Ree
     // Plateaus: adjacent vertices of equal value. Only a vertex whose value another vertex
     // shares (next to it in the sorted order) can be in one; in a noisy field that is rare.
     std::vector<char> tied;
+    const PassProgress compared(progress, 0.6, 0.65, "reeb: order");
     for (std::size_t i = 1; i < nv; ++i)
-        if (same_value(keys[i], keys[i - 1])) {
+        if (compared.at(i, nv); same_value(keys[i], keys[i - 1])) {
             if (tied.empty()) tied.assign(nv, 0);
             tied[idx(vertex(keys[i]))] = tied[idx(vertex(keys[i - 1]))] = 1;
         }
@@ -171,7 +175,7 @@ void order_events(const TriangleMesh& mesh, const std::vector<float>& field, Ree
                                  PassProgress(progress, 0.9, 0.9, "reeb: order"));
         detail::assign_in_slices(g.node_values, nv, 0.0f,
                                  PassProgress(progress, 0.9, 0.9, "reeb: order"));
-        each_chunk([&](std::size_t, std::size_t first, std::size_t end) {
+        each_chunk(0.9, 1.0, [&](std::size_t, std::size_t first, std::size_t end) {
             for (std::size_t i = first; i < end; ++i) {
                 if (i + kAhead < end)
                     __builtin_prefetch(&g.vertex_nodes[idx(vertex(keys[i + kAhead]))], 1);
