@@ -8,6 +8,7 @@
 #include <cmath>
 #include <map>
 
+#include "../../libterrain/src/segment/divide_absorbed_internal.hpp"
 #include "support/test_meshes.hpp"
 #include "support/test_support.hpp"
 #include "terrain/core/error.hpp"
@@ -148,6 +149,46 @@ TEST_CASE("Dividing absorbed vertices on the Vesta tile: connected, deterministi
     CHECK(one.divided.labels == run.divided.labels);
     CHECK(one.counts.relabelled == run.counts.relabelled);
     CHECK(one.counts.detached == run.counts.detached);
+}
+
+TEST_CASE("Dividing absorbed vertices in batches of offers on the threads: the same division",
+          "[segment][divide]") {
+    // Offers taken one at a time in order (the plain flooding) against batches of them taken
+    // on every thread, even batches of one offer; on the Vesta tile (a grid) and on a sphere
+    // (a mesh whose vertex numbers are not rows: bumps with a little noise, and deep pits that
+    // set the range, so that its steps are mostly the constant per edge length). Batches
+    // bounded by five times the least step (a flooding that takes offers too early) give
+    // other labels on the tile.
+    const auto dem = io::read_dem(test::sample("vesta_hamo_tile.lbl"));
+    const auto tile = mesh::dem_to_mesh(dem);
+    const auto sphere = icosphere(40);
+    std::vector<float> bumps(sphere.vertex_count());
+    for (std::size_t v = 0; v < bumps.size(); ++v) {
+        const auto& p = sphere.positions[v];
+        const float noise = static_cast<float>((v * 2654435761u) % 1000) / 1000.0f;
+        bumps[v] = v % 997 == 0 ? -10000.0f
+                                : 30.0f * std::sin(4.0f * p[0]) * std::cos(4.0f * p[1]) + noise;
+    }
+    for (const auto* mesh : {&tile, &sphere}) {
+        const auto field = mesh == &tile ? field::shape_index_field(tile) : bumps;
+        reeb::SimplifyOptions o;
+        o.persistence = 10;
+        o.area_ratio = mesh == &tile ? 0.5 : 0.0;  // (the sphere's bumps and pits stay)
+        const auto simplified = reeb::simplify(*mesh, reeb::build_reeb_graph(*mesh, field), o);
+        const auto grown = segment::grow_regions(*mesh, simplified.graph);
+        const auto divide = [&](std::size_t batch) {
+            auto s = grown;
+            const auto counts = segment::internal::divide_absorbed(
+                *mesh, simplified.graph, field, simplified.absorbed, s, nullptr, {}, batch);
+            return std::make_pair(s.labels, counts.relabelled);
+        };
+        const auto in_order = test::with_threads(1, [&] { return divide(SIZE_MAX); });
+        REQUIRE(in_order.second > 0);
+        CHECK(test::with_threads(2, [&] { return divide(1); }) == in_order);
+        CHECK(test::with_threads(2, [&] { return divide(64); }) == in_order);
+        CHECK(test::with_threads(1, [&] { return divide(1); }) == in_order);
+        CHECK(divide(segment::internal::kParallelBatch) == in_order);
+    }
 }
 
 TEST_CASE("Dividing with nothing absorbed changes nothing, mismatched sizes throw",
