@@ -1,8 +1,10 @@
-// Benchmark: the growing stage of `terrain segment` (single-threaded, as it is): the regions
-// grown on the simplified Reeb graph, the absorbed vertices divided among them by the
-// flooding, and the region graph. On a DEM given (a global grid of tests/bench/
+// Benchmark: the growing stage of `terrain segment`: the regions grown on the simplified Reeb
+// graph, the absorbed vertices divided among them by the flooding (its batches on every
+// thread), and the region graph. On a DEM given (a global grid of tests/bench/
 // make_global_dem.py) or a synthetic Vesta tile of the size given; the stages before it run
-// once, each step of the growing three times (best wall time, and its CPU time).
+// once, each step of the growing three times (best wall time, and the calling thread's CPU
+// time). It holds every stage's arrays, unlike `terrain segment`, which frees and parks them:
+// about 140 bytes a vertex, so not the 265 M pixel grid on a 24 GiB machine (killed there).
 //   build/tests/bench/bench_grow [DEM | size]
 
 #include <cstdio>
