@@ -124,9 +124,9 @@ double edge_length(const TriangleMesh& mesh, std::size_t a, std::size_t b) {
                      double(p[2] - q[2]) * (p[2] - q[2]));
 }
 
-// The edges' mean length, and the least length of the edges at each block of kBlock vertices
-// (+infinity for a block without edges). The sum is taken in vertex order, on one thread: the
-// costs, hence the labels, depend on its last bits.
+// The edges' mean length, and the least length of the edges at each block of 2^kBlockShift
+// consecutive vertices (+infinity for a block without edges). The sum is taken in vertex order, on
+// one thread: the costs, hence the labels, depend on its last bits.
 constexpr std::size_t kBlockShift = 12;
 struct EdgeLengths {
     double mean = 1;
@@ -186,7 +186,7 @@ class Flooding {
     // Offers from w (in a region) to the vertices around it without one.
     template <bool kShared, class Emit>
     void offer_around(std::size_t w, Emit&& emit) const {
-        const Site at = sites_[w];
+        const Site at = load<kShared>(sites_[w]);
         const std::uint32_t region = region_of(at);
         const float from = cost_of(at), centre = mean_[region];
         for (const i32 nw : mesh_.neighbors_of(w)) {
