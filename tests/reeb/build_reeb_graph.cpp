@@ -8,6 +8,7 @@
 #include <set>
 #include <string_view>
 #include <thread>
+#include <tuple>
 
 #include <tbb/task_arena.h>
 
@@ -220,6 +221,64 @@ TEST_CASE("Plateaus are single nodes: a mesa's flat top is one maximum", "[reeb]
     CHECK(g.node_kinds[n] == NodeKind::maximum);
     CHECK(static_cast<std::size_t>(g.node_vertex_offsets[n + 1] - g.node_vertex_offsets[n]) == top);
     CHECK(reeb::summarize(g).maxima == 1);
+}
+
+TEST_CASE("Events: by value, then plateau (its lowest vertex), then vertex, in any chunking",
+          "[reeb]") {
+    // The events are ordered in parallel over 64 chunks of the sorted vertices: runs of equal
+    // values crossing the chunks (4 levels: runs of hundreds) and many short ones (values to
+    // a hundredth: runs of a few), on a grid DEM mesh.
+    const auto dem = test::grid_dem(61, 47, [](int c, int r) { return 0.1 * c + 0.07 * r; });
+    const auto mesh = mesh::dem_to_mesh(dem);
+    const auto noise = test::noise_field(mesh.vertex_count(), 7);
+    std::vector<float> fine(noise);
+    for (float& x : fine) x = std::round(x * 3) / 3;
+    for (const auto& f : {quantized(noise), fine}) {
+        const auto g = reeb::build_reeb_graph(mesh, f);
+        REQUIRE(reeb::check_reeb_graph(g, f).empty());
+        // The reference: plateaus as components of equal neighbours, their lowest vertex.
+        const std::size_t n = f.size();
+        std::vector<std::int32_t> low(n, -1);
+        for (std::size_t v = 0; v < n; ++v) {
+            if (low[v] >= 0) continue;
+            std::vector<std::size_t> stack{v};
+            low[v] = static_cast<std::int32_t>(v);
+            while (!stack.empty()) {
+                const auto u = stack.back();
+                stack.pop_back();
+                for (const auto w : mesh.neighbors_of(u))
+                    if (low[std::size_t(w)] < 0 && f[std::size_t(w)] == f[v]) {
+                        low[std::size_t(w)] = static_cast<std::int32_t>(v);
+                        stack.push_back(std::size_t(w));
+                    }
+            }
+        }
+        std::vector<std::int32_t> order(n);
+        std::iota(order.begin(), order.end(), 0);
+        std::sort(order.begin(), order.end(), [&](std::int32_t a, std::int32_t b) {
+            const auto key = [&](std::int32_t v) {
+                return std::make_tuple(f[std::size_t(v)], low[std::size_t(v)], v);
+            };
+            return key(a) < key(b);
+        });
+        std::size_t runs = 0;
+        for (std::size_t i = 1; i < n; ++i)
+            runs += f[std::size_t(order[i])] == f[std::size_t(order[i - 1])];
+        CHECK(runs > n / 2);
+        REQUIRE(g.node_vertices == order);
+        std::int32_t node = -1;
+        for (std::size_t i = 0; i < n; ++i) {
+            const auto v = std::size_t(order[i]);
+            if (i == 0 || low[v] != low[std::size_t(order[i - 1])]) {
+                ++node;
+                REQUIRE(g.node_vertex_offsets[std::size_t(node)] == std::int32_t(i));
+                CHECK(g.node_values[std::size_t(node)] == f[v]);
+            }
+            REQUIRE(g.vertex_nodes[v] == node);
+        }
+        CHECK(g.node_count() == std::size_t(node + 1));
+        CHECK(g.node_vertex_offsets.back() == std::int32_t(n));
+    }
 }
 
 TEST_CASE("The graph does not depend on the vertex order", "[reeb]") {

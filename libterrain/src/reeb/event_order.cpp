@@ -10,8 +10,10 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <atomic>
 #include <bit>
 #include <cstdint>
+#include <numeric>
 #include <utility>
 
 #include "../core/disjoint_sets.hpp"
@@ -47,10 +49,8 @@ void order_events(const TriangleMesh& mesh, const std::vector<float>& field, Ree
                   const ProgressFn& progress) {
     const std::size_t nv = field.size();
     // Its passes: the keys (0 to 0.15), three radix passes (to 0.6), the ties (to 0.65), the
-    // plateaus (to 0.8), the nodes (to 1).
+    // plateaus (to 0.75), the runs of equal values (to 0.8), the nodes (to 1).
     using detail::PassProgress;
-    const PassProgress plateau(progress, 0.65, 0.8, "reeb: order"),
-        noded(progress, 0.9, 1, "reeb: order");
     // Stable LSD radix sort of (value bits << 32 | vertex) on the value bits, 11 bits per
     // pass: ties keep vertex order. Each pass in parallel over fixed chunks of the array: a
     // chunk's items of a digit go after those of the chunks before it, so the result is the
@@ -114,96 +114,139 @@ void order_events(const TriangleMesh& mesh, const std::vector<float>& field, Ree
     auto same_value = [](std::uint64_t a, std::uint64_t b) { return (a >> 32) == (b >> 32); };
     auto vertex = [](std::uint64_t k) { return static_cast<i32>(k & 0xffffffffu); };
     // Plateaus: adjacent vertices of equal value. Only a vertex whose value another vertex
-    // shares (next to it in the sorted order) can be in one; in a noisy field that is rare.
-    std::vector<char> tied;
-    const PassProgress compared(progress, 0.6, 0.65, "reeb: order");
-    for (std::size_t i = 1; i < nv; ++i)
-        if (compared.at(i, nv); same_value(keys[i], keys[i - 1])) {
-            if (tied.empty()) tied.assign(nv, 0);
-            tied[idx(vertex(keys[i]))] = tied[idx(vertex(keys[i - 1]))] = 1;
-        }
-    // Each vertex's plateau; its representative (the root) is its lowest vertex.
-    detail::DisjointSets<i32> plateaus;
-    for (std::size_t v = 0; v < tied.size(); ++v) {
-        plateau.at(v, tied.size());
-        if (!tied[v]) continue;
-        for (const i32 w : mesh.neighbors_of(v)) {
-            if (idx(w) > v && field[idx(w)] == field[v]) {
-                if (plateaus.empty()) plateaus.reset(nv);
-                plateaus.unite_to_smaller(static_cast<i32>(v), w);
+    // shares (next to it in the sorted order) can be in one. On a noisy grid of quantized
+    // heights about half the vertices share their value (a few each): the passes run in
+    // parallel over the chunks, with the same sets as one pass in order.
+    std::atomic<bool> any_tie{false};
+    each_chunk(0.6, 0.62, [&](std::size_t, std::size_t first, std::size_t end) {
+        for (std::size_t i = std::max<std::size_t>(first, 1); i < end; ++i)
+            if (same_value(keys[i], keys[i - 1])) {
+                any_tie = true;
+                return;
             }
-        }
+    });
+    std::vector<char> tied;
+    if (any_tie) {
+        tied.assign(nv, 0);
+        each_chunk(0.62, 0.65, [&](std::size_t, std::size_t first, std::size_t end) {
+            for (std::size_t i = std::max<std::size_t>(first, 1); i < end; ++i)
+                if (same_value(keys[i], keys[i - 1]))  // (a vertex may be marked by two chunks)
+                    for (const std::size_t at : {i, i - 1})
+                        std::atomic_ref<char>(tied[idx(vertex(keys[at]))])
+                            .store(1, std::memory_order_relaxed);
+        });
+    }
+    // Each vertex's plateau; its representative (the root) is its lowest vertex. Each chunk of
+    // vertices joins the equal neighbours within it (its sets' links stay within it), and
+    // the pairs reaching a later chunk are joined after, in order: the same sets, the same
+    // roots (a set's lowest vertex).
+    detail::DisjointSets<i32> plateaus;
+    if (!tied.empty()) {
+        plateaus.reset(nv);
+        std::vector<std::vector<std::pair<i32, i32>>> crossing(kChunks);
+        std::atomic<bool> joined{false};
+        each_chunk(0.65, 0.74, [&](std::size_t c, std::size_t first, std::size_t end) {
+            bool any = false;
+            for (std::size_t v = first; v < end; ++v) {
+                if (!tied[v]) continue;
+                for (const i32 w : mesh.neighbors_of(v)) {
+                    if (idx(w) <= v || field[idx(w)] != field[v]) continue;
+                    any = true;
+                    if (idx(w) < end)
+                        plateaus.unite_to_smaller(static_cast<i32>(v), w);
+                    else
+                        crossing[c].emplace_back(static_cast<i32>(v), w);
+                }
+            }
+            if (any) joined = true;
+        });
+        for (const auto& pairs : crossing)
+            for (const auto& [v, w] : pairs) plateaus.unite_to_smaller(v, w);
+        if (!joined) plateaus = {};
     }
     detail::release(tied);
     const bool any_plateau = !plateaus.empty();
     if (any_plateau) {
         plateaus.flatten();
-        const auto rep = [&](std::uint64_t k) { return plateaus.parent(vertex(k)); };
-        // Equal values: plateaus together, ordered by their lowest vertex.
-        for (std::size_t i = 0; i < nv;) {
-            std::size_t j = i + 1;
-            while (j < nv && same_value(keys[i], keys[j])) ++j;
-            if (j - i > 1)
-                std::sort(keys.begin() + static_cast<std::ptrdiff_t>(i),
-                          keys.begin() + static_cast<std::ptrdiff_t>(j),
-                          [&](std::uint64_t a, std::uint64_t b) {
-                              const i32 ra = rep(a), rb = rep(b);
-                              return ra != rb ? ra < rb : vertex(a) < vertex(b);
-                          });
-            i = j;
-        }
+        // Equal values: plateaus together, ordered by their lowest vertex, then by vertex. A
+        // run of equal values is sorted as (plateau << 32 | vertex), so that the sort reads
+        // nothing else. Half the vertices of a noisy grid are in such runs (a few vertices
+        // each): each chunk sorts the runs that start in it, from its first run's start.
+        std::vector<std::size_t> run_start(kChunks + 1, nv);
+        // (A chunk with no run starting in it gets the next chunk's first start: nothing.)
+        each_chunk(0.75, 0.77, [&](std::size_t c, std::size_t first, std::size_t) {
+            std::size_t i = first;
+            while (i < nv && i > 0 && same_value(keys[i - 1], keys[i])) ++i;
+            run_start[c] = i;
+        });
+        each_chunk(0.77, 0.8, [&](std::size_t c, std::size_t, std::size_t) {
+            std::vector<std::uint64_t> run;
+            const std::size_t stop = run_start[c + 1];
+            for (std::size_t i = run_start[c]; i < stop;) {
+                std::size_t j = i + 1;
+                while (j < nv && same_value(keys[i], keys[j])) ++j;
+                if (j - i > 1) {
+                    run.clear();
+                    for (std::size_t k = i; k < j; ++k) {
+                        const i32 v = vertex(keys[k]);
+                        run.push_back(std::uint64_t(std::uint32_t(plateaus.parent(v))) << 32 |
+                                      std::uint32_t(v));
+                    }
+                    std::sort(run.begin(), run.end());
+                    const std::uint64_t value_bits = keys[i] & ~std::uint64_t{0xffffffffu};
+                    for (std::size_t k = i; k < j; ++k)
+                        keys[k] = value_bits | (run[k - i] & 0xffffffffu);
+                }
+                i = j;
+            }
+        });
     }
     auto same_event = [&](std::uint64_t a, std::uint64_t b) {
         return any_plateau && same_value(a, b) &&
                plateaus.parent(vertex(a)) == plateaus.parent(vertex(b));
     };
-    detail::assign_in_slices(g.node_vertices, nv, i32{0},
-                             PassProgress(progress, 0.8, 0.85, "reeb: order"));
-    detail::assign_in_slices(g.vertex_nodes, nv, i32{0},
-                             PassProgress(progress, 0.85, 0.9, "reeb: order"));
-    g.node_vertex_offsets.clear();
-    g.node_values.clear();
-    std::size_t n_nodes = nv;
+    // Sorted entry i starts a node unless it is in the same event as the one before it.
+    const auto starts = [&](std::size_t i) { return i == 0 || !same_event(keys[i], keys[i - 1]); };
+    // The nodes before each chunk's first entry (with plateaus, counted in parallel).
+    std::vector<std::size_t> nodes_before(kChunks + 1, 0);
+    for (std::size_t c = 0; c <= kChunks; ++c) nodes_before[c] = chunk_begin(c);
     if (any_plateau) {
-        n_nodes = 0;
-        for (std::size_t i = 0; i < nv; ++i) n_nodes += i == 0 || !same_event(keys[i], keys[i - 1]);
-    }
-    constexpr std::size_t kAhead = 16;  // vertex_nodes is written in random order
-    if (!any_plateau) {
-        // Each vertex its own event: the nodes in parallel.
-        detail::assign_in_slices(g.node_vertex_offsets, nv + 1, i32{0},
-                                 PassProgress(progress, 0.9, 0.9, "reeb: order"));
-        detail::assign_in_slices(g.node_values, nv, 0.0f,
-                                 PassProgress(progress, 0.9, 0.9, "reeb: order"));
-        each_chunk(0.9, 1.0, [&](std::size_t, std::size_t first, std::size_t end) {
-            for (std::size_t i = first; i < end; ++i) {
-                if (i + kAhead < end)
-                    __builtin_prefetch(&g.vertex_nodes[idx(vertex(keys[i + kAhead]))], 1);
-                const i32 v = vertex(keys[i]);
-                g.node_vertex_offsets[i] = static_cast<i32>(i);
-                g.node_values[i] = key_float(static_cast<std::uint32_t>(keys[i] >> 32));
-                g.node_vertices[i] = v;
-                g.vertex_nodes[idx(v)] = static_cast<i32>(i);
-            }
+        each_chunk(0.8, 0.82, [&](std::size_t c, std::size_t first, std::size_t end) {
+            std::size_t begun = 0;
+            for (std::size_t i = first; i < end; ++i) begun += starts(i);
+            nodes_before[c + 1] = begun;
         });
-        g.node_vertex_offsets[nv] = static_cast<i32>(nv);
-        report_progress(progress, 1.0, "reeb: order");
-        return;
+        nodes_before[0] = 0;
+        std::partial_sum(nodes_before.begin(), nodes_before.end(), nodes_before.begin());
     }
-    g.node_vertex_offsets.reserve(n_nodes + 1);
-    g.node_values.reserve(n_nodes);
-    for (std::size_t i = 0; i < nv; ++i) {
-        noded.at(i, nv);
-        if (i + kAhead < nv) __builtin_prefetch(&g.vertex_nodes[idx(vertex(keys[i + kAhead]))], 1);
-        const i32 v = vertex(keys[i]);
-        if (i == 0 || !same_event(keys[i], keys[i - 1])) {
-            g.node_vertex_offsets.push_back(static_cast<i32>(i));
-            g.node_values.push_back(key_float(static_cast<std::uint32_t>(keys[i] >> 32)));
+    const std::size_t n_nodes = nodes_before[kChunks];
+    detail::assign_in_slices(g.node_vertices, nv, i32{0},
+                             PassProgress(progress, 0.82, 0.85, "reeb: order"));
+    detail::assign_in_slices(g.vertex_nodes, nv, i32{0},
+                             PassProgress(progress, 0.85, 0.88, "reeb: order"));
+    detail::assign_in_slices(g.node_vertex_offsets, n_nodes + 1, i32{0},
+                             PassProgress(progress, 0.88, 0.89, "reeb: order"));
+    detail::assign_in_slices(g.node_values, n_nodes, 0.0f,
+                             PassProgress(progress, 0.89, 0.9, "reeb: order"));
+    // The nodes in parallel: each chunk numbers its events on from those before it.
+    constexpr std::size_t kAhead = 16;  // vertex_nodes is written in random order
+    each_chunk(0.9, 1.0, [&](std::size_t c, std::size_t first, std::size_t end) {
+        auto node = static_cast<i32>(nodes_before[c]) - 1;
+        for (std::size_t i = first; i < end; ++i) {
+            if (i + kAhead < end)
+                __builtin_prefetch(&g.vertex_nodes[idx(vertex(keys[i + kAhead]))], 1);
+            const i32 v = vertex(keys[i]);
+            if (!any_plateau || starts(i)) {
+                ++node;
+                g.node_vertex_offsets[idx(node)] = static_cast<i32>(i);
+                g.node_values[idx(node)] = key_float(static_cast<std::uint32_t>(keys[i] >> 32));
+            }
+            g.node_vertices[i] = v;
+            g.vertex_nodes[idx(v)] = node;
         }
-        g.node_vertices[i] = v;
-        g.vertex_nodes[idx(v)] = static_cast<i32>(g.node_vertex_offsets.size() - 1);
-    }
-    g.node_vertex_offsets.push_back(static_cast<i32>(nv));
+    });
+    g.node_vertex_offsets[n_nodes] = static_cast<i32>(nv);
+    report_progress(progress, 1.0, "reeb: order");
 }
 
 }  // namespace terrain::reeb::internal
