@@ -10,6 +10,7 @@
 #include <limits>
 #include <memory>
 #include <numbers>
+#include <numeric>
 
 #include "../core/pass_progress.hpp"
 #include "../core/release.hpp"
@@ -44,35 +45,56 @@ namespace {
 
 // Vertex numbering: valid pixels in row-major order; a collapsed pole row is one vertex.
 // Returns each pixel's vertex (-1 for NoData) and fills the mesh's vertex -> pixel map and
-// pole vertices.
+// pole vertices. Each row's vertices are counted, then numbered from the count before the
+// row, both on every thread: the numbers of one pass in order.
 std::vector<std::int32_t> number_vertices(const Dem& dem, std::array<bool, 2> pole,
                                           TriangleMesh& mesh, const ProgressFn& progress) {
     const int W = dem.width, H = dem.height;
-    std::vector<std::int32_t> vertex_of(dem.size(), -1);
-    std::int32_t count = 0;
-    const detail::PassProgress rows(progress, 0, 1, "mesh", 5);
-    for (int row = 0; row < H; ++row) {
-        rows.at(std::size_t(row), std::size_t(H));
-        const int which = row == 0 && pole[0] ? 0 : (row == H - 1 && pole[1] ? 1 : -1);
-        std::int32_t pole_id = -1;
-        for (int col = 0; col < W; ++col) {
-            if (!dem.valid(col, row)) continue;
-            const auto p = dem.index(col, row);
-            if (which >= 0) {
-                if (pole_id < 0) {
-                    pole_id = count++;
-                    mesh.vertex_pixel.push_back(std::int32_t(p));
-                    mesh.pole_rows[which] = row;
-                    mesh.pole_vertices[which] = pole_id;
-                }
-                vertex_of[p] = pole_id;
-            } else {
-                vertex_of[p] = count++;
-                mesh.vertex_pixel.push_back(std::int32_t(p));
+    const auto pole_of = [&](int row) {
+        return row == 0 && pole[0] ? 0 : (row == H - 1 && pole[1] ? 1 : -1);
+    };
+    std::vector<std::int64_t> first(std::size_t(H) + 1, 0);
+    detail::parallel_slices(
+        H, 8, progress, 0, 0.3, "mesh", [&](const tbb::blocked_range<int>& rows) {
+            for (int row = rows.begin(); row < rows.end(); ++row) {
+                std::int64_t valid = 0;
+                for (int col = 0; col < W; ++col) valid += dem.valid(col, row);
+                first[std::size_t(row) + 1] = pole_of(row) >= 0 ? std::int64_t(valid > 0) : valid;
             }
-        }
-    }
+        });
+    std::partial_sum(first.begin(), first.end(), first.begin());
+    const std::int64_t count = first.back();
     if (count < 3) throw Error("mesh", "'" + dem.source + "' has fewer than 3 valid pixels");
+    if (count > std::int64_t{INT32_MAX})
+        throw Error("mesh", "'" + dem.source + "' has more than 2^31 valid pixels: too large");
+    std::vector<std::int32_t> vertex_of(dem.size());
+    mesh.vertex_pixel.resize(std::size_t(count));
+    detail::parallel_slices(
+        H, 8, progress, 0.3, 1, "mesh", [&](const tbb::blocked_range<int>& rows) {
+            for (int row = rows.begin(); row < rows.end(); ++row) {
+                const auto own = static_cast<std::int32_t>(first[std::size_t(row)]);
+                const bool collapsed = pole_of(row) >= 0;
+                std::int32_t next = own;
+                for (int col = 0; col < W; ++col) {
+                    const auto p = dem.index(col, row);
+                    if (!dem.valid(col, row)) {
+                        vertex_of[p] = -1;
+                    } else if (collapsed) {
+                        if (next == own) mesh.vertex_pixel[std::size_t(next++)] = std::int32_t(p);
+                        vertex_of[p] = own;
+                    } else {
+                        vertex_of[p] = next;
+                        mesh.vertex_pixel[std::size_t(next++)] = std::int32_t(p);
+                    }
+                }
+            }
+        });
+    for (int row : {0, H - 1}) {
+        const int which = pole_of(row);
+        if (which < 0 || first[std::size_t(row) + 1] == first[std::size_t(row)]) continue;
+        mesh.pole_rows[std::size_t(which)] = row;
+        mesh.pole_vertices[std::size_t(which)] = static_cast<std::int32_t>(first[std::size_t(row)]);
+    }
     return vertex_of;
 }
 
@@ -230,16 +252,19 @@ void triangulate_blocks(const Dem& dem, const std::vector<std::int32_t>& vertex_
                                         split, [&](const Triangle& t) { out.push_back(t); });
         }
     });
-    std::size_t total = 0;
-    for (const auto& r : per_row) total += r.size();
-    mesh.triangles.reserve(total);
-    const detail::PassProgress joined(progress, 0.8, 1, "mesh", 5);
-    for (std::size_t row = 0; row < per_row.size(); ++row) {
-        joined.at(row, per_row.size());
-        auto& r = per_row[row];
-        mesh.triangles.insert(mesh.triangles.end(), r.begin(), r.end());
-        detail::release(r);
-    }
+    // Joined in order, each row copied to its place on every thread.
+    std::vector<std::size_t> at(per_row.size() + 1, 0);
+    for (std::size_t row = 0; row < per_row.size(); ++row)
+        at[row + 1] = at[row] + per_row[row].size();
+    mesh.triangles.resize(at.back());
+    detail::parallel_slices(per_row.size(), std::size_t{16}, progress, 0.8, 1, "mesh",
+                            [&](const tbb::blocked_range<std::size_t>& rows) {
+                                for (std::size_t row = rows.begin(); row < rows.end(); ++row) {
+                                    std::copy(per_row[row].begin(), per_row[row].end(),
+                                              mesh.triangles.begin() + std::ptrdiff_t(at[row]));
+                                    detail::release(per_row[row]);
+                                }
+                            });
     if (mesh.triangles.empty())
         throw Error("mesh",
                     "'" + dem.source + "' gives no triangle: no 2x2 block has three valid pixels");

@@ -119,23 +119,42 @@ double triangle_area(const TriangleMesh& m, const std::array<std::int32_t, 3>& t
 void set_positions(TriangleMesh& mesh, const std::vector<std::array<double, 3>>& points,
                    const ProgressFn& progress) {
     const std::size_t n = points.size();
-    const detail::PassProgress bounds(progress, 0, 0.3, "mesh"), made(progress, 0.3, 0.6, "mesh"),
-        converted(progress, 0.6, 1, "mesh");
+    // The bounds of slices on every thread, joined in order: each slice keeps the first of
+    // equal values (std::min and std::max keep their first argument), as one pass would.
+    constexpr std::size_t kSlices = 64;
+    struct Bounds {
+        std::array<double, 3> lo, hi;
+    };
+    std::vector<Bounds> slices(kSlices);
+    const auto slice_begin = [n](std::size_t s) { return n * s / kSlices; };
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, kSlices, 1), [&](const auto& r) {
+        for (std::size_t s = r.begin(); s < r.end(); ++s) {
+            Bounds& b = slices[s];
+            b.lo.fill(std::numeric_limits<double>::infinity());
+            b.hi.fill(-std::numeric_limits<double>::infinity());
+            for (std::size_t v = slice_begin(s); v < slice_begin(s + 1); ++v)
+                for (int k = 0; k < 3; ++k)
+                    b.lo[k] = std::min(b.lo[k], points[v][k]),
+                    b.hi[k] = std::max(b.hi[k], points[v][k]);
+        }
+    });
+    report_progress(progress, 0.3, "mesh");
     std::array<double, 3> lo, hi;
     lo.fill(std::numeric_limits<double>::infinity());
     hi.fill(-std::numeric_limits<double>::infinity());
-    for (std::size_t v = 0; v < n; ++v) {
-        bounds.at(v, n);
+    for (const auto& b : slices)
         for (int k = 0; k < 3; ++k)
-            lo[k] = std::min(lo[k], points[v][k]), hi[k] = std::max(hi[k], points[v][k]);
-    }
+            lo[k] = std::min(lo[k], b.lo[k]), hi[k] = std::max(hi[k], b.hi[k]);
     for (int k = 0; k < 3; ++k) mesh.origin[k] = points.empty() ? 0.0 : 0.5 * (lo[k] + hi[k]);
-    detail::assign_in_slices(mesh.positions, n, std::array<float, 3>{}, made);
-    for (std::size_t v = 0; v < n; ++v) {
-        converted.at(v, n);
-        for (int k = 0; k < 3; ++k)
-            mesh.positions[v][k] = static_cast<float>(points[v][k] - mesh.origin[k]);
-    }
+    detail::assign_in_slices(mesh.positions, n, std::array<float, 3>{},
+                             detail::PassProgress(progress, 0.3, 0.6, "mesh"));
+    detail::parallel_slices(n, std::size_t{4096}, progress, 0.6, 1, "mesh",
+                            [&](const tbb::blocked_range<std::size_t>& r) {
+                                for (std::size_t v = r.begin(); v < r.end(); ++v)
+                                    for (int k = 0; k < 3; ++k)
+                                        mesh.positions[v][k] =
+                                            static_cast<float>(points[v][k] - mesh.origin[k]);
+                            });
 }
 
 namespace {
@@ -282,8 +301,7 @@ void finish_grid_mesh(TriangleMesh& mesh, const ProgressFn& progress) {
     }
     // Its passes: areas (0 to 0.3), the directions (made, set: to 0.6), checked (to 0.8), the
     // irregular vertices' lists (0.9 to 1).
-    const detail::PassProgress directions(progress, 0.35, 0.6, "mesh"),
-        listed(progress, 0.9, 1, "mesh");
+    const detail::PassProgress listed(progress, 0.9, 1, "mesh");
     mesh.release_adjacency();
     set_vertex_areas(mesh, detail::PassProgress(progress, 0, 0.3, "mesh"));
     mesh.direction_offsets = {-W - 1, -W, -W + 1, -1, 1, W - 1, W, W + 1};
@@ -304,23 +322,29 @@ void finish_grid_mesh(TriangleMesh& mesh, const ProgressFn& progress) {
     irregular.assign(n, 0);
     for (const auto pole : mesh.pole_vertices)
         if (pole >= 0) irregular[std::size_t(pole)] = 1;
-    for (std::size_t i = 0; i < nt; ++i) {
-        directions.at(i, nt);
-        const auto& t = mesh.triangles[i];
-        for (int k = 0; k < 3; ++k) {
-            const auto a = static_cast<std::size_t>(t[k]);
-            const std::int64_t pa = mesh.vertex_pixel[a];
-            for (int j = 1; j < 3; ++j) {
-                const std::int32_t b = t[(k + j) % 3];
-                const std::int64_t pb = mesh.vertex_pixel[std::size_t(b)];
-                const int d = direction(pb - pa);
-                if (d < 0 || mesh.pixel_vertex[std::size_t(pb)] != b)
-                    irregular[a] = 1;
-                else
-                    bits[a] = static_cast<std::uint8_t>(bits[a] | (1u << d));
+    // (On every thread: a vertex's bits are an OR and its mark a flag, the same in any order.)
+    detail::parallel_slices(
+        nt, std::size_t{4096}, progress, 0.35, 0.6, "mesh",
+        [&](const tbb::blocked_range<std::size_t>& r) {
+            for (std::size_t i = r.begin(); i < r.end(); ++i) {
+                const auto& t = mesh.triangles[i];
+                for (int k = 0; k < 3; ++k) {
+                    const auto a = static_cast<std::size_t>(t[k]);
+                    const std::int64_t pa = mesh.vertex_pixel[a];
+                    for (int j = 1; j < 3; ++j) {
+                        const std::int32_t b = t[(k + j) % 3];
+                        const std::int64_t pb = mesh.vertex_pixel[std::size_t(b)];
+                        const int d = direction(pb - pa);
+                        if (d < 0 || mesh.pixel_vertex[std::size_t(pb)] != b)
+                            std::atomic_ref<std::uint8_t>(irregular[a])
+                                .store(1, std::memory_order_relaxed);
+                        else
+                            std::atomic_ref<std::uint8_t>(bits[a]).fetch_or(
+                                static_cast<std::uint8_t>(1u << d), std::memory_order_relaxed);
+                    }
+                }
             }
-        }
-    }
+        });
     // A vertex is regular when its neighbours, read off the grid in the directions' order,
     // come in increasing order (not so across the seam, or next to a pinch's copy).
     mesh.neighbor_directions = std::move(bits);
