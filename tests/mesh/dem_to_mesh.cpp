@@ -391,13 +391,17 @@ TEST_CASE("dem_to_mesh: the adjacency on the grid is the triangles' adjacency", 
 TEST_CASE("dem_to_mesh: the same mesh whatever the thread count", "[mesh]") {
     // A crop, a global grid (seam, collapsed poles) and a grid with NoData holes and pinches:
     // the numbering, the bounds, the joined rows and the directions run on the threads.
-    std::vector<Dem> dems{io::read_dem(test::sample("moon_ldem4_copernicus.tif")),
-                          io::read_dem(test::sample("moon_ldem1_global.tif")),
-                          grid_dem(97, 61, 1.0, [](int c, int r) {
-                              return (c * 7 + r * 13) % 11 == 0 || (c % 9 == 4 && r % 5 == 2)
-                                         ? kNaN
-                                         : std::sin(c * 0.3) * std::cos(r * 0.2) * 10;
-                          })};
+    std::vector<Dem> dems{
+        io::read_dem(test::sample("moon_ldem4_copernicus.tif")),
+        io::read_dem(test::sample("moon_ldem1_global.tif")),
+        grid_dem(97, 61, 1.0, [](int c, int r) {
+            // (pixels alone in rings of NoData: isolated)
+            const int dc = c % 20 - 10, dr = r % 15 - 7;
+            const bool ring = std::abs(dc) <= 1 && std::abs(dr) <= 1 && (dc != 0 || dr != 0);
+            return ring || (c * 7 + r * 13) % 11 == 0 || (c % 9 == 4 && r % 5 == 2)
+                       ? kNaN
+                       : std::sin(c * 0.3) * std::cos(r * 0.2) * 10;
+        })};
     for (const Dem& dem : dems) {
         TriangleMesh one, two;
         {
@@ -408,6 +412,12 @@ TEST_CASE("dem_to_mesh: the same mesh whatever the thread count", "[mesh]") {
             tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 2);
             two = mesh::dem_to_mesh(dem);
         }
+        if (&dem == &dems.back()) {  // the holes make pinches and isolated pixels
+            CHECK(two.pinched_vertices > 0);
+            CHECK(two.isolated_vertices > 0);
+        }
+        CHECK(one.pinched_vertices == two.pinched_vertices);
+        CHECK(one.isolated_vertices == two.isolated_vertices);
         CHECK(one.vertex_pixel == two.vertex_pixel);
         CHECK(one.pixel_vertex == two.pixel_vertex);
         CHECK(one.pole_vertices == two.pole_vertices);

@@ -6,6 +6,8 @@
 #include "terrain/core/error.hpp"
 
 #include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
 
 #include <algorithm>
 #include <array>
@@ -489,25 +491,50 @@ std::size_t split_pinched_vertices(TriangleMesh& mesh, std::int32_t* first_pinch
                                    const std::function<bool(std::size_t)>& may_pinch) {
     const std::size_t n = mesh.positions.size();
     // Its passes: the incident triangles (counted, made, listed: 0 to 0.5), the fans (to 1).
-    const detail::PassProgress counted(progress, 0, 0.15, "mesh"),
-        listed(progress, 0.3, 0.5, "mesh"), each_vertex(progress, 0.5, 1, "mesh");
+    const detail::PassProgress counted(progress, 0, 0.1, "mesh"),
+        each_vertex(progress, 0.5, 1, "mesh");
     check_adjacency_size(3 * std::uint64_t{mesh.triangles.size()}, "triangle corners");
     // The incident triangles of the vertices looked at (all, or those that may be pinched),
     // by their rank among them.
     std::vector<std::int32_t> rank_of;  // with may_pinch: each vertex's rank, -1 if not looked at
     std::size_t looked_at = n;
-    if (may_pinch) {
-        rank_of.assign(n, -1);
+    if (may_pinch) {  // (asked on every thread, ranked in order)
+        detail::assign_in_slices(rank_of, n, -1, counted);
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, std::size_t{1} << 14),
+                          [&](const tbb::blocked_range<std::size_t>& r) {
+                              for (std::size_t v = r.begin(); v < r.end(); ++v)
+                                  if (may_pinch(v)) rank_of[v] = 0;
+                          });
         looked_at = 0;
         for (std::size_t v = 0; v < n; ++v)
-            if (may_pinch(v)) rank_of[v] = std::int32_t(looked_at++);
+            if (rank_of[v] == 0) rank_of[v] = std::int32_t(looked_at++);
     }
     const auto rank = [&](std::int32_t v) { return may_pinch ? rank_of[std::size_t(v)] : v; };
+    // The corners at vertices looked at, (rank, triangle): with may_pinch (a few vertices of a
+    // large grid) gathered by slices of triangles on every thread, in triangle order within
+    // each, then counted and listed slice by slice; else (every vertex: a mesh file) counted
+    // and listed in two passes over the triangles.
+    const std::size_t nt = mesh.triangles.size();
+    constexpr std::size_t kSlices = 64;
+    std::vector<std::vector<std::pair<std::int32_t, std::int32_t>>> corners(kSlices);
+    if (may_pinch) {
+        const auto slice_begin = [nt](std::size_t sl) { return nt * sl / kSlices; };
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, kSlices, 1), [&](const auto& r) {
+            for (std::size_t sl = r.begin(); sl < r.end(); ++sl)
+                for (std::size_t t = slice_begin(sl); t < slice_begin(sl + 1); ++t)
+                    for (auto v : mesh.triangles[t])
+                        if (const std::int32_t k = rank(v); k >= 0)
+                            corners[sl].emplace_back(k, std::int32_t(t));
+        });
+    }
+    report_progress(progress, 0.15, "mesh");
     std::vector<std::uint32_t> offsets(looked_at + 1, 0);
-    for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
-        counted.at(t, mesh.triangles.size());
-        for (auto v : mesh.triangles[t])
-            if (const std::int32_t r = rank(v); r >= 0) ++offsets[std::size_t(r) + 1];
+    if (may_pinch) {
+        for (const auto& list : corners)
+            for (const auto& c : list) ++offsets[std::size_t(c.first) + 1];
+    } else {
+        for (std::size_t t = 0; t < nt; ++t)
+            for (auto v : mesh.triangles[t]) ++offsets[std::size_t(v) + 1];
     }
     for (std::size_t r = 0; r < looked_at; ++r) offsets[r + 1] += offsets[r];
     std::vector<std::int32_t> incident;
@@ -515,13 +542,17 @@ std::size_t split_pinched_vertices(TriangleMesh& mesh, std::int32_t* first_pinch
                              detail::PassProgress(progress, 0.15, 0.3, "mesh"));
     {
         std::vector<std::uint32_t> fill(offsets.begin(), offsets.end() - 1);
-        for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
-            listed.at(t, mesh.triangles.size());
-            for (auto v : mesh.triangles[t])
-                if (const std::int32_t r = rank(v); r >= 0)
-                    incident[fill[std::size_t(r)]++] = std::int32_t(t);
+        if (may_pinch) {
+            for (auto& list : corners) {
+                for (const auto& c : list) incident[fill[std::size_t(c.first)]++] = c.second;
+                detail::release(list);
+            }
+        } else {
+            for (std::size_t t = 0; t < nt; ++t)
+                for (auto v : mesh.triangles[t]) incident[fill[std::size_t(v)]++] = std::int32_t(t);
         }
     }
+    report_progress(progress, 0.5, "mesh");
     std::size_t split = 0;
     std::vector<std::pair<std::int32_t, std::int32_t>> others;  // (other vertex, local index)
     detail::DisjointSets<std::int32_t> fans_of;  // the triangles around v, by local index
@@ -589,13 +620,29 @@ std::size_t split_pinched_vertices(TriangleMesh& mesh, std::int32_t* first_pinch
 
 std::size_t remove_unreferenced_vertices(TriangleMesh& mesh, const ProgressFn& progress) {
     // Its passes: the corners (0 to 0.4), the vertices (to 0.6), the corners again (to 1).
-    const detail::PassProgress used(progress, 0, 0.4, "mesh"), kept(progress, 0.4, 0.6, "mesh"),
+    const detail::PassProgress kept(progress, 0.4, 0.6, "mesh"),
         renumbered(progress, 0.6, 1, "mesh");
     const std::size_t nt = mesh.triangles.size();
     std::vector<std::int32_t> remap(mesh.positions.size(), -1);
-    for (std::size_t i = 0; i < nt; ++i) {
-        used.at(i, nt);
-        for (auto v : mesh.triangles[i]) remap[v] = 0;
+    // The corners marked on every thread (each mark the same 0), then counted: a whole grid
+    // has no vertex to remove, and is left as it is.
+    detail::parallel_slices(nt, std::size_t{4096}, progress, 0, 0.4, "mesh",
+                            [&](const tbb::blocked_range<std::size_t>& r) {
+                                for (std::size_t i = r.begin(); i < r.end(); ++i)
+                                    for (auto v : mesh.triangles[i])
+                                        std::atomic_ref<std::int32_t>(remap[std::size_t(v)])
+                                            .store(0, std::memory_order_relaxed);
+                            });
+    const std::size_t unused = tbb::parallel_reduce(
+        tbb::blocked_range<std::size_t>(0, remap.size(), std::size_t{1} << 16), std::size_t{0},
+        [&](const tbb::blocked_range<std::size_t>& r, std::size_t sum) {
+            for (std::size_t v = r.begin(); v < r.end(); ++v) sum += remap[v] < 0;
+            return sum;
+        },
+        std::plus<>());
+    if (unused == 0) {
+        report_progress(progress, 1, "mesh");
+        return 0;
     }
     const bool pixels = !mesh.vertex_pixel.empty();
     std::int32_t next = 0;
