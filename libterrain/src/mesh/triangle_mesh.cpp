@@ -303,7 +303,6 @@ void finish_grid_mesh(TriangleMesh& mesh, const ProgressFn& progress) {
     }
     // Its passes: areas (0 to 0.3), the directions (made, set: to 0.6), checked (to 0.8), the
     // irregular vertices' lists (0.9 to 1).
-    const detail::PassProgress listed(progress, 0.9, 1, "mesh");
     mesh.release_adjacency();
     set_vertex_areas(mesh, detail::PassProgress(progress, 0, 0.3, "mesh"));
     mesh.direction_offsets = {-W - 1, -W, -W + 1, -1, 1, W - 1, W, W + 1};
@@ -377,28 +376,36 @@ void finish_grid_mesh(TriangleMesh& mesh, const ProgressFn& progress) {
             mesh.irregular_vertices.begin());
     };
     const std::size_t ni = mesh.irregular_vertices.size();
-    std::vector<std::uint32_t> offsets(ni + 1, 0);
-    std::vector<std::int32_t> lists;
-    for (int pass = 0; pass < 2; ++pass) {
-        std::vector<std::uint32_t> fill(offsets.begin(), offsets.end() - 1);
-        for (std::size_t i = 0; i < nt; ++i) {
-            listed.at(std::size_t(pass) * nt + i, 2 * nt);
-            const auto& t = mesh.triangles[i];
-            for (int k = 0; k < 3; ++k) {
-                if (!irregular[std::size_t(t[k])]) continue;
-                const std::size_t at = rank(t[k]);
-                if (pass == 0) {
-                    offsets[at + 1] += 2;
-                } else {
-                    lists[fill[at]++] = t[(k + 1) % 3];
-                    lists[fill[at]++] = t[(k + 2) % 3];
-                }
+    // Their corners (rank, the two other corners), gathered by slices of triangles on every
+    // thread in triangle order within each, then listed slice by slice: the order of one pass.
+    constexpr std::size_t kSlices = 64;
+    std::vector<std::vector<std::array<std::int32_t, 3>>> corners(kSlices);
+    const auto slice_begin = [nt](std::size_t sl) { return nt * sl / kSlices; };
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, kSlices, 1), [&](const auto& r) {
+        for (std::size_t sl = r.begin(); sl < r.end(); ++sl)
+            for (std::size_t i = slice_begin(sl); i < slice_begin(sl + 1); ++i) {
+                const auto& t = mesh.triangles[i];
+                for (int k = 0; k < 3; ++k)
+                    if (irregular[std::size_t(t[k])])
+                        corners[sl].push_back({static_cast<std::int32_t>(rank(t[k])),
+                                               t[(k + 1) % 3], t[(k + 2) % 3]});
             }
-        }
-        if (pass == 0) {
-            std::partial_sum(offsets.begin(), offsets.end(), offsets.begin());
-            check_adjacency_size(offsets.back(), "corners at irregular vertices");
-            lists.assign(offsets.back(), 0);
+    });
+    report_progress(progress, 0.95, "mesh");
+    std::vector<std::uint32_t> offsets(ni + 1, 0);
+    for (const auto& list : corners)
+        for (const auto& c : list) offsets[std::size_t(c[0]) + 1] += 2;
+    std::partial_sum(offsets.begin(), offsets.end(), offsets.begin());
+    check_adjacency_size(offsets.back(), "corners at irregular vertices");
+    std::vector<std::int32_t> lists(offsets.back(), 0);
+    {
+        std::vector<std::uint32_t> fill(offsets.begin(), offsets.end() - 1);
+        for (auto& list : corners) {
+            for (const auto& c : list) {
+                lists[fill[std::size_t(c[0])]++] = c[1];
+                lists[fill[std::size_t(c[0])]++] = c[2];
+            }
+            detail::release(list);
         }
     }
     detail::release(irregular);
