@@ -425,6 +425,20 @@ TEST_CASE("dem_to_mesh: the same mesh whatever the thread count", "[mesh]") {
         CHECK(one.positions == two.positions);
         CHECK(one.triangles == two.triangles);
         CHECK(one.vertex_areas == two.vertex_areas);
+        // The areas (summed by bands of rows on the threads) are each vertex's thirds added in
+        // triangle order, as one pass in order adds them.
+        std::vector<double> sums(two.vertex_count(), 0.0);
+        for (const auto& t : two.triangles) {
+            const auto &a = two.positions[std::size_t(t[0])], &b = two.positions[std::size_t(t[1])],
+                       &c = two.positions[std::size_t(t[2])];
+            const double u[3] = {double(b[0]) - a[0], double(b[1]) - a[1], double(b[2]) - a[2]};
+            const double w[3] = {double(c[0]) - a[0], double(c[1]) - a[1], double(c[2]) - a[2]};
+            const double n[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2],
+                                 u[0] * w[1] - u[1] * w[0]};
+            const double third = 0.5 * std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]) / 3.0;
+            for (const auto v : t) sums[std::size_t(v)] += third;
+        }
+        CHECK(std::vector<float>(sums.begin(), sums.end()) == two.vertex_areas);
         CHECK(one.neighbor_directions == two.neighbor_directions);
         CHECK(one.irregular_vertices == two.irregular_vertices);
         CHECK(one.irregular_neighbors == two.irregular_neighbors);

@@ -203,6 +203,76 @@ void set_vertex_areas(TriangleMesh& mesh, const detail::PassProgress& areas) {
     mesh.vertex_areas.assign(area.begin(), area.end());
 }
 
+// The same sums for a DEM mesh, on every thread: its triangles come in rows of blocks, and a
+// vertex of pixel row p is a corner only in block rows p - 1 and p. Bands of block rows add
+// their thirds at once, except those for their first row of vertices, which they keep in
+// order and add after every band is done (after the band before's): each vertex's sum is
+// then taken in triangle order, as one pass would. False (nothing done) when a triangle is
+// not so.
+bool set_grid_vertex_areas(TriangleMesh& mesh, const detail::PassProgress& areas) {
+    const std::int64_t W = mesh.grid_width;
+    const std::size_t nt = mesh.triangles.size();
+    const auto row_of = [&](std::int32_t v) {
+        return static_cast<std::int64_t>(mesh.vertex_pixel[std::size_t(v)]) / W;
+    };
+    const auto block_row = [&](std::size_t i) {
+        const auto& t = mesh.triangles[i];
+        return std::min({row_of(t[0]), row_of(t[1]), row_of(t[2])});
+    };
+    constexpr std::size_t kBands = 64;
+    // Band k: triangles [first[k], first[k + 1]), block rows from start[k].
+    std::vector<std::size_t> first(kBands + 1, nt);
+    std::vector<std::int64_t> start(kBands + 1, 0);
+    first[0] = 0;
+    for (std::size_t k = 1; k < kBands; ++k) {
+        std::size_t i = std::max(first[k - 1], nt * k / kBands);
+        if (i >= nt) {
+            first[k] = nt;
+            continue;
+        }
+        const std::int64_t row = block_row(i);
+        while (i > first[k - 1] && block_row(i - 1) == row) --i;  // the row's first triangle
+        first[k] = i;
+        start[k] = row;
+    }
+    std::vector<double> area(mesh.positions.size(), 0.0);
+    std::vector<std::vector<std::pair<std::int32_t, double>>> kept(kBands);
+    std::atomic<bool> grid_like{true};
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, kBands, 1), [&](const auto& r) {
+        for (std::size_t k = r.begin(); k < r.end(); ++k) {
+            if (first[k] == first[k + 1]) continue;
+            const std::int64_t own = start[k];
+            // (Rows in order: within the band, and below the next band's first row.)
+            const std::int64_t next = first[k + 1] < nt ? block_row(first[k + 1])
+                                                        : std::numeric_limits<std::int64_t>::max();
+            std::int64_t previous = own;
+            for (std::size_t i = first[k]; i < first[k + 1]; ++i) {
+                const auto& t = mesh.triangles[i];
+                const std::int64_t b = block_row(i);
+                if (b < previous || b >= next) grid_like = false;
+                previous = b;
+                const double third = triangle_area(mesh, t) / 3.0;
+                for (int c = 0; c < 3; ++c) {
+                    const std::int64_t p = row_of(t[c]);
+                    if (p != b && p != b + 1) grid_like = false;
+                    if (k > 0 && p == own)
+                        kept[k].emplace_back(t[c], third);
+                    else
+                        area[std::size_t(t[c])] += third;
+                }
+            }
+        }
+    });
+    if (!grid_like) return false;
+    areas.at(0, 1);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, kBands, 1), [&](const auto& r) {
+        for (std::size_t k = r.begin(); k < r.end(); ++k)
+            for (const auto& [v, third] : kept[k]) area[std::size_t(v)] += third;
+    });
+    mesh.vertex_areas.assign(area.begin(), area.end());
+    return true;
+}
+
 }  // namespace
 
 void finish_mesh(TriangleMesh& mesh, const ProgressFn& progress) {
@@ -304,7 +374,8 @@ void finish_grid_mesh(TriangleMesh& mesh, const ProgressFn& progress) {
     // Its passes: areas (0 to 0.3), the directions (made, set: to 0.6), checked (to 0.8), the
     // irregular vertices' lists (0.9 to 1).
     mesh.release_adjacency();
-    set_vertex_areas(mesh, detail::PassProgress(progress, 0, 0.3, "mesh"));
+    if (!set_grid_vertex_areas(mesh, detail::PassProgress(progress, 0, 0.3, "mesh")))
+        set_vertex_areas(mesh, detail::PassProgress(progress, 0, 0.3, "mesh"));
     mesh.direction_offsets = {-W - 1, -W, -W + 1, -1, 1, W - 1, W, W + 1};
     mesh.uniform_ranges = uniform_ranges(mesh);
     // The direction of the pixel dp away (-1: not one of the 8 around, or across the seam,
