@@ -205,10 +205,10 @@ void set_vertex_areas(TriangleMesh& mesh, const detail::PassProgress& areas) {
 
 // The same sums for a DEM mesh, on every thread: its triangles come in rows of blocks, and a
 // vertex of pixel row p is a corner only in block rows p - 1 and p. Bands of block rows add
-// their thirds at once, except those for their first row of vertices, which they keep in
-// order and add after every band is done (after the band before's): each vertex's sum is
-// then taken in triangle order, as one pass would. False (nothing done) when a triangle is
-// not so.
+// their thirds at once, except those for their first row of vertices, which they add once
+// every band is done (after the band before's), going over their first block row again: each
+// vertex's sum is then taken in triangle order, as one pass would. False (nothing done) when a
+// triangle is not so.
 bool set_grid_vertex_areas(TriangleMesh& mesh, const detail::PassProgress& areas) {
     const std::int64_t W = mesh.grid_width;
     const std::size_t nt = mesh.triangles.size();
@@ -236,7 +236,7 @@ bool set_grid_vertex_areas(TriangleMesh& mesh, const detail::PassProgress& areas
         start[k] = row;
     }
     std::vector<double> area(mesh.positions.size(), 0.0);
-    std::vector<std::vector<std::pair<std::int32_t, double>>> kept(kBands);
+    std::vector<std::size_t> first_row_end(kBands, 0);  // the end of each band's first block row
     std::atomic<bool> grid_like{true};
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, kBands, 1), [&](const auto& r) {
         for (std::size_t k = r.begin(); k < r.end(); ++k) {
@@ -256,7 +256,7 @@ bool set_grid_vertex_areas(TriangleMesh& mesh, const detail::PassProgress& areas
                     const std::int64_t p = row_of(t[c]);
                     if (p != b && p != b + 1) grid_like = false;
                     if (k > 0 && p == own)
-                        kept[k].emplace_back(t[c], third);
+                        first_row_end[k] = i + 1;  // (its thirds are added after)
                     else
                         area[std::size_t(t[c])] += third;
                 }
@@ -267,7 +267,12 @@ bool set_grid_vertex_areas(TriangleMesh& mesh, const detail::PassProgress& areas
     areas.at(0, 1);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, kBands, 1), [&](const auto& r) {
         for (std::size_t k = r.begin(); k < r.end(); ++k)
-            for (const auto& [v, third] : kept[k]) area[std::size_t(v)] += third;
+            for (std::size_t i = first[k]; i < first_row_end[k]; ++i) {
+                const auto& t = mesh.triangles[i];
+                const double third = triangle_area(mesh, t) / 3.0;
+                for (int c = 0; c < 3; ++c)
+                    if (row_of(t[c]) == start[k]) area[std::size_t(t[c])] += third;
+            }
     });
     mesh.vertex_areas.assign(area.begin(), area.end());
     return true;
