@@ -22,28 +22,70 @@ namespace terrain::field {
 namespace detail {
 namespace {
 
-// Area-weighted vertex normals; triangles are counter-clockwise seen from outside/above.
+// Area-weighted vertex normals; triangles are counter-clockwise seen from outside/above. Each
+// vertex's sum is taken in triangle order. A DEM mesh whose rows of blocks can be made alone
+// (terrain::detail::rows_of_triangles) sums them on every thread: a vertex of pixel row p is a
+// corner only in block rows p - 1 and p, so bands of block rows add their triangles at once
+// but to their first row of vertices, to which they add once every band is done (after the
+// band before's), going over their first block row again: the sums of one pass in order.
 std::vector<Vec3> vertex_normals(const TriangleMesh& mesh, const ProgressFn& progress = {}) {
-    const terrain::detail::PassProgress summed(progress, 0.3, 0.8, "shape index"),
-        normalised(progress, 0.8, 1, "shape index");
+    const terrain::detail::PassProgress summed(progress, 0.3, 0.8, "shape index");
     std::vector<Vec3> normals;  // made a slice at a time: the first touch of a block is slow
     terrain::detail::assign_in_slices(
         normals, mesh.vertex_count(), Vec3{0, 0, 0},
         terrain::detail::PassProgress(progress, 0, 0.3, "shape index"));
-    // (In order, the stored triangles or those a DEM mesh makes again from its grid.)
-    const std::size_t nt = mesh.triangle_count();
     const auto& p = mesh.positions;
-    terrain::detail::for_each_triangle(
-        mesh, [&](std::size_t i, const std::array<std::int32_t, 3>& t) {
-            summed.at(i, nt);
-            const Vec3 n = cross(sub(p[t[1]], p[t[0]]), sub(p[t[2]], p[t[0]]));
-            for (auto v : t)
+    // Adds triangle t's normal to its corners that `take` takes.
+    const auto add = [&](const std::array<std::int32_t, 3>& t, auto&& take) {
+        const Vec3 n = cross(sub(p[t[1]], p[t[0]]), sub(p[t[2]], p[t[0]]));
+        for (auto v : t)
+            if (take(v))
                 for (int k = 0; k < 3; ++k) normals[v][k] += n[k];
-        });
-    for (std::size_t v = 0; v < normals.size(); ++v) {
-        normalised.at(v, normals.size());
-        normals[v] = normalized(normals[v]);
+    };
+    constexpr int kBandRows = 16;
+    if (terrain::detail::rows_of_triangles(mesh) && mesh.grid_height > 2 * kBandRows) {
+        const std::int64_t W = mesh.grid_width;
+        const int rows = mesh.grid_height - 1, bands = (rows + kBandRows - 1) / kBandRows;
+        const auto pixel_row = [&](std::int32_t v) {
+            return static_cast<int>(mesh.vertex_pixel[std::size_t(v)] / W);
+        };
+        for (const bool first_rows : {false, true})
+            terrain::detail::parallel_slices(
+                bands, 1, progress, first_rows ? 0.7 : 0.3, first_rows ? 0.8 : 0.7, "shape index",
+                [&](const tbb::blocked_range<int>& r) {
+                    for (int band = r.begin(); band < r.end(); ++band) {
+                        const int first = band * kBandRows;
+                        if (first_rows) {
+                            if (band > 0)
+                                terrain::detail::for_each_row_triangle(
+                                    mesh, first, [&](const std::array<std::int32_t, 3>& t) {
+                                        add(t,
+                                            [&](std::int32_t v) { return pixel_row(v) == first; });
+                                    });
+                            continue;
+                        }
+                        for (int row = first; row < std::min(rows, first + kBandRows); ++row)
+                            terrain::detail::for_each_row_triangle(
+                                mesh, row, [&](const std::array<std::int32_t, 3>& t) {
+                                    add(t, [&](std::int32_t v) {
+                                        return band == 0 || pixel_row(v) != first;
+                                    });
+                                });
+                    }
+                });
+    } else {
+        const std::size_t nt = mesh.triangle_count();
+        terrain::detail::for_each_triangle(
+            mesh, [&](std::size_t i, const std::array<std::int32_t, 3>& t) {
+                summed.at(i, nt);
+                add(t, [](std::int32_t) { return true; });
+            });
     }
+    terrain::detail::parallel_slices(normals.size(), std::size_t{1} << 14, progress, 0.8, 1,
+                                     "shape index", [&](const tbb::blocked_range<std::size_t>& r) {
+                                         for (std::size_t v = r.begin(); v < r.end(); ++v)
+                                             normals[v] = normalized(normals[v]);
+                                     });
     return normals;
 }
 
