@@ -23,11 +23,9 @@ namespace detail {
 namespace {
 
 // Area-weighted vertex normals; triangles are counter-clockwise seen from outside/above. Each
-// vertex's sum is taken in triangle order. A DEM mesh whose rows of blocks can be made alone
-// (terrain::detail::rows_of_triangles) sums them on every thread: a vertex of pixel row p is a
-// corner only in block rows p - 1 and p, so bands of block rows add their triangles at once
-// but to their first row of vertices, to which they add once every band is done (after the
-// band before's), going over their first block row again: the sums of one pass in order.
+// vertex's sum is taken in triangle order; a DEM mesh whose rows of blocks can be made alone
+// (terrain::detail::rows_of_triangles) sums them on every thread by bands of block rows
+// (terrain::detail::add_in_order_by_bands), the sums of one pass in order.
 std::vector<Vec3> vertex_normals(const TriangleMesh& mesh, const ProgressFn& progress = {}) {
     const terrain::detail::PassProgress summed(progress, 0.3, 0.8, "shape index");
     std::vector<Vec3> normals;  // made a slice at a time: the first touch of a block is slow
@@ -42,37 +40,13 @@ std::vector<Vec3> vertex_normals(const TriangleMesh& mesh, const ProgressFn& pro
             if (take(v))
                 for (int k = 0; k < 3; ++k) normals[v][k] += n[k];
     };
-    constexpr int kBandRows = 16;
-    if (terrain::detail::rows_of_triangles(mesh) && mesh.grid_height > 2 * kBandRows) {
+    if (terrain::detail::rows_of_triangles(mesh)) {
         const std::int64_t W = mesh.grid_width;
-        const int rows = mesh.grid_height - 1, bands = (rows + kBandRows - 1) / kBandRows;
-        const auto pixel_row = [&](std::int32_t v) {
-            return static_cast<int>(mesh.vertex_pixel[std::size_t(v)] / W);
-        };
-        for (const bool first_rows : {false, true})
-            terrain::detail::parallel_slices(
-                bands, 1, progress, first_rows ? 0.7 : 0.3, first_rows ? 0.8 : 0.7, "shape index",
-                [&](const tbb::blocked_range<int>& r) {
-                    for (int band = r.begin(); band < r.end(); ++band) {
-                        const int first = band * kBandRows;
-                        if (first_rows) {
-                            if (band > 0)
-                                terrain::detail::for_each_row_triangle(
-                                    mesh, first, [&](const std::array<std::int32_t, 3>& t) {
-                                        add(t,
-                                            [&](std::int32_t v) { return pixel_row(v) == first; });
-                                    });
-                            continue;
-                        }
-                        for (int row = first; row < std::min(rows, first + kBandRows); ++row)
-                            terrain::detail::for_each_row_triangle(
-                                mesh, row, [&](const std::array<std::int32_t, 3>& t) {
-                                    add(t, [&](std::int32_t v) {
-                                        return band == 0 || pixel_row(v) != first;
-                                    });
-                                });
-                    }
-                });
+        terrain::detail::add_in_order_by_bands(
+            mesh.grid_height - 1,
+            [&](std::int32_t v) { return mesh.vertex_pixel[std::size_t(v)] / W; },
+            [&](int row, const auto& f) { terrain::detail::for_each_row_triangle(mesh, row, f); },
+            add, progress, 0.3, 0.8, "shape index");
     } else {
         const std::size_t nt = mesh.triangle_count();
         terrain::detail::for_each_triangle(

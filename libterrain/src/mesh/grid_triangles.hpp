@@ -106,6 +106,43 @@ void for_each_row_triangle(const TriangleMesh& mesh, int row, F&& f) {
                         recorded_split(mesh, row), f);
 }
 
+// Sums at the corners of a DEM mesh's triangles, each vertex's taken in triangle order, on
+// every thread. emit_row(row, f) calls f(triangle) for each triangle of row `row` of blocks
+// (0 to rows - 1), in order; add(triangle, take) adds the triangle's share to its corners v
+// for which take(v). A vertex of pixel row p (pixel_row(v)) is a corner only in block rows
+// p - 1 and p, so bands of 16 block rows add their triangles at once but to their first row
+// of vertices, to which each band adds once every band is done (after the band before has
+// added its own), going over its first block row again: each vertex's sum runs in triangle
+// order, as one pass would. Progress from `begin` to `end` under `message`.
+template <class PixelRow, class EmitRow, class Add>
+void add_in_order_by_bands(int rows, const PixelRow& pixel_row, const EmitRow& emit_row,
+                           const Add& add, const ProgressFn& progress, double begin, double end,
+                           std::string_view message) {
+    constexpr int kBandRows = 16;
+    const int bands = (rows + kBandRows - 1) / kBandRows;
+    const double middle = begin + (end - begin) * 0.8;
+    for (const bool first_rows : {false, true})
+        parallel_slices(
+            bands, 1, progress, first_rows ? middle : begin, first_rows ? end : middle, message,
+            [&](const tbb::blocked_range<int>& r) {
+                for (int band = r.begin(); band < r.end(); ++band) {
+                    const int first = band * kBandRows;
+                    if (first_rows) {
+                        if (band > 0)
+                            emit_row(first, [&](const Triangle& t) {
+                                add(t, [&](std::int32_t v) { return pixel_row(v) == first; });
+                            });
+                        continue;
+                    }
+                    for (int row = first; row < std::min(rows, first + kBandRows); ++row)
+                        emit_row(row, [&](const Triangle& t) {
+                            add(t,
+                                [&](std::int32_t v) { return band == 0 || pixel_row(v) != first; });
+                        });
+                }
+            });
+}
+
 // f(index, triangle) for each triangle of `mesh` in order: its stored triangles, or for a
 // DEM mesh whose triangles were released, the same made again from the grid (with the
 // diagonals recorded when it was made: no position is read).

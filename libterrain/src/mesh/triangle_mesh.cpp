@@ -17,6 +17,7 @@
 #include <functional>
 #include <limits>
 #include <numeric>
+#include <ranges>
 #include <string>
 
 namespace terrain {
@@ -190,6 +191,21 @@ std::size_t pack_sorted_lists(std::vector<std::int32_t>& lists,
     return write;
 }
 
+// What gather(i, out) pushes into `out` for each triangle i, by 64 slices of the triangles on
+// every thread: each slice's items in triangle order, so that reading the slices one after the
+// other reads them in the order of one pass.
+template <class T, class Gather>
+std::vector<std::vector<T>> gather_by_slices(std::size_t nt, const Gather& gather) {
+    constexpr std::size_t kSlices = 64;
+    std::vector<std::vector<T>> out(kSlices);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, kSlices, 1), [&](const auto& r) {
+        for (std::size_t sl = r.begin(); sl < r.end(); ++sl)
+            for (std::size_t i = nt * sl / kSlices; i < nt * (sl + 1) / kSlices; ++i)
+                gather(i, out[sl]);
+    });
+    return out;
+}
+
 // Vertex areas: one third of each incident triangle (serial: the same sums every run).
 void set_vertex_areas(TriangleMesh& mesh, const detail::PassProgress& areas) {
     const std::size_t nt = mesh.triangles.size();
@@ -203,77 +219,54 @@ void set_vertex_areas(TriangleMesh& mesh, const detail::PassProgress& areas) {
     mesh.vertex_areas.assign(area.begin(), area.end());
 }
 
-// The same sums for a DEM mesh, on every thread: its triangles come in rows of blocks, and a
-// vertex of pixel row p is a corner only in block rows p - 1 and p. Bands of block rows add
-// their thirds at once, except those for their first row of vertices, which they add once
-// every band is done (after the band before's), going over their first block row again: each
-// vertex's sum is then taken in triangle order, as one pass would. False (nothing done) when a
-// triangle is not so.
-bool set_grid_vertex_areas(TriangleMesh& mesh, const detail::PassProgress& areas) {
+// The same sums for a DEM mesh, on every thread, by bands of block rows
+// (add_in_order_by_bands): its triangles come in rows of blocks, a vertex of pixel row p a
+// corner only in block rows p - 1 and p. False (nothing done) when a triangle is not so.
+bool set_grid_vertex_areas(TriangleMesh& mesh, const ProgressFn& progress, double begin,
+                           double end) {
     const std::int64_t W = mesh.grid_width;
     const std::size_t nt = mesh.triangles.size();
-    const auto row_of = [&](std::int32_t v) {
+    const int rows = mesh.grid_height - 1;
+    const auto pixel_row = [&](std::int32_t v) {
         return static_cast<std::int64_t>(mesh.vertex_pixel[std::size_t(v)]) / W;
     };
     const auto block_row = [&](std::size_t i) {
         const auto& t = mesh.triangles[i];
-        return std::min({row_of(t[0]), row_of(t[1]), row_of(t[2])});
+        return std::min({pixel_row(t[0]), pixel_row(t[1]), pixel_row(t[2])});
     };
-    constexpr std::size_t kBands = 64;
-    // Band k: triangles [first[k], first[k + 1]), block rows from start[k].
-    std::vector<std::size_t> first(kBands + 1, nt);
-    std::vector<std::int64_t> start(kBands + 1, 0);
-    first[0] = 0;
-    for (std::size_t k = 1; k < kBands; ++k) {
-        std::size_t i = std::max(first[k - 1], nt * k / kBands);
-        if (i >= nt) {
-            first[k] = nt;
-            continue;
-        }
-        const std::int64_t row = block_row(i);
-        while (i > first[k - 1] && block_row(i - 1) == row) --i;  // the row's first triangle
-        first[k] = i;
-        start[k] = row;
-    }
-    std::vector<double> area(mesh.positions.size(), 0.0);
-    std::vector<std::size_t> first_row_end(kBands, 0);  // the end of each band's first block row
-    std::atomic<bool> grid_like{true};
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, kBands, 1), [&](const auto& r) {
-        for (std::size_t k = r.begin(); k < r.end(); ++k) {
-            if (first[k] == first[k + 1]) continue;
-            const std::int64_t own = start[k];
-            // (Rows in order: within the band, and below the next band's first row.)
-            const std::int64_t next = first[k + 1] < nt ? block_row(first[k + 1])
-                                                        : std::numeric_limits<std::int64_t>::max();
-            std::int64_t previous = own;
-            for (std::size_t i = first[k]; i < first[k + 1]; ++i) {
-                const auto& t = mesh.triangles[i];
-                const std::int64_t b = block_row(i);
-                if (b < previous || b >= next) grid_like = false;
-                previous = b;
-                const double third = triangle_area(mesh, t) / 3.0;
-                for (int c = 0; c < 3; ++c) {
-                    const std::int64_t p = row_of(t[c]);
-                    if (p != b && p != b + 1) grid_like = false;
-                    if (k > 0 && p == own)
-                        first_row_end[k] = i + 1;  // (its thirds are added after)
-                    else
-                        area[std::size_t(t[c])] += third;
-                }
-            }
-        }
-    });
+    // Block rows in order, each corner on its block row or the next.
+    std::atomic<bool> grid_like{rows > 0};
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nt, std::size_t{1} << 14),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                          for (std::size_t i = r.begin(); i < r.end(); ++i) {
+                              const std::int64_t b = block_row(i);
+                              bool ok = b < rows && (i == 0 || block_row(i - 1) <= b);
+                              for (const auto v : mesh.triangles[i])
+                                  ok = ok && pixel_row(v) - b <= 1;
+                              if (!ok) grid_like = false;
+                          }
+                      });
     if (!grid_like) return false;
-    areas.at(0, 1);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, kBands, 1), [&](const auto& r) {
-        for (std::size_t k = r.begin(); k < r.end(); ++k)
-            for (std::size_t i = first[k]; i < first_row_end[k]; ++i) {
-                const auto& t = mesh.triangles[i];
-                const double third = triangle_area(mesh, t) / 3.0;
-                for (int c = 0; c < 3; ++c)
-                    if (row_of(t[c]) == start[k]) area[std::size_t(t[c])] += third;
-            }
-    });
+    // Each block row's first triangle.
+    std::vector<std::size_t> row_first(std::size_t(rows) + 1, nt);
+    for (int row = 0; row < rows; ++row)
+        row_first[std::size_t(row)] =
+            *std::ranges::partition_point(std::views::iota(std::size_t{0}, nt),
+                                          [&](std::size_t i) { return block_row(i) < row; });
+    std::vector<double> area(mesh.positions.size(), 0.0);
+    detail::add_in_order_by_bands(
+        rows, pixel_row,
+        [&](int row, const auto& f) {
+            for (std::size_t i = row_first[std::size_t(row)]; i < row_first[std::size_t(row) + 1];
+                 ++i)
+                f(mesh.triangles[i]);
+        },
+        [&](const std::array<std::int32_t, 3>& t, auto&& take) {
+            const double third = triangle_area(mesh, t) / 3.0;
+            for (const auto v : t)
+                if (take(v)) area[std::size_t(v)] += third;
+        },
+        progress, begin, end, "mesh");
     mesh.vertex_areas.assign(area.begin(), area.end());
     return true;
 }
@@ -379,7 +372,7 @@ void finish_grid_mesh(TriangleMesh& mesh, const ProgressFn& progress) {
     // Its passes: areas (0 to 0.3), the directions (made, set: to 0.6), checked (to 0.8), the
     // irregular vertices' lists (0.9 to 1).
     mesh.release_adjacency();
-    if (!set_grid_vertex_areas(mesh, detail::PassProgress(progress, 0, 0.3, "mesh")))
+    if (!set_grid_vertex_areas(mesh, progress, 0, 0.3))
         set_vertex_areas(mesh, detail::PassProgress(progress, 0, 0.3, "mesh"));
     mesh.direction_offsets = {-W - 1, -W, -W + 1, -1, 1, W - 1, W, W + 1};
     mesh.uniform_ranges = uniform_ranges(mesh);
@@ -454,18 +447,12 @@ void finish_grid_mesh(TriangleMesh& mesh, const ProgressFn& progress) {
     const std::size_t ni = mesh.irregular_vertices.size();
     // Their corners (rank, the two other corners), gathered by slices of triangles on every
     // thread in triangle order within each, then listed slice by slice: the order of one pass.
-    constexpr std::size_t kSlices = 64;
-    std::vector<std::vector<std::array<std::int32_t, 3>>> corners(kSlices);
-    const auto slice_begin = [nt](std::size_t sl) { return nt * sl / kSlices; };
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, kSlices, 1), [&](const auto& r) {
-        for (std::size_t sl = r.begin(); sl < r.end(); ++sl)
-            for (std::size_t i = slice_begin(sl); i < slice_begin(sl + 1); ++i) {
-                const auto& t = mesh.triangles[i];
-                for (int k = 0; k < 3; ++k)
-                    if (irregular[std::size_t(t[k])])
-                        corners[sl].push_back({static_cast<std::int32_t>(rank(t[k])),
-                                               t[(k + 1) % 3], t[(k + 2) % 3]});
-            }
+    auto corners = gather_by_slices<std::array<std::int32_t, 3>>(nt, [&](std::size_t i, auto& out) {
+        const auto& t = mesh.triangles[i];
+        for (int k = 0; k < 3; ++k)
+            if (irregular[std::size_t(t[k])])
+                out.push_back(
+                    {static_cast<std::int32_t>(rank(t[k])), t[(k + 1) % 3], t[(k + 2) % 3]});
     });
     report_progress(progress, 0.95, "mesh");
     std::vector<std::uint32_t> offsets(ni + 1, 0);
@@ -598,18 +585,14 @@ std::size_t split_pinched_vertices(TriangleMesh& mesh, std::int32_t* first_pinch
     // each, then counted and listed slice by slice; else (every vertex: a mesh file) counted
     // and listed in two passes over the triangles.
     const std::size_t nt = mesh.triangles.size();
-    constexpr std::size_t kSlices = 64;
-    std::vector<std::vector<std::pair<std::int32_t, std::int32_t>>> corners(kSlices);
-    if (may_pinch) {
-        const auto slice_begin = [nt](std::size_t sl) { return nt * sl / kSlices; };
-        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, kSlices, 1), [&](const auto& r) {
-            for (std::size_t sl = r.begin(); sl < r.end(); ++sl)
-                for (std::size_t t = slice_begin(sl); t < slice_begin(sl + 1); ++t)
-                    for (auto v : mesh.triangles[t])
-                        if (const std::int32_t k = rank(v); k >= 0)
-                            corners[sl].emplace_back(k, std::int32_t(t));
-        });
-    }
+    std::vector<std::vector<std::pair<std::int32_t, std::int32_t>>> corners;
+    if (may_pinch)
+        corners = gather_by_slices<std::pair<std::int32_t, std::int32_t>>(
+            nt, [&](std::size_t t, auto& out) {
+                for (auto v : mesh.triangles[t])
+                    if (const std::int32_t k = rank(v); k >= 0)
+                        out.emplace_back(k, std::int32_t(t));
+            });
     report_progress(progress, 0.15, "mesh");
     std::vector<std::uint32_t> offsets(looked_at + 1, 0);
     if (may_pinch) {
