@@ -20,13 +20,12 @@
 
 namespace terrain::field {
 namespace detail {
-namespace {
 
 // Area-weighted vertex normals; triangles are counter-clockwise seen from outside/above. Each
 // vertex's sum is taken in triangle order; a DEM mesh whose rows of blocks can be made alone
 // (terrain::detail::rows_of_triangles) sums them on every thread by bands of block rows
 // (terrain::detail::add_in_order_by_bands), the sums of one pass in order.
-std::vector<Vec3> vertex_normals(const TriangleMesh& mesh, const ProgressFn& progress = {}) {
+std::vector<Vec3> vertex_normals(const TriangleMesh& mesh, const ProgressFn& progress) {
     const terrain::detail::PassProgress summed(progress, 0.3, 0.8, "shape index");
     std::vector<Vec3> normals;  // made a slice at a time: the first touch of a block is slow
     terrain::detail::assign_in_slices(
@@ -62,6 +61,8 @@ std::vector<Vec3> vertex_normals(const TriangleMesh& mesh, const ProgressFn& pro
                                      });
     return normals;
 }
+
+namespace {
 
 // The neighbourhood of v: `rings` rings of mesh edges, or everything within `radius` metres
 // (a ball) reachable through vertices within it.
@@ -221,8 +222,6 @@ std::array<Vec3, 2> tangent_frame(const Vec3& normal) {
     return {t1, cross(normal, t1)};
 }
 
-namespace {
-
 // Fits h = a u^2 + b uv + c v^2 (+ d u + e v) to the neighbourhood in the tangent frame of
 // `normal`, coordinates divided by their mean distance so the fit is scale-free. Returns
 // false when the neighbourhood is too small. Curvatures come back in units of 1/scale.
@@ -251,7 +250,175 @@ bool fit_curvatures(const TriangleMesh& mesh, std::int32_t v, const Vec3& normal
     return solve_curvatures(e, out);
 }
 
+// Where v and each of its neighbours lie in the mesh's uniform ranges, each neighbour is the
+// vertex plus its direction's offset (TriangleMesh::neighbors_of), so the second ring's cells
+// are told apart by their pixel offset within the 5 x 5 pixels around v (a row of at least 5
+// pixels: offsets that differ give vertices that differ).
+bool gather_two_rings_on_grid(const TriangleMesh& mesh, std::int32_t v,
+                              std::vector<std::int32_t>& out) {
+    static constexpr int kDx[8] = {-1, 0, 1, -1, 1, -1, 0, 1}, kDy[8] = {-1, -1, -1, 0, 0, 1, 1, 1};
+    const auto uniform = [&](std::int32_t u) {
+        for (const auto& r : mesh.uniform_ranges)
+            if (u < r[1]) return u >= r[0];
+        return false;
+    };
+    if (mesh.grid_width < 5 || !mesh.grid_adjacency() || !uniform(v)) return false;
+    const unsigned bits = mesh.neighbor_directions[std::size_t(v)];
+    if (bits == 0) return false;
+    const auto cell = [](int dx, int dy) { return 1u << ((dy + 2) * 5 + dx + 2); };
+    out.clear();
+    out.push_back(v);
+    std::uint32_t seen = cell(0, 0);
+    std::array<int, 8> first_dir{};  // the direction of each first-ring neighbour
+    int first = 0;
+    for (unsigned b = bits; b != 0; b &= b - 1) {
+        const int d = __builtin_ctz(b);
+        const auto u =
+            static_cast<std::int32_t>(std::int64_t(v) + mesh.direction_offsets[std::size_t(d)]);
+        if (!uniform(u) || mesh.neighbor_directions[std::size_t(u)] == 0) return false;
+        seen |= cell(kDx[d], kDy[d]);
+        first_dir[std::size_t(first++)] = d;
+        out.push_back(u);
+    }
+    for (int i = 0; i < first; ++i) {
+        const int d1 = first_dir[std::size_t(i)];
+        const std::int32_t u = out[std::size_t(i + 1)];
+        for (unsigned b = mesh.neighbor_directions[std::size_t(u)]; b != 0; b &= b - 1) {
+            const int d2 = __builtin_ctz(b);
+            const std::uint32_t c = cell(kDx[d1] + kDx[d2], kDy[d1] + kDy[d2]);
+            if (seen & c) continue;
+            seen |= c;
+            out.push_back(static_cast<std::int32_t>(std::int64_t(u) +
+                                                    mesh.direction_offsets[std::size_t(d2)]));
+        }
+    }
+    return true;
+}
+
+namespace {
+
+using Lanes = double __attribute__((vector_size(kFitLanes * sizeof(double))));
+using LaneMask = std::int64_t __attribute__((vector_size(kFitLanes * sizeof(double))));
+
+// Each lane's square root, in place (by reference: no vector crosses a call by value, whose
+// ABI the two builds of fit_curvatures_batch would disagree on).
+[[gnu::always_inline]] inline void sqrt_lanes(Lanes& x) {
+    for (int l = 0; l < kFitLanes; ++l) x[l] = std::sqrt(x[l]);
+}
+
 }  // namespace
+
+// Each step below is fit_curvatures's and solve_curvatures's (5-term fit) on vectors whose
+// lane l holds vertex l's numbers. Built for AVX2 and for the baseline, chosen at load time;
+// neither contracts a product and a sum into one rounding (no FMA is enabled).
+__attribute__((target_clones("avx2", "default"))) void fit_curvatures_batch(
+    const TriangleMesh& mesh, const FitBatch& batch,
+    std::array<PrincipalCurvatures, kFitLanes>& out, std::array<double, kFitLanes>& scale,
+    std::array<bool, kFitLanes>& ok) {
+    std::array<bool, kFitLanes> lane_done{};
+    const std::size_t m = *std::max_element(batch.m.begin(), batch.m.end());
+    if (*std::min_element(batch.m.begin(), batch.m.end()) >= 5) {
+        Lanes count = {};
+        for (int l = 0; l < kFitLanes; ++l) count[l] = double(batch.m[std::size_t(l)]);
+        Lanes t1[3] = {}, t2[3] = {}, n[3] = {}, c[3] = {};
+        for (int l = 0; l < kFitLanes; ++l) {
+            const auto frame = tangent_frame(batch.normal[std::size_t(l)]);
+            const auto& centre = mesh.positions[std::size_t(batch.vertex[std::size_t(l)])];
+            for (int i = 0; i < 3; ++i) {
+                t1[i][l] = frame[0][std::size_t(i)];
+                t2[i][l] = frame[1][std::size_t(i)];
+                n[i][l] = batch.normal[std::size_t(l)][std::size_t(i)];
+                c[i][l] = centre[std::size_t(i)];
+            }
+        }
+        Lanes ata[5][5] = {}, atb[5] = {}, sum_scale = {};
+        for (std::size_t j = 0; j < m; ++j) {
+            Lanes d[3] = {};
+            LaneMask in = {};  // the lanes with a j-th neighbour; the others read their centre
+            for (int l = 0; l < kFitLanes; ++l) {
+                const bool has = j < batch.m[std::size_t(l)];
+                in[l] = has ? -1 : 0;
+                const auto w =
+                    has ? batch.neighbours[std::size_t(l)][j] : batch.vertex[std::size_t(l)];
+                const auto& q = mesh.positions[std::size_t(w)];
+                for (int i = 0; i < 3; ++i) d[i][l] = double(q[std::size_t(i)]);
+            }
+            for (int i = 0; i < 3; ++i) d[i] = d[i] - c[i];
+            const Lanes u = d[0] * t1[0] + d[1] * t1[1] + d[2] * t1[2];
+            const Lanes sv = d[0] * t2[0] + d[1] * t2[1] + d[2] * t2[2];
+            const Lanes h = d[0] * n[0] + d[1] * n[1] + d[2] * n[2];
+            Lanes dist = u * u + sv * sv + h * h;
+            sqrt_lanes(dist);
+            sum_scale = in ? sum_scale + dist : sum_scale;
+            const Lanes row[5] = {u * u, u * sv, sv * sv, u, sv};
+            for (int i = 0; i < 5; ++i) {
+                for (int k = 0; k <= i; ++k)
+                    ata[i][k] = in ? ata[i][k] + row[i] * row[k] : ata[i][k];
+                atb[i] = in ? atb[i] + row[i] * h : atb[i];
+            }
+        }
+        sum_scale /= count;
+        // solve_curvatures: the scaled equations, Cholesky, the fundamental forms.
+        const Lanes inv = 1.0 / sum_scale;
+        const Lanes unit[5] = {inv * inv, inv * inv, inv * inv, inv, inv};
+        Lanes A[5][5], B[5];
+        for (int i = 0; i < 5; ++i) {
+            for (int k = 0; k <= i; ++k) A[i][k] = ata[i][k] * (unit[i] * unit[k]);
+            B[i] = atb[i] * (unit[i] * inv);
+        }
+        LaneMask failed = !(sum_scale > 0.0);
+        Lanes trace = {};
+        for (int i = 0; i < 5; ++i) trace += A[i][i];
+        const Lanes eps = 1e-12 * (trace > 0.0 ? trace : Lanes{} + 1.0);
+        for (int j = 0; j < 5; ++j) {
+            Lanes dj = A[j][j];
+            for (int k = 0; k < j; ++k) dj -= A[j][k] * A[j][k];
+            failed |= dj <= eps;
+            sqrt_lanes(dj);
+            A[j][j] = dj;
+            for (int i = j + 1; i < 5; ++i) {
+                Lanes sum = A[i][j];
+                for (int k = 0; k < j; ++k) sum -= A[i][k] * A[j][k];
+                A[i][j] = sum / A[j][j];
+            }
+        }
+        for (int i = 0; i < 5; ++i) {
+            Lanes sum = B[i];
+            for (int k = 0; k < i; ++k) sum -= A[i][k] * B[k];
+            B[i] = sum / A[i][i];
+        }
+        for (int i = 4; i >= 0; --i) {
+            Lanes sum = B[i];
+            for (int k = i + 1; k < 5; ++k) sum -= A[k][i] * B[k];
+            B[i] = sum / A[i][i];
+        }
+        const Lanes a = B[0], b = B[1], cc = B[2], du = B[3], dv = B[4];
+        const Lanes E = 1.0 + du * du, F = du * dv, G = 1.0 + dv * dv;
+        Lanes W = 1.0 + du * du + dv * dv;
+        sqrt_lanes(W);
+        const Lanes L = 2.0 * a / W, M = b / W, N = 2.0 * cc / W;
+        const Lanes det = E * G - F * F;
+        const Lanes K = (L * N - M * M) / det;
+        const Lanes H = -(E * N - 2.0 * F * M + G * L) / (2.0 * det);
+        Lanes root = H * H - K;
+        for (int l = 0; l < kFitLanes; ++l) root[l] = std::max(0.0, root[l]);
+        sqrt_lanes(root);
+        const Lanes k1 = H + root, k2 = H - root;
+        for (int l = 0; l < kFitLanes; ++l) {
+            if (failed[l]) continue;
+            out[std::size_t(l)] = {k1[l], k2[l]};
+            scale[std::size_t(l)] = sum_scale[l];
+            ok[std::size_t(l)] = true;
+            lane_done[std::size_t(l)] = true;
+        }
+    }
+    for (int l = 0; l < kFitLanes; ++l)
+        if (!lane_done[std::size_t(l)])
+            ok[std::size_t(l)] =
+                fit_curvatures(mesh, batch.vertex[std::size_t(l)], batch.normal[std::size_t(l)],
+                               batch.neighbours[std::size_t(l)], batch.m[std::size_t(l)],
+                               out[std::size_t(l)], scale[std::size_t(l)]);
+}
 
 // The mesh path for one vertex: gather its neighbourhood on the mesh and fit. With
 // `disk_grid` (the disk window applies) the neighbourhood is the vertex's disk, except at a
@@ -624,6 +791,50 @@ std::size_t grid_for_each_vertex(const TriangleMesh& mesh, const GridLayout& g,
     return fallbacks.combine(std::plus<>()) + unowned.size();
 }
 
+// Lane buffers of fit_in_batches: each lane's neighbours.
+struct BatchScratch {
+    std::array<std::vector<std::int32_t>, kFitLanes> neighbours;
+};
+
+// The rings window's vertices [begin, end) through `body`: each gathered as mesh_fit gathers
+// it, then fitted kFitLanes at a time (the last few one by one). Each vertex gets the bits
+// mesh_fit gives it.
+template <class Body>
+void fit_in_batches(const TriangleMesh& mesh, const std::vector<Vec3>& normals,
+                    const ShapeIndexOptions& options, std::int32_t begin, std::int32_t end,
+                    Scratch& s, BatchScratch& lanes, Body& body) {
+    FitBatch batch;
+    std::size_t filled = 0;
+    const bool two_rings = options.rings == 2;
+    for (std::int32_t v = begin; v < end; ++v) {
+        auto& own = lanes.neighbours[filled];
+        if (two_rings && gather_two_rings_on_grid(mesh, v, own)) {
+            own.erase(own.begin());  // (v itself)
+        } else {
+            gather(mesh, v, options, s);
+            own.assign(s.gathered.begin() + 1, s.gathered.end());
+        }
+        batch.vertex[filled] = v;
+        batch.neighbours[filled] = own.data();
+        batch.normal[filled] = normals[std::size_t(v)];
+        batch.m[filled] = own.size();
+        if (++filled < std::size_t(kFitLanes)) continue;
+        std::array<PrincipalCurvatures, kFitLanes> k;
+        std::array<double, kFitLanes> scale{};
+        std::array<bool, kFitLanes> ok{};
+        fit_curvatures_batch(mesh, batch, k, scale, ok);
+        for (std::size_t l = 0; l < filled; ++l) body(batch.vertex[l], ok[l], k[l], scale[l]);
+        filled = 0;
+    }
+    for (std::size_t l = 0; l < filled; ++l) {
+        PrincipalCurvatures k;
+        double scale = 0;
+        const bool ok = fit_curvatures(mesh, batch.vertex[l], batch.normal[l], batch.neighbours[l],
+                                       batch.m[l], k, scale);
+        body(batch.vertex[l], ok, k, scale);
+    }
+}
+
 template <class Body>
 void for_each_vertex(const TriangleMesh& mesh, const ShapeIndexOptions& options,
                      const ProgressFn& progress, Body body) {
@@ -643,13 +854,22 @@ void for_each_vertex(const TriangleMesh& mesh, const ShapeIndexOptions& options,
         return;
     }
     const GridLayout* disk_grid = disk ? &layout : nullptr;
+    // The rings window fits its vertices kFitLanes at a time (fit_curvatures_batch): runs of
+    // vertices with as many neighbours, as on a grid away from its edges and holes.
+    const bool batched = !disk && !(options.radius > 0);
     const auto n = static_cast<std::int32_t>(mesh.vertex_count());
     tbb::enumerable_thread_specific<Scratch> scratch;
+    tbb::enumerable_thread_specific<BatchScratch> batches;
     const std::int32_t chunk = 1 << 16;
     for (std::int32_t start = 0; start < n; start += chunk) {
         const std::int32_t stop = std::min(n, start + chunk);
         tbb::parallel_for(tbb::blocked_range<std::int32_t>(start, stop, 512), [&](const auto& r) {
             Scratch& s = scratch.local();
+            if (batched) {
+                fit_in_batches(mesh, normals, options, r.begin(), r.end(), s, batches.local(),
+                               body);
+                return;
+            }
             for (std::int32_t v = r.begin(); v < r.end(); ++v) {
                 PrincipalCurvatures k;
                 double scale = 0;

@@ -158,6 +158,39 @@ bool solve_curvatures(NormalEquations e, PrincipalCurvatures& out);
 // The tangent frame (t1, t2) of a vertex normal.
 std::array<Vec3, 2> tangent_frame(const Vec3& normal);
 
+// Area-weighted unit vertex normals, each vertex's sum taken in triangle order (shape_index.cpp).
+std::vector<Vec3> vertex_normals(const TriangleMesh& mesh, const ProgressFn& progress = {});
+
+// Fits h = a u^2 + b uv + c v^2 (+ d u + e v) to the m neighbours of v in the tangent frame of
+// `normal` (shape_index.cpp): the normal equations, then solve_curvatures. False when the
+// neighbourhood is too small.
+bool fit_curvatures(const TriangleMesh& mesh, std::int32_t v, const Vec3& normal,
+                    const std::int32_t* neighbour_ids, std::size_t m, PrincipalCurvatures& out,
+                    double& scale);
+
+// fit_curvatures for kFitLanes vertices at once, in the lanes of vectors: every lane does the
+// same operations in the same order as fit_curvatures (no operation is fused or reordered; a
+// lane past its last neighbour keeps its sums as they are), so each vertex gets the same bits.
+// A lane the vectors cannot finish (fewer than 5 neighbours, a zero scale, a singular system)
+// is fitted by fit_curvatures.
+constexpr int kFitLanes = 4;
+struct FitBatch {
+    std::array<std::int32_t, kFitLanes> vertex{};
+    std::array<const std::int32_t*, kFitLanes> neighbours{};
+    std::array<Vec3, kFitLanes> normal{};
+    std::array<std::size_t, kFitLanes> m{};  // each lane's neighbour count
+};
+void fit_curvatures_batch(const TriangleMesh& mesh, const FitBatch& batch,
+                          std::array<PrincipalCurvatures, kFitLanes>& out,
+                          std::array<double, kFitLanes>& scale, std::array<bool, kFitLanes>& ok);
+
+// v and its two rings of neighbours in the order gather_where gives them (rings = 2), read off
+// a DEM mesh's grid directions without a stamp per vertex; false (`out` unfinished) where the
+// grid does not give them in order (near NoData, the seam, poles, pinches, the grid's first
+// and last rows): gather_where then does it.
+bool gather_two_rings_on_grid(const TriangleMesh& mesh, std::int32_t v,
+                              std::vector<std::int32_t>& out);
+
 // The mesh path for one vertex: gather its neighbourhood on the mesh and fit. With
 // `disk_grid` (the disk window applies) the neighbourhood is the vertex's disk, except at a
 // collapsed pole, whose pixel is no place on the ground: it takes the ball.
