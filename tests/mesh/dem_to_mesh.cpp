@@ -210,6 +210,53 @@ TEST_CASE("dem_to_mesh: a projected tile's area is planimetric area x mean slope
     CHECK(double(mesh.memory_bytes()) / double(mesh.vertex_count()) < 100);
 }
 
+TEST_CASE("dem_to_mesh: a radius grid's vertices are each pixel's radius along its lon and lat",
+          "[mesh]") {
+    // The rows of a lon/lat grid of radii take each column's cosine and sine of its longitude
+    // once: each vertex must still be its own pixel's point, to the bit (a global grid in
+    // degrees on a sphere of 255 km, whole and with NoData holes).
+    Dem dem;
+    dem.width = 360;
+    dem.height = 180;
+    dem.crs_wkt = R"(GEOGCRS["Sphere",DATUM["D",ELLIPSOID["S",255000,0]],CS[ellipsoidal,2],)"
+                  R"(AXIS["lat",north,ANGLEUNIT["degree",0.0174532925199433]],)"
+                  R"(AXIS["lon",east,ANGLEUNIT["degree",0.0174532925199433]]])";
+    dem.transform = {-180.0, 1.0, 0, 90.0, 0, -1.0};
+    dem.has_transform = true;
+    geo::georeference(dem);
+    dem.elevation = ElevationKind::radius;
+    for (int r = 0; r < dem.height; ++r)
+        for (int c = 0; c < dem.width; ++c)
+            dem.values.push_back(255000 + 3000 * std::sin(c * 0.11) * std::cos(r * 0.07));
+    for (int pass = 0; pass < 2; ++pass) {
+        if (pass == 1)
+            for (std::size_t p = 0; p < dem.values.size(); p += 7) dem.values[p] = kNaN;
+        const auto mesh = mesh::dem_to_mesh(dem);
+        REQUIRE(mesh.frame == MeshFrame::body);
+        const double degree = std::numbers::pi / 180;
+        std::size_t checked = 0, differing = 0;
+        for (int row = 0; row < dem.height; ++row) {
+            if (row == mesh.pole_rows[0] || row == mesh.pole_rows[1]) continue;
+            for (int col = 0; col < dem.width; ++col) {
+                const std::size_t p = dem.index(col, row);
+                const auto v = mesh.pixel_vertex[p];
+                if (v < 0 || mesh.vertex_pixel[std::size_t(v)] != std::int32_t(p)) continue;
+                const auto ll = dem.map_xy(col + 0.5, row + 0.5);
+                const double value = dem.values[p], cl = std::cos(ll[1] * degree);
+                const double xyz[3] = {value * cl * std::cos(ll[0] * degree),
+                                       value * cl * std::sin(ll[0] * degree),
+                                       value * std::sin(ll[1] * degree)};
+                ++checked;
+                for (int k = 0; k < 3; ++k)
+                    differing += mesh.positions[std::size_t(v)][std::size_t(k)] !=
+                                 static_cast<float>(xyz[k] - mesh.origin[std::size_t(k)]);
+            }
+        }
+        CHECK(checked > 50000);
+        CHECK(differing == 0);
+    }
+}
+
 TEST_CASE("dem_to_mesh: a lon/lat grid has the same shape in the body and map frames", "[mesh]") {
     // A Gaussian hill on a 0.001 degree grid at 45 N on WGS84.
     Dem dem;

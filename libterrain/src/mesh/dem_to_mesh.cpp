@@ -133,10 +133,18 @@ class VertexPlacer {
                       const ProgressFn& progress, double begin, double end, Put&& put) const {
         const int W = dem_.width, H = dem_.height;
         std::vector<std::uint8_t> failed(static_cast<std::size_t>(H), 0);
+        // Radii on a lon/lat grid whose columns are meridians and rows parallels (no
+        // rotation terms): a column's longitude, and so its cosine and sine, is the same in
+        // every row (x + row * 0 is x), and a row's latitude in every column; they are taken
+        // once per column and once per row, the same numbers point() takes per pixel.
+        const bool meridians = !lonlat_ && frame_ == MeshFrame::body &&
+                               dem_.elevation == ElevationKind::radius && dem_.transform[2] == 0 &&
+                               dem_.transform[4] == 0;
         detail::parallel_slices(
             H, 8, progress, begin, end, "mesh", [&](const tbb::blocked_range<int>& rows) {
                 std::vector<double> lon(W), lat(W);
                 std::vector<std::uint8_t> ok(W, 1);
+                std::vector<double> cos_lon, sin_lon;
                 for (int row = rows.begin(); row < rows.end(); ++row) {
                     if (row == skip[0] || row == skip[1]) continue;
                     for (int col = 0; col < W; ++col) {
@@ -146,6 +154,18 @@ class VertexPlacer {
                     }
                     if (lonlat_)
                         lonlat_->to_lonlat(std::size_t(W), lon.data(), lat.data(), ok.data());
+                    if (meridians) {
+                        if (cos_lon.empty()) {
+                            cos_lon.resize(std::size_t(W));
+                            sin_lon.resize(std::size_t(W));
+                            for (int col = 0; col < W; ++col) {
+                                cos_lon[std::size_t(col)] = std::cos(lon[col] * kDegree);
+                                sin_lon[std::size_t(col)] = std::sin(lon[col] * kDegree);
+                            }
+                        }
+                        place_radius_row(vertex_of, row, lon, lat, cos_lon, sin_lon, failed, put);
+                        continue;
+                    }
                     for (int col = 0; col < W; ++col) {
                         const auto p = dem_.index(col, row);
                         const auto v = vertex_of[p];
@@ -180,6 +200,27 @@ class VertexPlacer {
     }
 
   private:
+    // point() for a row of radii whose longitudes' cosines and sines are known.
+    template <class Put>
+    void place_radius_row(const std::vector<std::int32_t>& vertex_of, int row,
+                          const std::vector<double>& lon, const std::vector<double>& lat,
+                          const std::vector<double>& cos_lon, const std::vector<double>& sin_lon,
+                          std::vector<std::uint8_t>& failed, Put& put) const {
+        const int W = dem_.width;
+        const double cl = std::cos(lat[0] * kDegree), sl = std::sin(lat[0] * kDegree);
+        for (int col = 0; col < W; ++col) {
+            const auto v = vertex_of[dem_.index(col, row)];
+            if (v < 0) continue;
+            if (!std::isfinite(lon[std::size_t(col)]) || !std::isfinite(lat[std::size_t(col)])) {
+                failed[std::size_t(row)] = 1;
+                continue;
+            }
+            const double value = dem_.values[dem_.index(col, row)];
+            put(v, std::array<double, 3>{value * cl * cos_lon[std::size_t(col)],
+                                         value * cl * sin_lon[std::size_t(col)], value * sl});
+        }
+    }
+
     std::array<double, 3> point(int col, int row, double lon, double lat) const {
         const double value = dem_.values[dem_.index(col, row)];
         std::array<double, 3> out;
