@@ -854,8 +854,8 @@ void for_each_vertex(const TriangleMesh& mesh, const ShapeIndexOptions& options,
         return;
     }
     const GridLayout* disk_grid = disk ? &layout : nullptr;
-    // The rings window fits its vertices kFitLanes at a time (fit_curvatures_batch): runs of
-    // vertices with as many neighbours, as on a grid away from its edges and holes.
+    // The rings window fits its vertices kFitLanes at a time (fit_curvatures_batch; a lane
+    // with fewer neighbours than the others keeps its sums while they go on).
     const bool batched = !disk && !(options.radius > 0);
     const auto n = static_cast<std::int32_t>(mesh.vertex_count());
     tbb::enumerable_thread_specific<Scratch> scratch;
