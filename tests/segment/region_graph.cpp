@@ -322,3 +322,56 @@ TEST_CASE("Representative vertices are the deepest of one BFS, whatever the thre
                 CHECK(g.regions[r].representative_vertex == expected[r]);
         }
 }
+
+TEST_CASE("Boundary lengths are one pass's sums in triangle order, whatever the threads",
+          "[regions]") {
+    // The cut edges are counted on every thread and a released grid's crossing triangles are
+    // found by rows on every thread: each pair's count and length (a sum of doubles in
+    // triangle order) must be those of one pass over the triangles in order, to the bit, at
+    // one and two threads, triangles held or released.
+    const auto dem = io::read_dem(test::sample("vesta_hamo_tile.lbl"));
+    const auto t = test::segment_tile(dem, test::voronoi_cells(dem, 7, 5));
+    const auto& mesh = t.mesh;
+    using Point = std::array<double, 3>;
+    const auto mid = [](const Point& p, const Point& q) {
+        return Point{(p[0] + q[0]) / 2, (p[1] + q[1]) / 2, (p[2] + q[2]) / 2};
+    };
+    const auto dist = [](const Point& p, const Point& q) {
+        return std::hypot(p[0] - q[0], p[1] - q[1], p[2] - q[2]);
+    };
+    const auto key = [](std::uint32_t a, std::uint32_t b) {
+        return std::make_pair(std::min(a, b), std::max(a, b));
+    };
+    std::map<std::pair<std::uint32_t, std::uint32_t>, double> length;
+    for (const auto& tri : mesh.triangles) {
+        const std::uint32_t l[3] = {t.labels[std::size_t(tri[0])], t.labels[std::size_t(tri[1])],
+                                    t.labels[std::size_t(tri[2])]};
+        if (l[0] == l[1] && l[1] == l[2]) continue;
+        const Point p[3] = {mesh.position(std::size_t(tri[0])), mesh.position(std::size_t(tri[1])),
+                            mesh.position(std::size_t(tri[2]))};
+        const Point m[3] = {mid(p[0], p[1]), mid(p[1], p[2]), mid(p[2], p[0])};
+        if (l[0] != l[1] && l[1] != l[2] && l[2] != l[0]) {
+            const Point c = {(p[0][0] + p[1][0] + p[2][0]) / 3, (p[0][1] + p[1][1] + p[2][1]) / 3,
+                             (p[0][2] + p[1][2] + p[2][2]) / 3};
+            for (int k = 0; k < 3; ++k) length[key(l[k], l[(k + 1) % 3])] += dist(c, m[k]);
+            continue;
+        }
+        const int k = l[0] == l[1] ? 2 : (l[1] == l[2] ? 0 : 1);
+        length[key(l[k], l[(k + 1) % 3])] += dist(m[(k + 2) % 3], m[k]);
+    }
+    REQUIRE(length.size() > 50);
+    TriangleMesh released = mesh;
+    REQUIRE(released.release_triangles());
+    for (const TriangleMesh* m : {&mesh, static_cast<const TriangleMesh*>(&released)})
+        for (const int threads : {1, 2}) {
+            CAPTURE(threads, m == &released);
+            segment::RegionGraph g;
+            tbb::task_arena(threads).execute(
+                [&] { g = segment::region_graph(*m, t.field, t.labels, t.region_count, &t.dem); });
+            REQUIRE(g.edges.size() == length.size());
+            std::size_t differing = 0;
+            for (const auto& e : g.edges) differing += e.boundary_length_m != length[{e.a, e.b}];
+            CHECK(differing == 0);
+            check_graph({t.dem, *m, t.field, t.labels, t.region_count, g, {}});
+        }
+}

@@ -1,6 +1,7 @@
 #include "terrain/segment/regions.hpp"
 
 #include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
 
 #include <algorithm>
 #include <atomic>
@@ -161,23 +162,32 @@ std::vector<std::int32_t> representative_vertices(const TriangleMesh& mesh,
     return best;
 }
 
-// Boundary length and cut mesh edges per pair of labels (see RegionEdge).
+// Boundary length and cut mesh edges per pair of labels (see RegionEdge). The cut edges are
+// counted on every thread (whole numbers: any order gives the same counts). The lengths are
+// sums of doubles, each pair's in triangle order: a DEM mesh whose rows of blocks can be made
+// alone finds its triangles with corners in two or three regions on every thread, row by row,
+// and the lengths are then added in the order of the rows, each row's in its order: the
+// sums of one pass over the triangles.
 std::unordered_map<std::uint64_t, EdgeSums> boundary_sums(const TriangleMesh& mesh,
                                                           const std::vector<std::uint32_t>& labels,
                                                           const ProgressFn& progress) {
-    const detail::PassProgress by_vertex(progress, 0, 0.5, "regions"),
-        by_triangle(progress, 0.5, 1, "regions");
     std::unordered_map<std::uint64_t, EdgeSums> sums;
-    for (std::size_t v = 0; v < mesh.vertex_count(); ++v) {
-        by_vertex.at(v, mesh.vertex_count());
-        for (const auto nb : mesh.neighbors_of(v)) {
-            const auto w = static_cast<std::size_t>(nb);
-            if (w > v && labels[w] != labels[v]) ++sums[pair_key(labels[v], labels[w])].mesh_edges;
-        }
+    {
+        tbb::enumerable_thread_specific<std::unordered_map<std::uint64_t, std::size_t>> cuts;
+        detail::parallel_slices(mesh.vertex_count(), std::size_t{1} << 14, progress, 0, 0.5,
+                                "regions", [&](const tbb::blocked_range<std::size_t>& r) {
+                                    auto& mine = cuts.local();
+                                    for (std::size_t v = r.begin(); v < r.end(); ++v)
+                                        for (const auto nb : mesh.neighbors_of(v)) {
+                                            const auto w = static_cast<std::size_t>(nb);
+                                            if (w > v && labels[w] != labels[v])
+                                                ++mine[pair_key(labels[v], labels[w])];
+                                        }
+                                });
+        for (const auto& mine : cuts)
+            for (const auto& [key, count] : mine) sums[key].mesh_edges += count;
     }
-    const std::size_t nt = mesh.triangle_count();
-    detail::for_each_triangle(mesh, [&](std::size_t i, const std::array<std::int32_t, 3>& t) {
-        by_triangle.at(i, nt);
+    const auto add = [&](const std::array<std::int32_t, 3>& t) {
         const std::uint32_t l[3] = {labels[std::size_t(t[0])], labels[std::size_t(t[1])],
                                     labels[std::size_t(t[2])]};
         if (l[0] == l[1] && l[1] == l[2]) return;
@@ -196,6 +206,32 @@ std::unordered_map<std::uint64_t, EdgeSums> boundary_sums(const TriangleMesh& me
         // Two labels: the corner alone on its side is k; its two edges are k-1 and k.
         const int k = l[0] == l[1] ? 2 : (l[1] == l[2] ? 0 : 1);
         sums[pair_key(l[k], l[(k + 1) % 3])].length += distance(mid[(k + 2) % 3], mid[k]);
+    };
+    if (detail::rows_of_triangles(mesh) && mesh.grid_height > 1) {
+        const int rows = mesh.grid_height - 1;
+        std::vector<std::vector<std::array<std::int32_t, 3>>> crossing(
+            static_cast<std::size_t>(rows));
+        detail::parallel_slices(
+            rows, 1, progress, 0.5, 0.95, "regions", [&](const tbb::blocked_range<int>& r) {
+                for (int row = r.begin(); row < r.end(); ++row)
+                    detail::for_each_row_triangle(mesh, row, [&](const auto& t) {
+                        const auto a = labels[std::size_t(t[0])];
+                        if (labels[std::size_t(t[1])] != a || labels[std::size_t(t[2])] != a)
+                            crossing[std::size_t(row)].push_back(t);
+                    });
+            });
+        const detail::PassProgress added(progress, 0.95, 1, "regions");
+        for (int row = 0; row < rows; ++row) {
+            added.at(std::size_t(row), std::size_t(rows));
+            for (const auto& t : crossing[std::size_t(row)]) add(t);
+        }
+        return sums;
+    }
+    const detail::PassProgress by_triangle(progress, 0.5, 1, "regions");
+    const std::size_t nt = mesh.triangle_count();
+    detail::for_each_triangle(mesh, [&](std::size_t i, const std::array<std::int32_t, 3>& t) {
+        by_triangle.at(i, nt);
+        add(t);
     });
     return sums;
 }
