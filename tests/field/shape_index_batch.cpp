@@ -169,3 +169,28 @@ TEST_CASE("shape index: the rings window's curvatures are the one-vertex path's"
     CHECK(vertices > 50000);
     CHECK(differing == 0);
 }
+
+TEST_CASE("shape index: rings gathered with a small set of the vertices seen are gather_where's",
+          "[shape_index]") {
+    // The batches gather the vertices the grid does not give in order with a small set instead
+    // of a stamp per vertex: the same vertices in the same order, at 1 to 3 rings, poles (360
+    // neighbours on the global Moon) included.
+    std::size_t vertices = 0, differing = 0, largest = 0;
+    for (const auto& mesh : test_meshes()) {
+        field::detail::Scratch s;
+        field::detail::SmallVertexSet visited;
+        std::vector<std::int32_t> gathered;
+        for (int rings = 1; rings <= 3; ++rings)
+            for (std::int32_t v = 0; v < std::int32_t(mesh.vertex_count()); v += rings) {
+                field::detail::gather_where(
+                    mesh, v, rings, [](std::int32_t) { return true; }, s);
+                field::detail::gather_rings(mesh, v, rings, visited, gathered);
+                ++vertices;
+                differing += gathered != s.gathered;
+                largest = std::max(largest, gathered.size());
+            }
+    }
+    CHECK(vertices > 100000);
+    CHECK(largest > 700);  // a pole's two rings
+    CHECK(differing == 0);
+}

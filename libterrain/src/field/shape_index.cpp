@@ -250,6 +250,23 @@ bool fit_curvatures(const TriangleMesh& mesh, std::int32_t v, const Vec3& normal
     return solve_curvatures(e, out);
 }
 
+void gather_rings(const TriangleMesh& mesh, std::int32_t v, int rings, SmallVertexSet& visited,
+                  std::vector<std::int32_t>& gathered) {
+    visited.clear();
+    gathered.clear();
+    visited.insert(v);
+    gathered.push_back(v);
+    std::size_t begin = 0;
+    for (int ring = 0; ring < rings; ++ring) {
+        const std::size_t end = gathered.size();
+        if (begin == end) break;
+        for (std::size_t i = begin; i < end; ++i)
+            for (const auto w : mesh.neighbors_of(std::size_t(gathered[i])))
+                if (visited.insert(w)) gathered.push_back(w);
+        begin = end;
+    }
+}
+
 // Where v and each of its neighbours lie in the mesh's uniform ranges, each neighbour is the
 // vertex plus its direction's offset (TriangleMesh::neighbors_of), so the second ring's cells
 // are told apart by their pixel offset within the 5 x 5 pixels around v (a row of at least 5
@@ -791,18 +808,21 @@ std::size_t grid_for_each_vertex(const TriangleMesh& mesh, const GridLayout& g,
     return fallbacks.combine(std::plus<>()) + unowned.size();
 }
 
-// Lane buffers of fit_in_batches: each lane's neighbours.
+// Lane buffers of fit_in_batches: each lane's neighbours; the rings gathered on the mesh.
 struct BatchScratch {
     std::array<std::vector<std::int32_t>, kFitLanes> neighbours;
+    SmallVertexSet visited;
+    std::vector<std::int32_t> gathered;
 };
 
 // The rings window's vertices [begin, end) through `body`: each gathered as mesh_fit gathers
-// it, then fitted kFitLanes at a time (the last few one by one). Each vertex gets the bits
-// mesh_fit gives it.
+// it (off the grid, or on the mesh with a small set of the vertices seen instead of a stamp
+// per vertex of the mesh: 4 bytes a vertex a thread less), then fitted kFitLanes at a time
+// (the last few one by one). Each vertex gets the bits mesh_fit gives it.
 template <class Body>
 void fit_in_batches(const TriangleMesh& mesh, const std::vector<Vec3>& normals,
                     const ShapeIndexOptions& options, std::int32_t begin, std::int32_t end,
-                    Scratch& s, BatchScratch& lanes, Body& body) {
+                    BatchScratch& lanes, Body& body) {
     FitBatch batch;
     std::size_t filled = 0;
     const bool two_rings = options.rings == 2;
@@ -811,8 +831,8 @@ void fit_in_batches(const TriangleMesh& mesh, const std::vector<Vec3>& normals,
         if (two_rings && gather_two_rings_on_grid(mesh, v, own)) {
             own.erase(own.begin());  // (v itself)
         } else {
-            gather(mesh, v, options, s);
-            own.assign(s.gathered.begin() + 1, s.gathered.end());
+            gather_rings(mesh, v, options.rings, lanes.visited, lanes.gathered);
+            own.assign(lanes.gathered.begin() + 1, lanes.gathered.end());
         }
         batch.vertex[filled] = v;
         batch.neighbours[filled] = own.data();
@@ -864,12 +884,11 @@ void for_each_vertex(const TriangleMesh& mesh, const ShapeIndexOptions& options,
     for (std::int32_t start = 0; start < n; start += chunk) {
         const std::int32_t stop = std::min(n, start + chunk);
         tbb::parallel_for(tbb::blocked_range<std::int32_t>(start, stop, 512), [&](const auto& r) {
-            Scratch& s = scratch.local();
             if (batched) {
-                fit_in_batches(mesh, normals, options, r.begin(), r.end(), s, batches.local(),
-                               body);
+                fit_in_batches(mesh, normals, options, r.begin(), r.end(), batches.local(), body);
                 return;
             }
+            Scratch& s = scratch.local();
             for (std::int32_t v = r.begin(); v < r.end(); ++v) {
                 PrincipalCurvatures k;
                 double scale = 0;

@@ -184,6 +184,48 @@ void fit_curvatures_batch(const TriangleMesh& mesh, const FitBatch& batch,
                           std::array<PrincipalCurvatures, kFitLanes>& out,
                           std::array<double, kFitLanes>& scale, std::array<bool, kFitLanes>& ok);
 
+// A set of vertex ids that holds what one vertex's rings hold (an open-addressing table, its
+// room doubled as it fills, emptied entry by entry): gather_rings' visited vertices, instead
+// of a stamp per vertex of the mesh on each thread.
+class SmallVertexSet {
+  public:
+    // Whether v was not there (it is now).
+    bool insert(std::int32_t v) {
+        if (2 * (used_.size() + 1) > slots_.size()) grow();
+        for (std::size_t h = slot_of(v);; h = (h + 1) & (slots_.size() - 1)) {
+            if (slots_[h] == v) return false;
+            if (slots_[h] < 0) {
+                slots_[h] = v;
+                used_.push_back(h);
+                return true;
+            }
+        }
+    }
+    void clear() {
+        for (const std::size_t h : used_) slots_[h] = -1;
+        used_.clear();
+    }
+
+  private:
+    std::size_t slot_of(std::int32_t v) const {
+        return (std::uint32_t(v) * 2654435761u) & (slots_.size() - 1);
+    }
+    void grow() {
+        std::vector<std::int32_t> held;
+        for (const std::size_t h : used_) held.push_back(slots_[h]);
+        slots_.assign(std::max<std::size_t>(64, 2 * slots_.size()), -1);
+        used_.clear();
+        for (const std::int32_t v : held) insert(v);
+    }
+    std::vector<std::int32_t> slots_;
+    std::vector<std::size_t> used_;
+};
+
+// v and `rings` rings of its neighbours (gathered[0] is v), in gather_where's order, with
+// `visited` for the vertices seen.
+void gather_rings(const TriangleMesh& mesh, std::int32_t v, int rings, SmallVertexSet& visited,
+                  std::vector<std::int32_t>& gathered);
+
 // v and its two rings of neighbours in the order gather_where gives them (rings = 2), read off
 // a DEM mesh's grid directions without a stamp per vertex; false (`out` unfinished) where the
 // grid does not give them in order (near NoData, the seam, poles, pinches, the grid's first
