@@ -75,6 +75,22 @@ void check_graph(const test::SegmentedTile& t) {
         CHECK(g.regions[i].neighbor_count == degree[i]);
 }
 
+// f(graph, mesh) for region_graph on t's labels at one and two threads, t's mesh with its
+// triangles held and released.
+template <class F>
+void for_each_region_graph(const test::SegmentedTile& t, F&& f) {
+    TriangleMesh released = t.mesh;
+    REQUIRE(released.release_triangles());
+    for (const TriangleMesh* m : {&t.mesh, static_cast<const TriangleMesh*>(&released)})
+        for (const int threads : {1, 2}) {
+            CAPTURE(threads, m == &released);
+            segment::RegionGraph g;
+            tbb::task_arena(threads).execute(
+                [&] { g = segment::region_graph(*m, t.field, t.labels, t.region_count, &t.dem); });
+            f(g, *m);
+        }
+}
+
 }  // namespace
 
 TEST_CASE("landform classes follow Koenderink's intervals on [0,100]", "[regions]") {
@@ -310,17 +326,10 @@ TEST_CASE("Representative vertices are the deepest of one BFS, whatever the thre
     }
     REQUIRE(t.region_count == 35);
     REQUIRE(*std::max_element(depth.begin(), depth.end()) > 10);
-    TriangleMesh released = mesh;
-    REQUIRE(released.release_triangles());
-    for (const TriangleMesh* m : {&mesh, static_cast<const TriangleMesh*>(&released)})
-        for (const int threads : {1, 2}) {
-            CAPTURE(threads, m == &released);
-            segment::RegionGraph g;
-            tbb::task_arena(threads).execute(
-                [&] { g = segment::region_graph(*m, t.field, t.labels, t.region_count, &t.dem); });
-            for (std::uint32_t r = 0; r < t.region_count; ++r)
-                CHECK(g.regions[r].representative_vertex == expected[r]);
-        }
+    for_each_region_graph(t, [&](const segment::RegionGraph& g, const TriangleMesh&) {
+        for (std::uint32_t r = 0; r < t.region_count; ++r)
+            CHECK(g.regions[r].representative_vertex == expected[r]);
+    });
 }
 
 TEST_CASE("Boundary lengths are one pass's sums in triangle order, whatever the threads",
@@ -360,18 +369,11 @@ TEST_CASE("Boundary lengths are one pass's sums in triangle order, whatever the 
         length[key(l[k], l[(k + 1) % 3])] += dist(m[(k + 2) % 3], m[k]);
     }
     REQUIRE(length.size() > 50);
-    TriangleMesh released = mesh;
-    REQUIRE(released.release_triangles());
-    for (const TriangleMesh* m : {&mesh, static_cast<const TriangleMesh*>(&released)})
-        for (const int threads : {1, 2}) {
-            CAPTURE(threads, m == &released);
-            segment::RegionGraph g;
-            tbb::task_arena(threads).execute(
-                [&] { g = segment::region_graph(*m, t.field, t.labels, t.region_count, &t.dem); });
-            REQUIRE(g.edges.size() == length.size());
-            std::size_t differing = 0;
-            for (const auto& e : g.edges) differing += e.boundary_length_m != length[{e.a, e.b}];
-            CHECK(differing == 0);
-            check_graph({t.dem, *m, t.field, t.labels, t.region_count, g, {}});
-        }
+    for_each_region_graph(t, [&](const segment::RegionGraph& g, const TriangleMesh& m) {
+        REQUIRE(g.edges.size() == length.size());
+        std::size_t differing = 0;
+        for (const auto& e : g.edges) differing += e.boundary_length_m != length[{e.a, e.b}];
+        CHECK(differing == 0);
+        check_graph({t.dem, m, t.field, t.labels, t.region_count, g, {}});
+    });
 }

@@ -253,18 +253,9 @@ bool fit_curvatures(const TriangleMesh& mesh, std::int32_t v, const Vec3& normal
 void gather_rings(const TriangleMesh& mesh, std::int32_t v, int rings, SmallVertexSet& visited,
                   std::vector<std::int32_t>& gathered) {
     visited.clear();
-    gathered.clear();
-    visited.insert(v);
-    gathered.push_back(v);
-    std::size_t begin = 0;
-    for (int ring = 0; ring < rings; ++ring) {
-        const std::size_t end = gathered.size();
-        if (begin == end) break;
-        for (std::size_t i = begin; i < end; ++i)
-            for (const auto w : mesh.neighbors_of(std::size_t(gathered[i])))
-                if (visited.insert(w)) gathered.push_back(w);
-        begin = end;
-    }
+    gather_breadth_first(
+        mesh, v, rings, [](std::int32_t) { return true; },
+        [&](std::int32_t w) { return visited.insert(w); }, gathered);
 }
 
 // Where v and each of its neighbours lie in the mesh's uniform ranges, each neighbour is the

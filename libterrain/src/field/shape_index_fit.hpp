@@ -38,7 +38,29 @@ struct Scratch {
 };
 
 // The neighbourhood of v (gathered[0] is v itself): the vertices `inside` takes, reached
-// from v through vertices it takes, within `rings` rings of mesh edges (< 0: any number).
+// from v through vertices it takes, within `rings` rings of mesh edges (< 0: any number),
+// breadth first, each neighbour's list in its order. first_seen(w) says whether w is met for
+// the first time (and remembers it); v is met first.
+template <class Inside, class FirstSeen>
+void gather_breadth_first(const TriangleMesh& mesh, std::int32_t v, int rings, const Inside& inside,
+                          FirstSeen&& first_seen, std::vector<std::int32_t>& gathered) {
+    gathered.clear();
+    first_seen(v);
+    gathered.push_back(v);
+    std::size_t begin = 0;
+    for (int ring = 0; rings < 0 || ring < rings; ++ring) {
+        const std::size_t end = gathered.size();
+        if (begin == end) break;
+        for (std::size_t i = begin; i < end; ++i) {
+            const auto u = gathered[i];
+            for (const auto w : mesh.neighbors_of(std::size_t(u)))
+                if (first_seen(w) && inside(w)) gathered.push_back(w);
+        }
+        begin = end;
+    }
+}
+
+// gather_breadth_first with a stamp per vertex of the mesh (s.stamp) for the vertices met.
 template <class Inside>
 void gather_where(const TriangleMesh& mesh, std::int32_t v, int rings, const Inside& inside,
                   Scratch& s) {
@@ -47,23 +69,14 @@ void gather_where(const TriangleMesh& mesh, std::int32_t v, int rings, const Ins
         std::fill(s.stamp.begin(), s.stamp.end(), 0);
         s.current = 1;
     }
-    s.gathered.clear();
-    s.stamp[v] = s.current;
-    std::size_t begin = 0;
-    s.gathered.push_back(v);
-    for (int ring = 0; rings < 0 || ring < rings; ++ring) {
-        const std::size_t end = s.gathered.size();
-        if (begin == end) break;
-        for (std::size_t i = begin; i < end; ++i) {
-            const auto u = s.gathered[i];
-            for (const auto w : mesh.neighbors_of(std::size_t(u))) {
-                if (s.stamp[w] == s.current) continue;
-                s.stamp[w] = s.current;
-                if (inside(w)) s.gathered.push_back(w);
-            }
-        }
-        begin = end;
-    }
+    gather_breadth_first(
+        mesh, v, rings, inside,
+        [&](std::int32_t w) {
+            if (s.stamp[std::size_t(w)] == s.current) return false;
+            s.stamp[std::size_t(w)] = s.current;
+            return true;
+        },
+        s.gathered);
 }
 
 struct GridLayout {

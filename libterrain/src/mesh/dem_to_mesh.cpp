@@ -200,6 +200,12 @@ class VertexPlacer {
     }
 
   private:
+    // Radii are distances from the centre along the geocentric direction.
+    static std::array<double, 3> along_radius(double value, double cos_lat, double sin_lat,
+                                              double cos_lon, double sin_lon) {
+        return {value * cos_lat * cos_lon, value * cos_lat * sin_lon, value * sin_lat};
+    }
+
     // point() for a row of radii whose longitudes' cosines and sines are known.
     template <class Put>
     void place_radius_row(const std::vector<std::int32_t>& vertex_of, int row,
@@ -215,9 +221,8 @@ class VertexPlacer {
                 failed[std::size_t(row)] = 1;
                 continue;
             }
-            const double value = dem_.values[dem_.index(col, row)];
-            put(v, std::array<double, 3>{value * cl * cos_lon[std::size_t(col)],
-                                         value * cl * sin_lon[std::size_t(col)], value * sl});
+            put(v, along_radius(dem_.values[dem_.index(col, row)], cl, sl,
+                                cos_lon[std::size_t(col)], sin_lon[std::size_t(col)]));
         }
     }
 
@@ -226,10 +231,8 @@ class VertexPlacer {
         std::array<double, 3> out;
         if (frame_ == MeshFrame::body) {
             if (dem_.elevation == ElevationKind::radius) {
-                // Radii are distances from the centre along the geocentric direction.
-                const double cl = std::cos(lat * kDegree);
-                out = {value * cl * std::cos(lon * kDegree), value * cl * std::sin(lon * kDegree),
-                       value * std::sin(lat * kDegree)};
+                out = along_radius(value, std::cos(lat * kDegree), std::sin(lat * kDegree),
+                                   std::cos(lon * kDegree), std::sin(lon * kDegree));
             } else {
                 earth_->Forward(lat, lon, value, out[0], out[1], out[2]);
             }
