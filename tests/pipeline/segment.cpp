@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <set>
 #include <string>
+#include <tuple>
 
 #include "support/test_meshes.hpp"
 #include "support/test_support.hpp"
@@ -93,8 +94,13 @@ TEST_CASE("pipeline::segment gives the DEM back bit for bit, floats or not", "[p
     // a metre on a Moon radius); either way the growing and the outputs see the same numbers.
     // With a hole (a Reeb graph with a loop) and without (a tree: the field is parked once the
     // Reeb graph's events are ordered).
-    for (const auto& [step, hole] : {std::pair{0.5, true}, {0.1, true}, {0.5, false}}) {
-        INFO("step " << step << (hole ? ", a hole" : ", no hole"));
+    // The height field reads the DEM: it is parked after it.
+    for (const auto& [step, hole, field] : {std::tuple{0.5, true, "shape-index"},
+                                            {0.1, true, "shape-index"},
+                                            {0.5, false, "shape-index"},
+                                            {0.5, false, "height"},
+                                            {0.1, true, "height"}}) {
+        INFO("step " << step << (hole ? ", a hole, " : ", no hole, ") << field);
         const Dem dem = test::grid_dem(90, 70, [&](int c, int r) {
             if (hole && (c - 30) * (c - 30) + (r - 20) * (r - 20) < 40) return std::nan("");
             return 1737400.0 + step * std::round(40 * std::sin(c * 0.2) * std::cos(r * 0.15) +
@@ -105,6 +111,7 @@ TEST_CASE("pipeline::segment gives the DEM back bit for bit, floats or not", "[p
         parking.park_min_bytes = 0;
         parking.park_directory = test::scratch_dir("pipeline_parked").string();
         holding.park_min_bytes = SIZE_MAX;
+        parking.field = holding.field = field;
         const auto result = pipeline::segment(pipeline::input_from_dem(dem, "map"), parking);
         REQUIRE(result.dem());
         const auto& back = result.dem()->values;
@@ -115,8 +122,12 @@ TEST_CASE("pipeline::segment gives the DEM back bit for bit, floats or not", "[p
         // are), the field, the pixel maps, the directions, the vertices' areas, the Reeb
         // graph's vertices' nodes.
         const std::size_t n = dem.values.size(), nv = result.input.mesh.vertex_count();
-        CHECK(result.parked_bytes ==
-              (step == 0.5 ? 4 : 8) * n + 4 * nv + 4 * n + 4 * nv + nv + 4 * nv + 4 * nv);
+        const std::size_t dem_bytes = (step == 0.5 ? 4 : 8) * n;
+        CHECK(result.parked_bytes == dem_bytes + 4 * nv + 4 * n + 4 * nv + nv + 4 * nv + 4 * nv);
+        // The DEM waits on disk through the field (which does not read it) and through the
+        // growing, alone each time.
+        CHECK(result.parked_field == (std::string(field) == "height" ? 0 : dem_bytes));
+        CHECK(result.parked_growing == dem_bytes);
         const auto held = pipeline::segment(pipeline::input_from_dem(dem, "map"), holding);
         CHECK(result.label_pixels() == held.label_pixels());
         CHECK(result.field == held.field);
@@ -132,6 +143,8 @@ TEST_CASE("pipeline::segment gives the DEM back bit for bit, floats or not", "[p
         CHECK(result.after.critical == held.after.critical);
         CHECK(result.critical_before == held.critical_before);
         CHECK(held.parked_bytes == 0);
+        CHECK(held.parked_field == 0);
+        CHECK(held.parked_growing == 0);
         CHECK(std::distance(fs::directory_iterator(parking.park_directory), {}) == 0);
     }
 }

@@ -30,6 +30,7 @@ ParkedArrays::~ParkedArrays() {
 }
 
 void ParkedArrays::decide(std::size_t bytes) {
+    decided_ = true;
     if (fd_ >= 0 || bytes == 0 || bytes < min_bytes_) return;
     std::error_code ec;
     std::string dir = dir_;

@@ -33,6 +33,7 @@ class ParkedArrays {
     // Decides, from the bytes the arrays to be parked hold in all, whether to park them: when
     // they reach min_bytes and the file can be made.
     void decide(std::size_t bytes);
+    bool decided() const { return decided_; }
     // Whether parking is on.
     bool on() const { return fd_ >= 0 && !full_; }
 
@@ -73,6 +74,7 @@ class ParkedArrays {
     std::size_t min_bytes_;
     int fd_ = -1;
     bool full_ = false;      // a write failed: nothing more is parked
+    bool decided_ = false;   // decide() was called
     std::uint64_t end_ = 0;  // the file's length
     std::vector<Entry> entries_;
 };

@@ -259,21 +259,24 @@ ScaleResult grow_scale(const Input& input, const std::vector<float>& field,
     return out;
 }
 
-// The DEM's values held as floats while the Reeb graph and the simplification run, which do
-// not read them, when every value is one exactly (16- and 32-bit samples, and integers times
-// a power of two below 2^24 of them): 4 bytes a pixel less at the peak. They are doubles
-// again, the same numbers, before the growing; a DEM with a value no float holds keeps its
-// doubles.
+// The DEM's values held as floats while the stages that do not read them run, when every
+// value is one exactly (16- and 32-bit samples, and integers times a power of two below 2^24
+// of them): 4 bytes a pixel less. They are doubles again, the same numbers, where they are
+// read (the placing of the positions, the region graph's points); a DEM with a value no float
+// holds keeps its doubles. Packed again later, the values are not checked again.
 class PackedHeights {
   public:
     void pack(Dem& dem, const ProgressFn& progress) {
         const std::size_t n = dem.values.size();
         const detail::PassProgress checked(progress, 0, 0.4, "mesh"),
             packed(progress, 0.4, 1, "mesh");
-        for (std::size_t i = 0; i < n; ++i) {
-            checked.at(i, n);
-            const double v = dem.values[i];
-            if (!std::isnan(v) && static_cast<double>(static_cast<float>(v)) != v) return;
+        if (!exact_) {
+            for (std::size_t i = 0; i < n; ++i) {
+                checked.at(i, n);
+                const double v = dem.values[i];
+                if (!std::isnan(v) && static_cast<double>(static_cast<float>(v)) != v) return;
+            }
+            exact_ = true;
         }
         values_.reserve(n);
         for (std::size_t i = 0; i < n; ++i) {
@@ -310,6 +313,7 @@ class PackedHeights {
   private:
     std::vector<float> values_;
     bool packed_ = false;
+    bool exact_ = false;  // every value is a float
 };
 
 }  // namespace
@@ -348,34 +352,49 @@ SegmentResult segment(Input input, const SegmentOptions& options, const Progress
     // field, which it precedes.)
     auto& mesh = result.input.mesh;
     const auto tf = clock::now();
-    const bool tree = field::parse_field_kind(options.field) != field::FieldKind::sdf &&
-                      mesh.triangles_releasable() &&
+    const auto kind = field::parse_field_kind(options.field);
+    const bool tree = kind != field::FieldKind::sdf && mesh.triangles_releasable() &&
                       reeb::reeb_is_tree(mesh, scaled_progress(progress, 0, 0.02));
     if (tree) mesh.release_triangles();
     result.add_time("field", since(tf));
-    compute_field(result, options, scaled_progress(progress, 0.02, 0.2));
+    // The DEM's values (as floats when they all are floats), then the field and the mesh's
+    // pixel maps, wait unread through the stages that do not read them: parked on disk
+    // (parked_arrays.hpp; docs/performance.md, "Arrays parked on disk") when large. The DEM
+    // waits from before the field (only the height field reads it) to the placing of the
+    // positions, and again through the growing.
+    PackedHeights packed;
+    internal::ParkedArrays parked(options.park_directory, options.park_min_bytes);
+    // The DEM's values held as floats when they can be, and parked; the first time, whether
+    // to park at all is decided on what all the arrays parked through the run hold (the
+    // field is a float a vertex).
+    const auto hold_dem = [&](const ProgressFn& held) {
+        Dem& dem = *result.input.dem;
+        packed.pack(dem, scaled_progress(held, 0, 0.5));
+        if (!parked.decided())
+            parked.decide(packed.bytes(dem) +
+                          sizeof(float) * (mesh.vertex_count() + mesh.vertex_areas.size()) +
+                          sizeof(std::int32_t) *
+                              (mesh.pixel_vertex.size() + mesh.vertex_pixel.size()) +
+                          mesh.neighbor_directions.size());
+        if (!packed.park(parked, scaled_progress(held, 0.5, 1)))
+            parked.park(dem.values, held, 0.5, 1);
+    };
+    const bool field_reads_dem = kind == field::FieldKind::height;
+    if (result.input.dem && !field_reads_dem) hold_dem(scaled_progress(progress, 0.02, 0.03));
+    result.parked_field = parked.parked_bytes();
+    compute_field(
+        result, options,
+        scaled_progress(progress, field_reads_dem ? 0.02 : 0.03, field_reads_dem ? 0.19 : 0.2));
     // A DEM mesh frees its positions (12 bytes a vertex) while the Reeb graph and the
     // simplification run, which do not read them, and places them again before the growing:
     // the same floats (docs/mesh.md, "Positions freed and placed again").
     const bool placed_again = result.input.dem && mesh.release_positions();
-    // The DEM's values, then the field and the mesh's pixel maps, wait unread through the Reeb
-    // graph and the simplification, which hold the run's peak of memory: they are parked on
-    // disk (parked_arrays.hpp; docs/performance.md, "Arrays parked on disk") when large.
-    PackedHeights packed;
-    internal::ParkedArrays parked(options.park_directory, options.park_min_bytes);
     const auto tp = clock::now();
     if (result.input.dem) {
-        Dem& dem = *result.input.dem;
-        packed.pack(dem, scaled_progress(progress, 0.2, 0.205));
-        parked.decide(packed.bytes(dem) +
-                      sizeof(float) * (result.field.size() + mesh.vertex_areas.size()) +
-                      sizeof(std::int32_t) * (mesh.pixel_vertex.size() + mesh.vertex_pixel.size()) +
-                      mesh.neighbor_directions.size());
-        if (!packed.park(parked, scaled_progress(progress, 0.205, 0.208)))
-            parked.park(dem.values, progress, 0.205, 0.208);
+        if (field_reads_dem) hold_dem(scaled_progress(progress, 0.19, 0.2));
         // The vertices' areas wait through the Reeb graph, which does not read them (the
         // simplification does).
-        parked.park(mesh.vertex_areas, progress, 0.208, 0.21);
+        parked.park(mesh.vertex_areas, progress, 0.2, 0.21);
     }
     result.add_time("reeb", since(tp));  // (which it precedes: the times stay in run order)
     // The field waits on disk too once the Reeb graph's events are ordered (the contour tree
@@ -421,13 +440,18 @@ SegmentResult segment(Input input, const SegmentOptions& options, const Progress
     parked.restore(mesh.vertex_pixel, progress, 0.601, 0.602);
     parked.restore(mesh.pixel_vertex, progress, 0.602, 0.603);
     parked.restore(result.field, progress, 0.603, 0.604);
-    if (result.input.dem) {
-        parked.restore(result.input.dem->values, progress, 0.604, 0.605);
-        packed.restore(parked, scaled_progress(progress, 0.604, 0.605));
-        packed.unpack(*result.input.dem, scaled_progress(progress, 0.605, 0.61));
-    }
+    // The DEM back as doubles for the placing of the positions, then waiting again through
+    // the growing, which does not read it; back for the region graph's points.
+    const auto restore_dem = [&](const ProgressFn& back) {
+        parked.restore(result.input.dem->values, back, 0, 0.2);
+        packed.restore(parked, scaled_progress(back, 0, 0.2));
+        packed.unpack(*result.input.dem, scaled_progress(back, 0.2, 1));
+    };
+    if (result.input.dem) restore_dem(scaled_progress(progress, 0.604, 0.61));
     if (placed_again)
-        mesh::restore_positions(*result.input.dem, mesh, scaled_progress(progress, 0.61, 0.62));
+        mesh::restore_positions(*result.input.dem, mesh, scaled_progress(progress, 0.61, 0.615));
+    if (result.input.dem && parked.on()) hold_dem(scaled_progress(progress, 0.615, 0.62));
+    result.parked_growing = parked.parked_bytes();
     const double placing = since(t2);
     auto scale = grow_scale(result.input, result.field, options, simplified, seconds,
                             scaled_progress(progress, 0.62, 0.9));
@@ -436,9 +460,10 @@ SegmentResult segment(Input input, const SegmentOptions& options, const Progress
     result.divided = scale.divided;
     result.add_time("simplify", scale.simplify_seconds);
     const auto t1 = clock::now();
+    if (result.input.dem) restore_dem(scaled_progress(progress, 0.9, 0.905));
     result.regions = segment::region_graph(
         result.input.mesh, result.field, result.segmentation.labels,
-        result.segmentation.region_count, result.dem(), scaled_progress(progress, 0.9, 1));
+        result.segmentation.region_count, result.dem(), scaled_progress(progress, 0.905, 1));
     // On a DEM, with the regions of valid pixels in no triangle (segment::label_pixels).
     result.segmentation.region_count = static_cast<std::uint32_t>(result.regions.regions.size());
     result.add_time("grow", placing + scale.grow_seconds + since(t1));
@@ -567,6 +592,8 @@ void write_run_json(const SegmentResult& result, const std::string& input_path,
         .field("absorbed_vertices", result.divided.absorbed)
         .field("absorbed_relabelled", result.divided.relabelled)
         .field("parked_bytes", result.parked_bytes)
+        .field("parked_bytes_field", result.parked_field)
+        .field("parked_bytes_growing", result.parked_growing)
         .end_object();
     j.key("timings_seconds").begin_object();
     double total = 0;

@@ -140,7 +140,9 @@ struct SegmentResult {
     std::vector<float> field;         // per mesh vertex, as computed
     std::size_t critical_before = 0;  // critical nodes of the unsimplified Reeb graph
     std::size_t parked_bytes = 0;     // the most bytes parked on disk at once (segment())
-    reeb::ReebSummary after;          // the simplified graph of the segmentation
+    // Bytes parked while the field is computed and while the regions are grown (segment()).
+    std::size_t parked_field = 0, parked_growing = 0;
+    reeb::ReebSummary after;  // the simplified graph of the segmentation
     // Its region_count counts every region of the table: on a DEM, after the vertices'
     // regions, those of valid pixels in no triangle (segment::label_pixels).
     segment::Segmentation segmentation;
