@@ -479,6 +479,8 @@ RegionGraph region_graph(const TriangleMesh& mesh, const std::vector<float>& fie
                 if (r.pixel_count++ == 0) first_pixel[l - 1] = dem->index(col, row);
                 r.area_m2 += pixel_area(col, row);
             }
+        // (Not read again: 4 bytes a pixel less through the representatives and boundaries.)
+        std::vector<std::uint32_t>().swap(pixels);
     }
 
     report_progress(progress, 0.5, "regions");
