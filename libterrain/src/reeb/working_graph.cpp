@@ -153,6 +153,15 @@ double node_area(const TriangleMesh& mesh, const ReebGraph& g, std::size_t n,
     return s;
 }
 
+// Whether every node's vertex list is ascending (node_area's order).
+bool lists_ascending(const ReebGraph& g) {
+    for (std::size_t n = 0; n + 1 < g.node_vertex_offsets.size(); ++n)
+        if (!std::is_sorted(g.node_vertices.data() + g.node_vertex_offsets[n],
+                            g.node_vertices.data() + g.node_vertex_offsets[n + 1]))
+            return false;
+    return true;
+}
+
 }  // namespace
 
 WorkingGraph::WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big_degree,
@@ -191,17 +200,39 @@ WorkingGraph::WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big
     }
     critical_count_ = 0;
     for (const i32 i : node_map_) critical_count_ += i < 0;
-    // (Large blocks, made a slice at a time: their first touch is slow, docs/performance.md.)
-    detail::assign_in_slices(critical_, idx(critical_count_), CriticalNode{},
-                             PassProgress(progress, 0.1, 0.2, "simplify"));
+    // The regular nodes' records are written in list order, at random: made whole first (a
+    // slice at a time: a large block's first touch is slow, docs/performance.md). The
+    // critical nodes' are written in order by the nodes' pass: their pages are touched as it
+    // goes, while the input's node arrays it has read are given back behind it.
     detail::assign_in_slices(regular_, nl, RegularNode{},
-                             PassProgress(progress, 0.2, 0.25, "simplify"));
+                             PassProgress(progress, 0.1, 0.25, "simplify"));
+    critical_.reserve(idx(critical_count_));
+    // Whether write_result makes the vertex lists again from the vertices' nodes (every list
+    // ascending): then the lists are not read after this pass either.
+    if (owned)
+        lists_from_vertex_nodes_ =
+            owned->vertex_nodes.size() == input_vertices_ && lists_ascending(g);
+    detail::PagesBehind values_behind, kinds_behind, offsets_behind, lists_behind;
+    if (owned) {
+        values_behind = detail::PagesBehind(g.node_values.data());
+        kinds_behind = detail::PagesBehind(g.node_kinds.data());
+        if (lists_from_vertex_nodes_) {
+            offsets_behind = detail::PagesBehind(g.node_vertex_offsets.data());
+            lists_behind = detail::PagesBehind(g.node_vertices.data());
+        }
+    }
     total_area_ = 0;
     std::vector<i32> scratch;
     bool sorted = true;  // every node's vertex list ascending
     i32 k = 0;
     for (std::size_t n = 0; n < nn; ++n) {
         nodes.at(n, nn);
+        if ((n & 0x3fff) == 0) {  // (what nodes before n held is read for the last time)
+            values_behind.before(g.node_values.data() + n);
+            kinds_behind.before(g.node_kinds.data() + n);
+            offsets_behind.before(g.node_vertex_offsets.data() + n);
+            lists_behind.before(g.node_vertices.data() + g.node_vertex_offsets[n]);
+        }
         if (n + kAhead < nn) {
             const std::size_t m = n + kAhead;
             const i32 i = g.node_vertex_offsets[m];
@@ -212,9 +243,10 @@ WorkingGraph::WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big
         const double area = node_area(mesh, g, n, scratch, sorted);
         total_area_ += area;
         if (node_map_[n] < 0) {
-            critical_[idx(k)].area = area;
-            critical_[idx(k)].value = g.node_values[n];
-            critical_[idx(k)].flags = g.node_kinds[n] != NodeKind::regular ? kCritical : 0;
+            CriticalNode& c = critical_.emplace_back();
+            c.area = area;
+            c.value = g.node_values[n];
+            c.flags = g.node_kinds[n] != NodeKind::regular ? kCritical : 0;
             node_map_[n] = k++;
         } else {
             regular_[idx(node_map_[n])].area = area;
@@ -228,7 +260,8 @@ WorkingGraph::WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big
         detail::release(owned->node_values);
         detail::release(owned->node_kinds);
         // The vertex lists or the vertices' nodes, whichever write_result will not read.
-        lists_from_vertex_nodes_ = sorted && owned->vertex_nodes.size() == input_vertices_;
+        if (lists_from_vertex_nodes_ != (sorted && owned->vertex_nodes.size() == input_vertices_))
+            throw Error("simplify", "internal: the vertex lists' order changed during the copy");
         if (lists_from_vertex_nodes_) {
             detail::release(owned->node_vertices);
             detail::release(owned->node_vertex_offsets);
