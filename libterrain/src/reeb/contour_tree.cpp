@@ -105,6 +105,10 @@ bool contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& prog
     std::vector<LinkCounts> vertex_links;
     std::vector<LinkReps> reps =
         link_components(mesh, g, vertex_links, general, scaled_progress(progress, 0.2, 0.3));
+    // Node e's upper representatives once the join sweep has moved them (below).
+    const auto upper_reps = [&](std::size_t e) -> std::array<i32, 2>& {
+        return e % 2 == 0 ? reps[e / 2].lower : reps[e / 2].upper;
+    };
 
     // Each event's parent in the join tree (below it) and in the split tree (above it).
     // (Large blocks made a slice at a time, the sweeps' own too: their first touch is slow,
@@ -112,9 +116,8 @@ bool contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& prog
     const auto made = [&](double from) {
         return detail::PassProgress(progress, from, from, "reeb: join and split trees");
     };
-    std::vector<i32> join_parent, split_parent;
+    std::vector<i32> join_parent, split_parent;  // (the split tree's made after the join sweep)
     detail::assign_in_slices(join_parent, nn, kNone, made(0.3));
-    detail::assign_in_slices(split_parent, nn, kNone, made(0.3));
     // Children in the join and split trees. The sweeps run in opposite directions, so they
     // share cache lines only where they cross.
     std::vector<std::array<i32, 2>> children;
@@ -164,8 +167,7 @@ bool contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& prog
             return r;
         };
         auto reps_at = [&](std::size_t k) -> const std::array<i32, 2>& {
-            const std::size_t e = ascending ? k : nn - 1 - k;
-            return ascending ? reps[e].lower : reps[e].upper;
+            return ascending ? reps[k].lower : upper_reps(nn - 1 - k);
         };
         // Paths are short: two steps up without branching, then the rare longer path.
         auto find_short = [&](i32 x) {
@@ -244,6 +246,15 @@ bool contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& prog
         }
     };
     sweep(true, join_parent);
+    // The join sweep has read the lower representatives for the last time: the upper ones move
+    // to the array's first half, in order (node e's to the e-th pair of it: each lands where a
+    // node before it was, already moved), and the second half's pages go back to the system,
+    // 8 bytes a node less through the split sweep.
+    for (std::size_t e = 0; e < nn; ++e) upper_reps(e) = reps[e].upper;
+    detail::PagesBehind(reps.data() + (nn + 1) / 2).before(reps.data() + nn);
+    detail::assign_in_slices(
+        split_parent, nn, kNone,
+        made(0.3 + 0.3 * double(swept_events.load()) / double(std::max<std::size_t>(1, 2 * nn))));
     sweep(false, split_parent);
     detail::release(swept);
     detail::release(reps);  // (16 bytes a node: what the arcs below are made beside)
