@@ -83,13 +83,14 @@ class LargeBlocks {
         const std::lock_guard lock(mutex_);
         const std::size_t i = used_.find(static_cast<char*>(p));
         if (i == Slots) return false;
-        const Block b = used_.take(i);
+        Block b = used_.take(i);
         if (kept_.full()) {
             unmap(b);
             fit(0);
         } else {
+            const std::size_t held = settle(b);
             kept_.add(b);
-            fit(0, b.touched);  // (the peak counts it as held: it was, up to now)
+            fit(0, held);  // (the peak counts it as held: it was, up to now)
         }
         return true;
     }
@@ -260,6 +261,39 @@ class LargeBlocks {
     }
 
     static void unmap(Block b) { ::munmap(b.start, b.bytes); }
+
+    // A block about to be kept, its `touched` made true to what is resident (mincore): its
+    // owner may have left the end of its front untouched (then the front is the part up to
+    // the first page not resident), or given pages back to the system inside it (the library
+    // gives an array's pages back behind a pass that reads it for the last time: its next
+    // owner would find fresh pages where they were counted resident), and then the whole
+    // block goes back and none of it counts. Returns the resident bytes it had.
+    static std::size_t settle(Block& b) {
+        static const auto page = static_cast<std::size_t>(::sysconf(_SC_PAGESIZE));
+        unsigned char in[4096];
+        std::size_t resident = 0, front = 0;
+        bool gap = false, holed = false;
+        for (std::size_t at = 0; at < b.touched; at += sizeof in * page) {
+            const std::size_t len = std::min(b.touched - at, sizeof in * page);
+            if (::mincore(b.start + at, len, in) != 0) return b.touched;  // (as it was)
+            for (std::size_t k = 0; k < (len + page - 1) / page; ++k) {
+                if (in[k] & 1) {
+                    holed = gap;
+                    resident += page;
+                    if (!gap) front = at + (k + 1) * page;
+                } else {
+                    gap = true;
+                }
+            }
+        }
+        if (holed) {
+            ::madvise(b.start, b.touched, MADV_DONTNEED);
+            b.touched = 0;
+        } else {
+            b.touched = std::min(front, b.touched);
+        }
+        return resident;
+    }
 
     ResidentFn resident_;
     std::size_t slack_share_;
