@@ -13,6 +13,7 @@
 #include <tbb/task_arena.h>
 
 #include "../../libterrain/src/reeb/contour_tree.hpp"
+#include "../../libterrain/src/reeb/link_components.hpp"
 #include "support/test_meshes.hpp"
 #include "support/test_support.hpp"
 #include "terrain/core/error.hpp"
@@ -574,6 +575,48 @@ TEST_CASE("The Reeb graph is the same at one and two threads, its triangles held
             CHECK(g.arcs == held.arcs);
             CHECK(g.arc_offsets == held.arc_offsets);
             CHECK(g.arc_nodes == held.arc_nodes);
+        }
+    }
+}
+
+TEST_CASE("Link components are the same gathered in parts of the vertices", "[reeb]") {
+    // Large meshes gather their stars in two passes over the triangles, each for half of the
+    // vertices; any number of parts gives the same representatives, link counts and general
+    // nodes. On a disk with its triangles held and released (walked from the grid in bands of
+    // rows) and on the closed Moon (poles, seam), with plateaus.
+    const auto dem = io::read_dem(test::sample("vesta_hamo_tile.lbl"));
+    const auto disk = mesh::dem_to_mesh(dem);
+    REQUIRE(disk.triangles_releasable());
+    const auto released = [&] {
+        auto m = disk;
+        m.release_triangles();
+        return m;
+    }();
+    const auto sphere = mesh::dem_to_mesh(io::read_dem(test::sample("moon_ldem1_global.tif")));
+    for (const TriangleMesh* mesh : {&disk, &released, &sphere}) {
+        for (const bool plateaus : {false, true}) {
+            const auto f = plateaus ? quantized(test::noise_field(mesh->vertex_count(), 3))
+                                    : field::shape_index_field(*mesh);
+            const auto g = reeb::build_reeb_graph(*mesh, f);
+            std::vector<reeb::internal::LinkCounts> links_one;
+            std::vector<char> general_one;
+            const auto one =
+                reeb::internal::link_components(*mesh, g, links_one, general_one, {}, 1);
+            if (plateaus) REQUIRE(std::count(general_one.begin(), general_one.end(), 1) > 0);
+            for (const std::size_t parts : {2, 3, 7}) {
+                INFO(parts << " parts, " << mesh->vertex_count() << " vertices");
+                std::vector<reeb::internal::LinkCounts> links;
+                std::vector<char> general;
+                const auto reps =
+                    reeb::internal::link_components(*mesh, g, links, general, {}, parts);
+                REQUIRE(reps.size() == one.size());
+                bool same = true;
+                for (std::size_t n = 0; n < reps.size(); ++n)
+                    same = same && reps[n].lower == one[n].lower && reps[n].upper == one[n].upper;
+                CHECK(same);
+                CHECK(links == links_one);
+                CHECK(general == general_one);
+            }
         }
     }
 }

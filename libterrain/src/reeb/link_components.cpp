@@ -64,9 +64,10 @@ std::pair<int, int> LinkCounter::count_star(const ReebGraph& g, i32 e, std::size
 
 std::vector<LinkReps> link_components(const TriangleMesh& mesh, const ReebGraph& g,
                                       std::vector<LinkCounts>& vertex_links,
-                                      std::vector<char>& general, const ProgressFn& progress) {
+                                      std::vector<char>& general, const ProgressFn& progress,
+                                      std::size_t parts) {
     const std::size_t nv = mesh.vertex_count(), nn = g.node_count();
-    // Its passes: the triangles (0.2 to 0.6), the vertices (0.65 to 1).
+    // Its passes, for each part of the vertices (below): the triangles, then the vertices.
     const auto& node = g.vertex_nodes;
     // starts[0..1]: lower runs' first vertices, starts[2..3]: upper runs'; runs[0], runs[1]:
     // how many lower and upper runs were seen.
@@ -75,46 +76,52 @@ std::vector<LinkReps> link_components(const TriangleMesh& mesh, const ReebGraph&
         std::uint8_t triangles, lower_edges, upper_edges;
         std::array<std::uint8_t, 2> runs;
     };
-    // (Made a slice at a time: the first touch of a large block is slow, docs/performance.md.)
+    // The stars are gathered for a part of the vertices at a time, each part in a pass over
+    // every triangle, and read for those vertices: their records (24 bytes a vertex) are then
+    // not whole beside the nodes' representatives (16 bytes a node), which set the Reeb graph's
+    // peak of memory. Two parts on large meshes: one more pass over the triangles, 12 bytes a
+    // vertex less. (What a star gathers is the same in any part: its own triangles.) An
+    // empty mesh: one part of nothing.
+    if (parts == 0) parts = nv >= kPartedStars ? 2 : 1;
+    parts = std::max<std::size_t>(1, std::min(parts, nv));
     std::vector<Star> stars;
-    detail::assign_in_slices(stars, nv, Star{{kNone, kNone, kNone, kNone}, 0, 0, 0, {0, 0}},
-                             detail::PassProgress(progress, 0, 0.2, "reeb: links"));
+    std::size_t lo = 0, hi = 0;  // the part's vertices
+    const auto star = [&](i32 c) -> Star* {
+        const std::size_t v = idx(c);
+        return v >= lo && v < hi ? &stars[v - lo] : nullptr;
+    };
     const auto add = [&](const std::array<i32, 3>& t) {
         const std::array<i32, 3> n{node[idx(t[0])], node[idx(t[1])], node[idx(t[2])]};
-        for (const i32 c : t) ++stars[idx(c)].triangles;
+        for (const i32 c : t)
+            if (Star* s = star(c)) ++s->triangles;
         if (n[0] != n[1] && n[1] != n[2] && n[0] != n[2]) {
             // The highest corner sees a lower link edge, the lowest an upper one; going round
             // the middle corner counter-clockwise, the step a -> b crosses its value: b starts
             // a lower run when a is above, an upper run when a is below. No branches: the
             // orders are unpredictable.
-            const int hi = n[0] > n[1] ? (n[0] > n[2] ? 0 : 2) : (n[1] > n[2] ? 1 : 2);
-            const int lo = n[0] < n[1] ? (n[0] < n[2] ? 0 : 2) : (n[1] < n[2] ? 1 : 2);
-            const int mid = 3 - hi - lo, a = mid == 2 ? 0 : mid + 1, b = 3 - mid - a;
-            ++stars[idx(t[idx(hi)])].lower_edges;
-            ++stars[idx(t[idx(lo)])].upper_edges;
-            Star& s = stars[idx(t[idx(mid)])];
-            const int side = n[idx(a)] > n[idx(mid)] ? 0 : 1;
-            s.starts[idx(2 * side + (s.runs[idx(side)] & 1))] = n[idx(b)];
-            ++s.runs[idx(side)];
+            const int top = n[0] > n[1] ? (n[0] > n[2] ? 0 : 2) : (n[1] > n[2] ? 1 : 2);
+            const int bottom = n[0] < n[1] ? (n[0] < n[2] ? 0 : 2) : (n[1] < n[2] ? 1 : 2);
+            const int mid = 3 - top - bottom, a = mid == 2 ? 0 : mid + 1, b = 3 - mid - a;
+            if (Star* s = star(t[idx(top)])) ++s->lower_edges;
+            if (Star* s = star(t[idx(bottom)])) ++s->upper_edges;
+            if (Star* s = star(t[idx(mid)])) {
+                const int side = n[idx(a)] > n[idx(mid)] ? 0 : 1;
+                s->starts[idx(2 * side + (s->runs[idx(side)] & 1))] = n[idx(b)];
+                ++s->runs[idx(side)];
+            }
             return;
         }
         // Two corners in one node (a plateau): the third sees an edge of its lower or upper
         // link; the plateau's corners see an edge touching their node, which does not count.
         for (int k = 0; k < 3; ++k) {
+            Star* s = star(t[idx(k)]);
+            if (!s) continue;
             const i32 m = n[idx(k)], p = n[idx((k + 1) % 3)], q = n[idx((k + 2) % 3)];
-            stars[idx(t[idx(k)])].lower_edges += (m > p) & (m > q);
-            stars[idx(t[idx(k)])].upper_edges += (m < p) & (m < q);
+            s->lower_edges += (m > p) & (m > q);
+            s->upper_edges += (m < p) & (m < q);
         }
     };
-    // What a star gathers does not depend on the order of its triangles (counts, and the two
-    // runs' first vertices, read in increasing order): a released grid goes in bands of rows in
-    // parallel. (Through grid_triangles.hpp: a DEM mesh may have released its triangles.)
-    detail::for_each_triangle_by_bands(mesh, progress, 0.2, 0.6, "reeb: links", add);
     std::vector<LinkReps> reps;
-    detail::assign_in_slices(reps, nn, LinkReps{},
-                             detail::PassProgress(progress, 0.6, 0.65, "reeb: links"));
-    general.assign(nn, 0);
-    vertex_links.resize(nv);
     // The vertices in parallel: each writes its own entries and its node's, and a node of
     // several vertices (a plateau) is written from its first vertex only.
     constexpr std::size_t kAhead = 16;  // the nodes' entries are written in random order
@@ -139,7 +146,7 @@ std::vector<LinkReps> link_components(const TriangleMesh& mesh, const ReebGraph&
             return;
         }
         const int above = degree - below;
-        const Star& s = stars[v];
+        const Star& s = stars[v - lo];
         const bool interior = s.triangles == degree;
         const int lower = (above == 0 && interior && below > 0) ? 1 : below - s.lower_edges;
         const int upper = (below == 0 && interior && above > 0) ? 1 : above - s.upper_edges;
@@ -153,11 +160,34 @@ std::vector<LinkReps> link_components(const TriangleMesh& mesh, const ReebGraph&
         reps[idx(n)] = {side(lower, some_below, s.runs[0], s.starts[0], s.starts[1]),
                         side(upper, some_above, s.runs[1], s.starts[2], s.starts[3])};
     };
-    detail::parallel_slices(nv, std::size_t{1} << 14, progress, 0.65, 1.0, "reeb: links",
-                            [&](const tbb::blocked_range<std::size_t>& r) {
-                                for (std::size_t v = r.begin(); v < r.end(); ++v)
-                                    vertex(v, r.end());
-                            });
+    // Each part's share of the progress: its stars made (a fifth), its triangles (three
+    // fifths), its vertices (the rest); the representatives made before the first vertices.
+    for (std::size_t part = 0; part < parts; ++part) {
+        const double from = double(part) / double(parts), share = 1.0 / double(parts);
+        const auto at = [&](double f) { return from + share * f; };
+        lo = nv * part / parts;
+        hi = nv * (part + 1) / parts;
+        // (Made a slice at a time: the first touch of a large block is slow,
+        // docs/performance.md.)
+        detail::assign_in_slices(stars, hi - lo,
+                                 Star{{kNone, kNone, kNone, kNone}, 0, 0, 0, {0, 0}},
+                                 detail::PassProgress(progress, at(0), at(0.2), "reeb: links"));
+        // (Through grid_triangles.hpp: a DEM mesh may have released its triangles; a released
+        // grid goes in bands of rows in parallel.)
+        detail::for_each_triangle_by_bands(mesh, progress, at(0.2), at(0.6), "reeb: links", add);
+        if (part == 0) {
+            detail::assign_in_slices(
+                reps, nn, LinkReps{},
+                detail::PassProgress(progress, at(0.6), at(0.65), "reeb: links"));
+            general.assign(nn, 0);
+            vertex_links.resize(nv);
+        }
+        detail::parallel_slices(hi - lo, std::size_t{1} << 14, progress, at(0.65), at(1.0),
+                                "reeb: links", [&](const tbb::blocked_range<std::size_t>& r) {
+                                    for (std::size_t v = lo + r.begin(); v < lo + r.end(); ++v)
+                                        vertex(v, lo + r.end());
+                                });
+    }
     return reps;
 }
 

@@ -59,10 +59,15 @@ struct LinkReps {
 // lower (upper) link vertices starts right after an upper (lower) one: the triangle holding
 // that step names the run's first vertex, its representative. Gives the link counts of those
 // vertices in `vertex_links`; `general` marks the nodes left to a LinkCounter.
+// The stars of the triangles are gathered for `parts` parts of the vertices one after the
+// other, a pass over the triangles each (0: one part below kPartedStars vertices, else two):
+// the same results, less memory at once.
 using LinkCounts = std::array<std::uint8_t, 2>;
+inline constexpr std::size_t kPartedStars = std::size_t{1} << 22;
 std::vector<LinkReps> link_components(const TriangleMesh& mesh, const ReebGraph& g,
                                       std::vector<LinkCounts>& vertex_links,
-                                      std::vector<char>& general, const ProgressFn& progress = {});
+                                      std::vector<char>& general, const ProgressFn& progress = {},
+                                      std::size_t parts = 0);
 
 // The link counts of the critical nodes that link_components left (plateaus, vertices of very
 // high degree), from their stars' triangles.
