@@ -1,4 +1,4 @@
-// Pages given back behind a pass (core/release.hpp).
+// Pieces of memory given back behind a pass (core/release.hpp).
 
 #include <sys/mman.h>
 #include <unistd.h>
@@ -8,6 +8,8 @@
 #include <vector>
 
 #include "../../libterrain/src/core/release.hpp"
+
+using terrain::detail::PagesBehind;
 
 namespace {
 
@@ -22,45 +24,42 @@ bool resident(const void* p) {
 
 }  // namespace
 
-TEST_CASE("PagesBehind gives back the whole pages before the pass and nothing at or after it",
+TEST_CASE("PagesBehind gives back the whole 2 MiB pieces before the pass, nothing at or after it",
           "[core]") {
-    const std::size_t page = static_cast<std::size_t>(::sysconf(_SC_PAGESIZE)) / sizeof(int);
-    // 4 MiB of ints, every one touched (a mapping of its own: what is given back reads zero).
-    std::vector<int> v(std::size_t{1} << 20, 7);
-    terrain::detail::PagesBehind behind(v.data());
-    // Less than the least given back at once: nothing yet.
-    behind.before(v.data() + 3 * page + 5);
-    CHECK(v[page + 1] == 7);
-    // Half way, not on a page's edge.
+    // 32 MiB of ints, every one touched (a mapping of its own: what is given back reads zero).
+    std::vector<int> v(std::size_t{8} << 20, 7);
+    const auto at = [&](std::size_t i) { return reinterpret_cast<std::uintptr_t>(v.data() + i); };
+    const std::size_t per_piece = PagesBehind::kPiece / sizeof(int);
+    // The first element on a piece's edge.
+    std::size_t first = 0;
+    while (at(first) % PagesBehind::kPiece != 0) ++first;
+    PagesBehind behind(v.data());
+    // Inside the first whole piece: nothing yet.
+    behind.before(v.data() + first + per_piece - 1);
+    CHECK(v[first] == 7);
+    // Half way, not on a piece's edge.
     const std::size_t half = v.size() / 2 + 17;
     behind.before(v.data() + half);
-    // The first page, partly before the array's start, is kept; the pages wholly before the
-    // pass are given back (zeros and no longer resident); the page the pass is in and all after
-    // it are kept, every value.
-    CHECK(v[0] == 7);
-    const std::size_t first_given =
-        (page - reinterpret_cast<std::uintptr_t>(v.data()) / sizeof(int) % page) % page;
-    const std::size_t last_given = half / page * page;  // (the array starts on a page's edge
-                                                        // or not: checked with a page's margin)
-    for (std::size_t i = first_given + page; i + 2 * page < last_given; i += page) {
-        CHECK(!resident(v.data() + i));
-        CHECK(v[i] == 0);
+    std::size_t edge = half;  // the first element of the piece the pass is in
+    while (at(edge) % PagesBehind::kPiece != 0) --edge;
+    REQUIRE(edge > first);
+    // Before the first whole piece (partly before the array's start): kept. The whole pieces
+    // before the pass: given back (zeros, not resident). The piece the pass is in and all after
+    // it: kept, every value.
+    std::size_t kept_before = 0, given = 0, kept_after = 0;
+    for (std::size_t i = 0; i < first; ++i) kept_before += v[i] == 7;
+    for (std::size_t i = first; i < edge; i += 1024) {
+        CHECK(!resident(v.data() + i));  // (before it is read: a read maps a page of zeros)
+        given += v[i] == 0;
     }
-    std::size_t kept = 0;
-    for (std::size_t i = half; i < v.size(); ++i) kept += v[i] == 7;
-    CHECK(kept == v.size() - half);
-    // The part of the pass's page before it too.
-    const auto bytes = static_cast<std::uintptr_t>(::sysconf(_SC_PAGESIZE));
-    const auto edge = reinterpret_cast<std::uintptr_t>(v.data() + half) & ~(bytes - 1);
-    const std::size_t in_page = half - (edge - reinterpret_cast<std::uintptr_t>(v.data())) /
-                                           sizeof(int);  // (elements of that page before it)
-    REQUIRE(in_page > 0);
-    for (std::size_t i = half - in_page; i < half; ++i) CHECK(v[i] == 7);
-    CHECK(v[half - in_page - 1] == 0);  // (the element just before that page is given back)
+    for (std::size_t i = edge; i < v.size(); ++i) kept_after += v[i] == 7;
+    CHECK(kept_before == first);
+    CHECK(given == (edge - first + 1023) / 1024);
+    CHECK(kept_after == v.size() - edge);
     // Going back does nothing; an empty array gives nothing back.
     behind.before(v.data() + 10);
-    CHECK(v[half - 1] == 7);
-    terrain::detail::PagesBehind none(nullptr);
+    CHECK(v[edge] == 7);
+    PagesBehind none(nullptr);
     none.before(v.data() + v.size());
     CHECK(v[v.size() - 1] == 7);
 }
