@@ -1,28 +1,13 @@
 // Pieces of memory given back behind a pass (core/release.hpp).
 
-#include <sys/mman.h>
-#include <unistd.h>
-
 #include <catch2/catch.hpp>
 #include <cstdint>
 #include <vector>
 
 #include "../../libterrain/src/core/release.hpp"
+#include "support/test_support.hpp"
 
 using terrain::detail::PagesBehind;
-
-namespace {
-
-// Whether the page holding p is resident.
-bool resident(const void* p) {
-    const auto page = static_cast<std::uintptr_t>(::sysconf(_SC_PAGESIZE));
-    void* start = reinterpret_cast<void*>(reinterpret_cast<std::uintptr_t>(p) & ~(page - 1));
-    unsigned char in = 0;
-    REQUIRE(::mincore(start, page, &in) == 0);
-    return (in & 1) != 0;
-}
-
-}  // namespace
 
 TEST_CASE("PagesBehind gives back the whole 2 MiB pieces before the pass, nothing at or after it",
           "[core]") {
@@ -49,7 +34,8 @@ TEST_CASE("PagesBehind gives back the whole 2 MiB pieces before the pass, nothin
     std::size_t kept_before = 0, given = 0, kept_after = 0;
     for (std::size_t i = 0; i < first; ++i) kept_before += v[i] == 7;
     for (std::size_t i = first; i < edge; i += 1024) {
-        CHECK(!resident(v.data() + i));  // (before it is read: a read maps a page of zeros)
+        CHECK(terrain::test::resident_bytes(v.data() + i, 1) == 0);  // (before it is read: a read
+                                                                     // maps a page of zeros)
         given += v[i] == 0;
     }
     for (std::size_t i = edge; i < v.size(); ++i) kept_after += v[i] == 7;

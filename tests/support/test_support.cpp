@@ -2,9 +2,11 @@
 
 #include <gdal_priv.h>
 #include <ogr_spatialref.h>
+#include <sys/mman.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cstdint>
 #include <cstdlib>
 #include <fstream>
 #include <memory>
@@ -35,6 +37,18 @@ std::string file_bytes(const std::filesystem::path& path) {
     std::stringstream ss;
     ss << in.rdbuf();
     return ss.str();
+}
+
+std::size_t resident_bytes(const void* p, std::size_t n) {
+    const auto page = static_cast<std::uintptr_t>(::sysconf(_SC_PAGESIZE));
+    const auto first = reinterpret_cast<std::uintptr_t>(p) & ~(page - 1);
+    const auto end = reinterpret_cast<std::uintptr_t>(p) + n;
+    std::vector<unsigned char> in((end - first + page - 1) / page);
+    if (::mincore(reinterpret_cast<void*>(first), end - first, in.data()) != 0)
+        throw std::runtime_error("mincore failed");
+    std::size_t pages = 0;
+    for (const unsigned char c : in) pages += c & 1;
+    return pages * page;
 }
 
 std::string write_raster(const std::filesystem::path& path, const RasterSpec& spec) {

@@ -23,6 +23,9 @@ std::filesystem::path scratch_dir(const std::string& name);
 // The whole content of a file, as bytes.
 std::string file_bytes(const std::filesystem::path& path);
 
+// The bytes of the pages overlapping [p, p + n) that are resident now (mincore).
+std::size_t resident_bytes(const void* p, std::size_t n);
+
 struct RasterSpec {
     int width = 4, height = 4;
     std::string type = "Float32";  // a GDAL data type name

@@ -9,6 +9,7 @@
 #include <random>
 #include <vector>
 
+#include "support/test_support.hpp"
 #include "tools/large_blocks.hpp"
 
 using terrain::cli::LargeBlocks;
@@ -246,12 +247,6 @@ TEST_CASE("a kept block counts only the pages its owner left resident") {
     // counted resident and found fresh by the block's next owner, past the peak.
     LargeBlocks<8> blocks(&resident, 0);
     const auto page = static_cast<std::size_t>(sysconf(_SC_PAGESIZE));
-    const auto in_memory = [&](const char* p, std::size_t n) {
-        std::vector<unsigned char> in((n + page - 1) / page);
-        REQUIRE(::mincore(const_cast<char*>(p), n, in.data()) == 0);
-        return std::count_if(in.begin(), in.end(), [](unsigned char c) { return c & 1; }) *
-               static_cast<std::ptrdiff_t>(page);
-    };
     // Every page touched: kept whole.
     auto* p = static_cast<char*>(blocks.allocate(32 * MiB));
     REQUIRE(p != nullptr);
@@ -265,14 +260,14 @@ TEST_CASE("a kept block counts only the pages its owner left resident") {
     ::madvise(p, 16 * MiB, MADV_DONTNEED);
     REQUIRE(blocks.release(p));
     CHECK(blocks.counts().kept_touched == 0);
-    CHECK(in_memory(p, 32 * MiB) == 0);
+    CHECK(terrain::test::resident_bytes(p, 32 * MiB) == 0);
     // Only its first 8 MiB touched: those are counted, and stay.
     p = static_cast<char*>(blocks.allocate(32 * MiB));
     REQUIRE(p != nullptr);
     fill(p, 8 * MiB, 3);
     REQUIRE(blocks.release(p));
     CHECK(blocks.counts().kept_touched == 8 * MiB);
-    CHECK(in_memory(p, 8 * MiB) == std::ptrdiff_t(8 * MiB));
+    CHECK(terrain::test::resident_bytes(p, 8 * MiB) == 8 * MiB);
     CHECK(holds(p, 8 * MiB, 3));
     // A page given back in the middle: none counted.
     p = static_cast<char*>(blocks.allocate(32 * MiB));

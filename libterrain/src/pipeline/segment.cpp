@@ -362,11 +362,10 @@ SegmentResult segment(Input input, const SegmentOptions& options, const Progress
     // (parked_arrays.hpp; docs/performance.md, "Arrays parked on disk") when large. The DEM
     // waits from before the field (only the height field reads it) to the placing of the
     // positions, and again through the growing.
+    // Whether to park at all is decided the first time, on what all the arrays parked through
+    // the run hold (the field is a float a vertex).
     PackedHeights packed;
     internal::ParkedArrays parked(options.park_directory, options.park_min_bytes);
-    // The DEM's values held as floats when they can be, and parked; the first time, whether
-    // to park at all is decided on what all the arrays parked through the run hold (the
-    // field is a float a vertex).
     const auto hold_dem = [&](const ProgressFn& held) {
         Dem& dem = *result.input.dem;
         packed.pack(dem, scaled_progress(held, 0, 0.5));

@@ -141,20 +141,20 @@ bool contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& prog
     // keeps the fraction from going back.
     const auto caller = std::this_thread::get_id();
     std::atomic<std::size_t> swept_events{0};
+    const auto swept_fraction = [&](std::size_t events) {
+        return 0.3 + 0.3 * double(events) / double(std::max<std::size_t>(1, 2 * nn));
+    };
     std::vector<Entry> swept;
     auto sweep = [&](bool ascending, std::vector<i32>& tree_parent) {
         const std::size_t side = ascending ? 0 : 1;
         const bool reports = progress && std::this_thread::get_id() == caller;
-        detail::assign_in_slices(swept, nn, Entry{-1, 0},
-                                 made(0.3 + 0.3 * double(swept_events.load()) /
-                                                double(std::max<std::size_t>(1, 2 * nn))));
+        detail::assign_in_slices(swept, nn, Entry{-1, 0}, made(swept_fraction(swept_events)));
         const auto passed = [&](std::size_t k) {
             constexpr std::size_t kStep = std::size_t{1} << 18;
             if ((k & (kStep - 1)) != kStep - 1) return;
             const std::size_t all = swept_events.fetch_add(kStep) + kStep;
             if (reports)
-                report_progress(progress, 0.3 + 0.3 * double(all) / double(2 * nn),
-                                "reeb: join and split trees");
+                report_progress(progress, swept_fraction(all), "reeb: join and split trees");
         };
         auto find = [&](i32 x) {
             i32 r = x;
@@ -252,9 +252,7 @@ bool contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& prog
     // 8 bytes a node less through the split sweep.
     for (std::size_t e = 0; e < nn; ++e) upper_reps(e) = reps[e].upper;
     detail::PagesBehind(reps.data() + (nn + 1) / 2).before(reps.data() + nn);
-    detail::assign_in_slices(
-        split_parent, nn, kNone,
-        made(0.3 + 0.3 * double(swept_events.load()) / double(std::max<std::size_t>(1, 2 * nn))));
+    detail::assign_in_slices(split_parent, nn, kNone, made(swept_fraction(swept_events)));
     sweep(false, split_parent);
     detail::release(swept);
     detail::release(reps);  // (16 bytes a node: what the arcs below are made beside)
