@@ -608,3 +608,49 @@ TEST_CASE("The simplification's output is the same at one and two threads", "[si
         check_same_result(handed, one);
     }
 }
+
+TEST_CASE("The vertices absorbed are those of the nodes that did not remain (Vesta sample)",
+          "[simplify]") {
+    // Each remaining node is one old node, numbered anew in the order of the old ones; the
+    // others' vertices joined the node that took them and are flagged absorbed. So a node's
+    // vertices are all absorbed or none is, the nodes with none absorbed are as many as the
+    // nodes left, and each of them is whole in a new node of its own, by increasing id. Lent
+    // and handed over (the output then makes the lists again from the vertices' nodes).
+    const auto& s = vesta();
+    const auto g = reeb::build_reeb_graph(s.mesh, s.si);
+    for (const bool handed_over : {false, true}) {
+        INFO((handed_over ? "handed over" : "lent"));
+        auto given = g;
+        const auto r = handed_over ? reeb::simplify(s.mesh, std::move(given), paper_thresholds())
+                                   : reeb::simplify(s.mesh, g, paper_thresholds());
+        REQUIRE(r.absorbed.size() == s.mesh.vertex_count());
+        std::size_t remaining = 0, absorbed = 0, split = 0, out_of_order = 0, empty = 0;
+        std::int32_t last = -1;
+        for (std::size_t n = 0; n < g.node_count(); ++n) {
+            const auto first = g.node_vertex_offsets[n], end = g.node_vertex_offsets[n + 1];
+            if (first >= end) {
+                ++empty;
+                continue;
+            }
+            const auto v0 = static_cast<std::size_t>(g.node_vertices[std::size_t(first)]);
+            const bool gone = r.absorbed[v0] != 0;
+            const std::int32_t id = r.graph.vertex_nodes[v0];
+            for (auto i = first; i < end; ++i) {
+                const auto v = static_cast<std::size_t>(g.node_vertices[std::size_t(i)]);
+                split += (r.absorbed[v] != 0) != gone || (!gone && r.graph.vertex_nodes[v] != id);
+                absorbed += gone;
+            }
+            if (gone) continue;
+            ++remaining;
+            out_of_order += id <= last;
+            last = id;
+        }
+        CHECK(empty == 0);
+        CHECK(split == 0);
+        CHECK(out_of_order == 0);
+        CHECK(remaining == r.graph.node_count());
+        CHECK(absorbed > s.mesh.vertex_count() / 2);  // (the thresholds take most of the tile)
+        CHECK(absorbed == static_cast<std::size_t>(
+                              std::count(r.absorbed.begin(), r.absorbed.end(), std::uint8_t{1})));
+    }
+}
