@@ -107,6 +107,7 @@ case "$mode" in
     "$build_dir/tests/bench/bench_reeb"
     "$build_dir/tests/bench/bench_grow"
     "$build_dir/tests/bench/bench_outputs"
+    "$build_dir/tests/bench/bench_random_access"
     tests/bench/bench_segment.sh "$build_dir"
     ;;
   qgis)

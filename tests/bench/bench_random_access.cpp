@@ -1,0 +1,102 @@
+// Benchmark: what one random read of memory costs on this machine as the memory read grows,
+// the cost behind the stages that read at random (the contour tree's sweeps, the
+// simplification, the flooding of the absorbed vertices): a global grid of 265 M pixels holds
+// 4 times the bytes of one of 66 M, and each of its random reads costs more.
+//   build/tests/bench/bench_random_access [GiB ...]   (default 0.25 1 4 12)
+// For each size, a block of 64-bit words (asking for transparent huge pages, as the program
+// does) is read at random places: independent reads (several in flight, as in a prefetched
+// pass) and a chain of reads each of whose address comes from the one before (one in flight:
+// the latency). Prints nanoseconds a read.
+
+#include <sys/mman.h>
+
+#include <chrono>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <string>
+#include <vector>
+
+namespace {
+
+// The memory the system says it can give (MemAvailable), in bytes; 0 when unknown.
+std::size_t available_bytes() {
+    std::ifstream meminfo("/proc/meminfo");
+    std::string key;
+    std::size_t kib = 0;
+    while (meminfo >> key >> kib)
+        if (key == "MemAvailable:")
+            return kib * 1024;
+        else
+            meminfo.ignore(256, '\n');
+    return 0;
+}
+
+struct Costs {
+    double independent_ns = 0, chained_ns = 0;
+};
+
+Costs measure(std::size_t bytes) {
+    const std::size_t n = bytes / sizeof(std::uint64_t);
+    void* block =
+        ::mmap(nullptr, bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    if (block == MAP_FAILED) {
+        std::fprintf(stderr, "bench_random_access: cannot map %zu bytes\n", bytes);
+        std::exit(1);
+    }
+    ::madvise(block, bytes, MADV_HUGEPAGE);
+    auto* words = static_cast<std::uint64_t*>(block);
+    for (std::size_t i = 0; i < n; ++i) words[i] = i * 0x9E3779B97F4A7C15ull;
+    constexpr std::size_t kReads = 20'000'000;
+    using Clock = std::chrono::steady_clock;
+    const auto ns_per_read = [&](Clock::time_point from) {
+        return std::chrono::duration<double, std::nano>(Clock::now() - from).count() / kReads;
+    };
+    Costs costs;
+    // Independent: the addresses come from a generator, not from the words read.
+    std::uint64_t x = 0x2545F4914F6CDD1Dull, sum = 0;
+    auto start = Clock::now();
+    for (std::size_t i = 0; i < kReads; ++i) {
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        sum += words[x % n];
+    }
+    costs.independent_ns = ns_per_read(start);
+    // Chained: each address mixes the word just read with the step's number (no short cycle).
+    std::uint64_t at = 1;
+    start = Clock::now();
+    for (std::size_t i = 0; i < kReads; ++i) at = (words[at] ^ (i + 1) * 0xBF58476D1CE4E5B9ull) % n;
+    costs.chained_ns = ns_per_read(start);
+    ::munmap(block, bytes);
+    if ((sum ^ at) == 42) std::printf(" ");  // (keeps the reads)
+    return costs;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    std::vector<double> sizes;
+    for (int i = 1; i < argc; ++i) sizes.push_back(std::atof(argv[i]));
+    if (sizes.empty()) sizes = {0.25, 1, 4, 12};
+    std::printf("bench_random_access: ns a random 8-byte read, by the bytes read at random\n");
+    std::printf("%8s %12s %10s\n", "GiB", "independent", "chained");
+    for (const double gib : sizes) {
+        if (!(gib > 0)) {
+            std::fprintf(stderr, "bench_random_access: sizes are GiB > 0\n");
+            return 1;
+        }
+        const auto bytes = static_cast<std::size_t>(gib * double(std::size_t{1} << 30));
+        // (Not when it would not fit: a block the system must take back would be killed.)
+        const std::size_t available = available_bytes();
+        if (available != 0 && bytes > available / 10 * 9) {
+            std::printf("%8.2f      skipped (%.1f GiB available)\n", gib,
+                        double(available) / double(std::size_t{1} << 30));
+            continue;
+        }
+        const Costs c = measure(bytes);
+        std::printf("%8.2f %12.1f %10.1f\n", gib, c.independent_ns, c.chained_ns);
+    }
+    return 0;
+}
