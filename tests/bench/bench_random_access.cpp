@@ -88,7 +88,7 @@ int main(int argc, char** argv) {
             return 1;
         }
         const auto bytes = static_cast<std::size_t>(gib * double(std::size_t{1} << 30));
-        // (Not when it would not fit: a block the system must take back would be killed.)
+        // (Not a size that does not fit: the system would kill the process.)
         const std::size_t available = available_bytes();
         if (available != 0 && bytes > available / 10 * 9) {
             std::printf("%8.2f      skipped (%.1f GiB available)\n", gib,
