@@ -14,24 +14,11 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
-#include <fstream>
-#include <string>
 #include <vector>
 
-namespace {
+#include "terrain/core/memory_budget.hpp"
 
-// The memory the system says it can give (MemAvailable), in bytes; 0 when unknown.
-std::size_t available_bytes() {
-    std::ifstream meminfo("/proc/meminfo");
-    std::string key;
-    std::size_t kib = 0;
-    while (meminfo >> key >> kib)
-        if (key == "MemAvailable:")
-            return kib * 1024;
-        else
-            meminfo.ignore(256, '\n');
-    return 0;
-}
+namespace {
 
 struct Costs {
     double independent_ns = 0, chained_ns = 0;
@@ -89,10 +76,10 @@ int main(int argc, char** argv) {
         }
         const auto bytes = static_cast<std::size_t>(gib * double(std::size_t{1} << 30));
         // (Not a size that does not fit: the system would kill the process.)
-        const std::size_t available = available_bytes();
-        if (available != 0 && bytes > available / 10 * 9) {
+        const auto available = terrain::available_memory();
+        if (available && bytes > *available / 10 * 9) {
             std::printf("%8.2f      skipped (%.1f GiB available)\n", gib,
-                        double(available) / double(std::size_t{1} << 30));
+                        double(*available) / double(std::size_t{1} << 30));
             continue;
         }
         const Costs c = measure(bytes);
