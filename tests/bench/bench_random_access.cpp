@@ -63,9 +63,12 @@ Costs measure(std::size_t bytes) {
     }
     costs.independent_ns = ns_per_read(start);
     // Chained: each address mixes the word just read with the step's number (no short cycle).
+    const auto random_after = [&](std::uint64_t at, std::size_t i) {
+        return (words[at] ^ (i + 1) * 0xBF58476D1CE4E5B9ull) % n;
+    };
     std::uint64_t at = 1;
     start = Clock::now();
-    for (std::size_t i = 0; i < kReads; ++i) at = (words[at] ^ (i + 1) * 0xBF58476D1CE4E5B9ull) % n;
+    for (std::size_t i = 0; i < kReads; ++i) at = random_after(at, i);
     costs.chained_ns = ns_per_read(start);
     // Pairs: a chained random read, then one within +-d bytes of it whose offset comes from
     // the word just read; the near read's cost is the pair's less a random read's.
@@ -74,7 +77,7 @@ Costs measure(std::size_t bytes) {
         const std::size_t half = span / 2;
         start = Clock::now();
         for (std::size_t i = 0; i < kReads / 2; ++i) {
-            at = (words[at] ^ (i + 1) * 0xBF58476D1CE4E5B9ull) % n;
+            at = random_after(at, i);
             const std::size_t offset = (words[at] ^ (i + 1) * 0x94D049BB133111EBull) % span;
             at = at + offset < half ? 0 : std::min(n - 1, at + offset - half);
         }
