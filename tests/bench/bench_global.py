@@ -2,18 +2,34 @@
 """Benchmark: `terrain segment` end to end on global equirectangular DEMs of Vesta
 (cratered, radii in 2 m steps like the HAMO DNs; make_global_dem.py beside this file) at
 several sizes. Prints, per size, the wall time and the peak memory (bytes per pixel), then
-seconds per million pixels for each stage, so that the growth of the cost with size shows.
+seconds per million pixels for each stage, so that the growth of the cost with size shows;
+`x_first` is a size's seconds per Mpx over the first size's (the run's linearity: 1.3 at most
+is asked of the 265 M grid against the 1 M one). The first size runs three times, and its
+median is the reference.
 
   bench_global.py [BUILD_DIR] [WIDTH ...]      (height = width / 2)
 
 Widths: 1440 (1 M pixels), 5760 (16 M), 11520 (66 M), 23040 (265 M). Default: 1440 2880."""
 import json
 import os
+import statistics
 import subprocess
 import sys
 import tempfile
 
 STAGES = ["read", "mesh", "field", "reeb", "simplify", "grow", "write"]
+FIRST_RUNS = 3
+
+
+def run(terrain, dem, work):
+    """`terrain segment` with every output: wall seconds, peak resident bytes, stage seconds."""
+    out, timing = os.path.join(work, "out"), os.path.join(work, "time")
+    subprocess.run(["rm", "-rf", out], check=True)
+    subprocess.run(["/usr/bin/time", "-f", "%e %M", "-o", timing, terrain, "segment", "-q", dem,
+                    "-o", out, "--timings"], check=True, stdout=subprocess.DEVNULL)
+    wall, rss_kb = open(timing).read().split()[-2:]
+    t = json.load(open(os.path.join(out, "run.json")))["timings_seconds"]
+    return float(wall), int(rss_kb) * 1024, t
 
 
 def main():
@@ -21,25 +37,29 @@ def main():
     widths = [int(w) for w in sys.argv[2:]] or [1440, 2880]
     terrain = os.path.join(build, "tools", "terrain")
     here = os.path.dirname(os.path.abspath(__file__))
-    print(f"{'pixels':<12} {'wall_s':>8} {'peak_MiB':>9} {'B/pixel':>8} {'s/Mpx':>7} "
+    print(f"{'pixels':<12} {'wall_s':>8} {'peak_MiB':>9} {'B/pixel':>8} {'s/Mpx':>7} {'x_first':>7} "
           + " ".join(f"{s:>8}" for s in STAGES) + f"   ({os.cpu_count()} cores; stages in s/Mpx)")
+    first = None  # the first size's median seconds per Mpx
     with tempfile.TemporaryDirectory() as work:
-        for w in widths:
+        for i, w in enumerate(widths):
             h = w // 2
             dem = os.path.join(work, "dem.tif")
             subprocess.run([sys.executable, os.path.join(here, "make_global_dem.py"), dem, str(w)],
                            check=True, stderr=subprocess.DEVNULL)
-            out, timing = os.path.join(work, "out"), os.path.join(work, "time")
-            subprocess.run(["rm", "-rf", out], check=True)
-            subprocess.run(["/usr/bin/time", "-f", "%e %M", "-o", timing, terrain, "segment", "-q",
-                            dem, "-o", out, "--timings"], check=True, stdout=subprocess.DEVNULL)
-            wall, rss_kb = open(timing).read().split()[-2:]
-            wall, rss = float(wall), int(rss_kb) * 1024
+            # The first size is small, and its time varies by a third from run to run: it runs
+            # FIRST_RUNS times, and the median of its seconds per Mpx is what x_first divides by.
             px = w * h
             mpx = px / 1e6
-            t = json.load(open(os.path.join(out, "run.json")))["timings_seconds"]
-            print(f"{w}x{h:<7} {wall:8.1f} {rss / 2**20:9.0f} {rss / px:8.0f} {wall / mpx:7.2f} "
-                  + " ".join(f"{t.get(s, 0) / mpx:8.2f}" for s in STAGES), flush=True)
+            rates = []
+            for _ in range(FIRST_RUNS if i == 0 else 1):
+                wall, rss, t = run(terrain, dem, work)
+                rates.append(wall / mpx)
+                ratio = f"{wall / mpx / first:7.2f}" if first else f"{'':7}"
+                print(f"{w}x{h:<7} {wall:8.1f} {rss / 2**20:9.0f} {rss / px:8.0f} {wall / mpx:7.2f} "
+                      f"{ratio} " + " ".join(f"{t.get(s, 0) / mpx:8.2f}" for s in STAGES), flush=True)
+            if first is None:
+                first = statistics.median(rates)
+                print(f"{'':12} (the first size's median: {first:.2f} s/Mpx)", flush=True)
             os.remove(dem)
 
 
