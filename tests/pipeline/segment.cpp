@@ -86,6 +86,31 @@ TEST_CASE("pipeline::segment gives labels, regions and the files of terrain segm
     // The same DEM handed over in memory gives the same labels.
     auto again = pipeline::segment(pipeline::input_from_dem(io::read_dem(path)), options);
     CHECK(again.label_pixels() == pixels);
+
+    // Written as `terrain segment` writes (the large data freed as soon as no file needs it:
+    // the mesh's geometry before the files, the rest before the preview is encoded): the
+    // same bytes in every file, and the same counts in run.json.
+    pipeline::WriteOptions freeing;
+    freeing.release_memory = true;
+    const auto dir2 = test::scratch_dir("pipeline_segment_freeing");
+    CHECK(pipeline::write_segment_directory(again, options, path, dir2.string(), freeing) ==
+          files);
+    CHECK(again.input.mesh.positions.empty());
+    CHECK(again.input.mesh.vertex_areas.empty());
+    const auto counts = [](const std::string& json) {
+        const auto at = json.find("\"counts\"");
+        return at == std::string::npos ? std::string() : json.substr(at, json.find('}', at) - at);
+    };
+    for (const auto& f : files) {
+        INFO(f);
+        const auto a = test::file_bytes(dir / f), b = test::file_bytes(dir2 / f);
+        if (f == "run.json") {
+            CHECK_FALSE(counts(a).empty());
+            CHECK(counts(a) == counts(b));
+        } else {
+            CHECK(a == b);
+        }
+    }
 }
 
 TEST_CASE("pipeline::segment gives the DEM back bit for bit, floats or not", "[pipeline]") {
