@@ -273,18 +273,20 @@ void place_vertices(const Dem& dem, const GridGeoref& geo,
 void triangulate_blocks(const Dem& dem, const std::vector<std::int32_t>& vertex_of,
                         TriangleMesh& mesh, const ProgressFn& progress) {
     const int W = dem.width, H = dem.height;
-    const int block_rows = H - 1;
-    std::vector<std::vector<Triangle>> per_row(static_cast<std::size_t>(block_rows));
+    const int block_rows = std::max(H - 1, 0);
     // Each block's diagonal is recorded (a bit, each row of blocks in its own words), so
     // that the triangles can be made again without the positions.
     const std::size_t words = detail::diagonal_words(W);
-    mesh.block_diagonals.assign(static_cast<std::size_t>(std::max(block_rows, 0)) * words, 0);
-    // Rows in parallel (0 to 0.8 of the progress), then joined in order.
-    detail::parallel_slices(block_rows, 16, progress, 0, 0.8, "mesh", [&](const auto& rows) {
+    mesh.block_diagonals.assign(static_cast<std::size_t>(block_rows) * words, 0);
+    const auto row_top = [&](int row) { return vertex_of.data() + dem.index(0, row); };
+    // Two passes over the rows of blocks, each in parallel: the first chooses the diagonals
+    // and counts each row's triangles (0 to 0.6 of the progress), the second writes them at
+    // their row's place in the one array, made again from the recorded diagonals (to 1). Rows
+    // made apart and joined after were held beside the joined array (24 bytes a pixel more
+    // at the mesh's peak: freed rows stay with the allocator).
+    std::vector<std::size_t> offsets(static_cast<std::size_t>(block_rows) + 1, 0);
+    detail::parallel_slices(block_rows, 16, progress, 0, 0.6, "mesh", [&](const auto& rows) {
         for (int row = rows.begin(); row < rows.end(); ++row) {
-            auto& out = per_row[row];
-            out.reserve(2 * std::size_t(W));
-            const std::int32_t* top = vertex_of.data() + dem.index(0, row);
             std::uint64_t* bits = mesh.block_diagonals.data() + std::size_t(row) * words;
             const auto split = [&](int col, std::int32_t v00, std::int32_t v10, std::int32_t v01,
                                    std::int32_t v11) {
@@ -292,27 +294,27 @@ void triangulate_blocks(const Dem& dem, const std::vector<std::int32_t>& vertex_
                 if (across) bits[unsigned(col) / 64] |= std::uint64_t{1} << (unsigned(col) % 64);
                 return across;
             };
-            detail::block_row_triangles(top, top + W, W, mesh.seam_closed, mesh.triangles_flipped,
-                                        split, [&](const Triangle& t) { out.push_back(t); });
+            std::size_t count = 0;
+            detail::block_row_triangles(row_top(row), row_top(row) + W, W, mesh.seam_closed,
+                                        mesh.triangles_flipped, split,
+                                        [&](const Triangle&) { ++count; });
+            offsets[std::size_t(row) + 1] = count;
         }
     });
-    // Joined in order, one row after the other: each row is freed as it is copied, so that
-    // the rows and the joined array are not both whole at once (a copy of each row into its
-    // place on the threads would first make the joined array whole: 24 bytes a pixel more at
-    // the mesh's peak).
-    std::size_t total = 0;
-    for (const auto& r : per_row) total += r.size();
-    mesh.triangles.reserve(total);
-    const detail::PassProgress joined(progress, 0.8, 1, "mesh", 5);
-    for (std::size_t row = 0; row < per_row.size(); ++row) {
-        joined.at(row, per_row.size());
-        auto& r = per_row[row];
-        mesh.triangles.insert(mesh.triangles.end(), r.begin(), r.end());
-        detail::release(r);
-    }
-    if (mesh.triangles.empty())
+    std::partial_sum(offsets.begin(), offsets.end(), offsets.begin());
+    if (offsets.back() == 0)
         throw Error("mesh",
                     "'" + dem.source + "' gives no triangle: no 2x2 block has three valid pixels");
+    detail::assign_in_slices(mesh.triangles, offsets.back(), Triangle{},
+                             detail::PassProgress(progress, 0.6, 0.7, "mesh"));
+    detail::parallel_slices(block_rows, 16, progress, 0.7, 1, "mesh", [&](const auto& rows) {
+        for (int row = rows.begin(); row < rows.end(); ++row) {
+            Triangle* out = mesh.triangles.data() + offsets[std::size_t(row)];
+            detail::block_row_triangles(row_top(row), row_top(row) + W, W, mesh.seam_closed,
+                                        mesh.triangles_flipped, detail::recorded_split(mesh, row),
+                                        [&](const Triangle& t) { *out++ = t; });
+        }
+    });
 }
 
 }  // namespace
