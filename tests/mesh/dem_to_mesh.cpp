@@ -436,19 +436,26 @@ TEST_CASE("dem_to_mesh: the adjacency on the grid is the triangles' adjacency", 
 }
 
 TEST_CASE("dem_to_mesh: the same mesh whatever the thread count", "[mesh]") {
-    // A crop, a global grid (seam, collapsed poles) and a grid with NoData holes and pinches:
-    // the numbering, the bounds, the joined rows and the directions run on the threads.
+    // A crop, a global grid (seam, collapsed poles), a grid with NoData holes and pinches, and
+    // one with isolated pixels only: the numbering, the bounds, the rows of triangles, the
+    // areas and the directions run on the threads. (Pixels alone in rings of NoData are
+    // isolated.)
+    const auto ring = [](int c, int r) {
+        const int dc = c % 20 - 10, dr = r % 15 - 7;
+        return std::abs(dc) <= 1 && std::abs(dr) <= 1 && (dc != 0 || dr != 0);
+    };
+    const auto wave = [](int c, int r) { return std::sin(c * 0.3) * std::cos(r * 0.2) * 10; };
     std::vector<Dem> dems{
         io::read_dem(test::sample("moon_ldem4_copernicus.tif")),
         io::read_dem(test::sample("moon_ldem1_global.tif")),
-        grid_dem(97, 61, 1.0, [](int c, int r) {
-            // (pixels alone in rings of NoData: isolated)
-            const int dc = c % 20 - 10, dr = r % 15 - 7;
-            const bool ring = std::abs(dc) <= 1 && std::abs(dr) <= 1 && (dc != 0 || dr != 0);
-            return ring || (c * 7 + r * 13) % 11 == 0 || (c % 9 == 4 && r % 5 == 2)
-                       ? kNaN
-                       : std::sin(c * 0.3) * std::cos(r * 0.2) * 10;
-        })};
+        grid_dem(97, 61, 1.0,
+                 [&](int c, int r) {
+                     const bool hole = (c * 7 + r * 13) % 11 == 0 || (c % 9 == 4 && r % 5 == 2);
+                     return ring(c, r) || hole ? kNaN : wave(c, r);
+                 }),
+        // (isolated pixels without pinches: the areas summed by bands that hold their rows'
+        // doubles only, the pixels without a vertex skipped)
+        grid_dem(83, 70, 1.0, [&](int c, int r) { return ring(c, r) ? kNaN : wave(c, r); })};
     for (const Dem& dem : dems) {
         TriangleMesh one, two;
         {
@@ -459,8 +466,12 @@ TEST_CASE("dem_to_mesh: the same mesh whatever the thread count", "[mesh]") {
             tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 2);
             two = mesh::dem_to_mesh(dem);
         }
-        if (&dem == &dems.back()) {  // the holes make pinches and isolated pixels
+        if (&dem == &dems[2]) {  // the holes make pinches and isolated pixels
             CHECK(two.pinched_vertices > 0);
+            CHECK(two.isolated_vertices > 0);
+        }
+        if (&dem == &dems[3]) {
+            CHECK(two.pinched_vertices == 0);
             CHECK(two.isolated_vertices > 0);
         }
         CHECK(one.pinched_vertices == two.pinched_vertices);

@@ -93,8 +93,7 @@ TEST_CASE("pipeline::segment gives labels, regions and the files of terrain segm
     pipeline::WriteOptions freeing;
     freeing.release_memory = true;
     const auto dir2 = test::scratch_dir("pipeline_segment_freeing");
-    CHECK(pipeline::write_segment_directory(again, options, path, dir2.string(), freeing) ==
-          files);
+    CHECK(pipeline::write_segment_directory(again, options, path, dir2.string(), freeing) == files);
     CHECK(again.input.mesh.positions.empty());
     CHECK(again.input.mesh.vertex_areas.empty());
     const auto counts = [](const std::string& json) {

@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <functional>
@@ -219,6 +220,76 @@ void set_vertex_areas(TriangleMesh& mesh, const detail::PassProgress& areas) {
     mesh.vertex_areas.assign(area.begin(), area.end());
 }
 
+// set_grid_vertex_areas's sums for a DEM mesh whose vertices each have a pixel of their own
+// (no split pinch): the same additions in the same order, each vertex's in triangle order, but
+// in doubles for a band's rows only, written out as floats once they are whole. A whole array
+// of doubles beside the floats was 8 bytes a pixel more at the mesh's peak. Bands of 16 block
+// rows on every thread add their triangles to their pixel rows but the first; the last row's
+// sums, still partial, wait in `seam` for the next band, which adds its first block row to
+// them once every band is done.
+void add_areas_by_bands(TriangleMesh& mesh, int rows, const std::vector<std::size_t>& row_first,
+                        const ProgressFn& progress, double begin, double end) {
+    const std::size_t W = static_cast<std::size_t>(mesh.grid_width);
+    constexpr int kBandRows = 16;
+    const int bands = (rows + kBandRows - 1) / kBandRows;
+    const double zeroed = begin + (end - begin) * 0.1, middle = begin + (end - begin) * 0.8;
+    detail::assign_in_slices(mesh.vertex_areas, mesh.positions.size(), 0.0f,
+                             detail::PassProgress(progress, begin, zeroed, "mesh"));
+    const auto pixel_of = [&](std::int32_t v) {
+        return static_cast<std::size_t>(mesh.vertex_pixel[std::size_t(v)]);
+    };
+    // f(pixel, third) for each corner of block row `row`'s triangles, in order.
+    const auto corners = [&](int row, const auto& f) {
+        for (std::size_t i = row_first[std::size_t(row)]; i < row_first[std::size_t(row) + 1];
+             ++i) {
+            const auto& t = mesh.triangles[i];
+            const double third = triangle_area(mesh, t) / 3.0;
+            for (const auto v : t) f(pixel_of(v), third);
+        }
+    };
+    // Pixel row `row`'s sums (W doubles from `sums`) to its vertices.
+    const auto put_row = [&](std::size_t row, const double* sums) {
+        for (std::size_t col = 0; col < W; ++col) {
+            const std::size_t p = row * W + col;
+            const std::int32_t v = mesh.pixel_vertex[p];
+            if (v >= 0 && pixel_of(v) == p)
+                mesh.vertex_areas[std::size_t(v)] = static_cast<float>(sums[col]);
+        }
+    };
+    std::vector<double> seam(std::size_t(bands) * W, 0.0);  // band b's first row, from b - 1
+    detail::parallel_slices(
+        bands, 1, progress, zeroed, middle, "mesh", [&](const tbb::blocked_range<int>& r) {
+            std::vector<double> sums;  // pixel rows first to last of the band
+            for (int band = r.begin(); band < r.end(); ++band) {
+                const int first = band * kBandRows, last = std::min(rows, first + kBandRows);
+                sums.assign(std::size_t(last - first + 1) * W, 0.0);
+                for (int row = first; row < last; ++row)
+                    corners(row, [&](std::size_t p, double third) {
+                        const std::size_t at = p - std::size_t(first) * W;
+                        if (band == 0 || at >= W) sums[at] += third;
+                    });
+                for (int row = band == 0 ? first : first + 1; row < last; ++row)
+                    put_row(std::size_t(row), &sums[std::size_t(row - first) * W]);
+                const double* tail = &sums[std::size_t(last - first) * W];
+                if (band + 1 == bands)
+                    put_row(std::size_t(last), tail);  // the grid's last row
+                else
+                    std::copy(tail, tail + W, &seam[std::size_t(band + 1) * W]);
+            }
+        });
+    detail::parallel_slices(bands, 1, progress, middle, end, "mesh",
+                            [&](const tbb::blocked_range<int>& r) {
+                                for (int band = std::max(r.begin(), 1); band < r.end(); ++band) {
+                                    const std::size_t first = std::size_t(band) * kBandRows;
+                                    double* sums = &seam[std::size_t(band) * W];
+                                    corners(band * kBandRows, [&](std::size_t p, double third) {
+                                        if (p / W == first) sums[p % W] += third;
+                                    });
+                                    put_row(first, sums);
+                                }
+                            });
+}
+
 // The same sums for a DEM mesh, on every thread, by bands of block rows
 // (add_in_order_by_bands): its triangles come in rows of blocks, a vertex of pixel row p a
 // corner only in block rows p - 1 and p. False (nothing done) when a triangle is not so.
@@ -253,6 +324,11 @@ bool set_grid_vertex_areas(TriangleMesh& mesh, const ProgressFn& progress, doubl
         row_first[std::size_t(row)] =
             *std::ranges::partition_point(std::views::iota(std::size_t{0}, nt),
                                           [&](std::size_t i) { return block_row(i) < row; });
+    if (mesh.pinched_vertices == 0 &&
+        mesh.pixel_vertex.size() == std::size_t(W) * std::size_t(mesh.grid_height)) {
+        add_areas_by_bands(mesh, rows, row_first, progress, begin, end);
+        return true;
+    }
     std::vector<double> area(mesh.positions.size(), 0.0);
     detail::add_in_order_by_bands(
         rows, pixel_row,
@@ -566,20 +642,35 @@ std::size_t split_pinched_vertices(TriangleMesh& mesh, std::int32_t* first_pinch
     check_adjacency_size(3 * std::uint64_t{mesh.triangles.size()}, "triangle corners");
     // The incident triangles of the vertices looked at (all, or those that may be pinched),
     // by their rank among them.
-    std::vector<std::int32_t> rank_of;  // with may_pinch: each vertex's rank, -1 if not looked at
+    // With may_pinch, the vertices looked at are a bit each, a word of 64 of them with the
+    // count of those before it: a vertex's rank is that count and the bits below its own.
+    // (An array of ranks was 4 bytes a pixel at the mesh's peak, for a few vertices.)
+    std::vector<std::uint64_t> looked;
+    std::vector<std::uint32_t> before;  // by word
     std::size_t looked_at = n;
-    if (may_pinch) {  // (asked on every thread, ranked in order)
-        detail::assign_in_slices(rank_of, n, -1, counted);
-        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, std::size_t{1} << 14),
+    if (may_pinch) {  // (asked on every thread, a word each; counted in order)
+        const std::size_t words = (n + 63) / 64;
+        detail::assign_in_slices(looked, words, std::uint64_t{0}, counted);
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, words, std::size_t{1} << 8),
                           [&](const tbb::blocked_range<std::size_t>& r) {
-                              for (std::size_t v = r.begin(); v < r.end(); ++v)
-                                  if (may_pinch(v)) rank_of[v] = 0;
+                              for (std::size_t w = r.begin(); w < r.end(); ++w)
+                                  for (std::size_t v = 64 * w; v < std::min(n, 64 * w + 64); ++v)
+                                      if (may_pinch(v)) looked[w] |= std::uint64_t{1} << (v % 64);
                           });
+        before.resize(words);
         looked_at = 0;
-        for (std::size_t v = 0; v < n; ++v)
-            if (rank_of[v] == 0) rank_of[v] = std::int32_t(looked_at++);
+        for (std::size_t w = 0; w < words; ++w) {
+            before[w] = static_cast<std::uint32_t>(looked_at);
+            looked_at += static_cast<std::size_t>(std::popcount(looked[w]));
+        }
     }
-    const auto rank = [&](std::int32_t v) { return may_pinch ? rank_of[std::size_t(v)] : v; };
+    const auto rank = [&](std::int32_t v) -> std::int32_t {
+        if (!may_pinch) return v;
+        const std::size_t w = std::size_t(v) / 64;
+        const std::uint64_t bit = std::uint64_t{1} << (std::size_t(v) % 64);
+        if ((looked[w] & bit) == 0) return -1;
+        return static_cast<std::int32_t>(before[w] + std::popcount(looked[w] & (bit - 1)));
+    };
     // The corners at vertices looked at, (rank, triangle): with may_pinch (a few vertices of a
     // large grid) gathered by slices of triangles on every thread, in triangle order within
     // each, then counted and listed slice by slice; else (every vertex: a mesh file) counted
