@@ -155,7 +155,7 @@ TEST_CASE("Disk-like DEMs give a tree, a hole in the DEM can give a loop", "[ree
     CHECK(reeb::reeb_is_tree(disks_mesh));
     const auto f = test::noise_field(disks_mesh.vertex_count(), 11);
     const auto forest =
-        reeb::build_reeb_graph(disks_mesh, f, {reeb::ReebAlgorithm::contour_tree, false, {}});
+        reeb::build_reeb_graph(disks_mesh, f, {reeb::ReebAlgorithm::contour_tree, false, {}, {}});
     REQUIRE(reeb::check_reeb_graph(forest, f).empty());
     CHECK(reeb::summarize(forest).components == 2);
     CHECK(reeb::summarize(forest).loops == 0);
@@ -343,7 +343,7 @@ TEST_CASE("The contour tree and the sweep give the same graph on disks and spher
     CHECK_FALSE(reeb::reeb_is_tree(holed));
     CHECK_FALSE(reeb::reeb_is_tree(test::torus_mesh(3, 1, 12, 8, true)));
     CHECK_THROWS_WITH(reeb::build_reeb_graph(holed, test::noise_field(holed.vertex_count(), 1),
-                                             {reeb::ReebAlgorithm::contour_tree, false, {}}),
+                                             {reeb::ReebAlgorithm::contour_tree, false, {}, {}}),
                       Catch::Contains("disks or spheres"));
     // Noise on four levels (quantized): plateaus of every shape, degenerate saddles and
     // boundary runs.
@@ -356,9 +356,10 @@ TEST_CASE("The contour tree and the sweep give the same graph on disks and spher
         {&sphere, quantized(test::noise_field(sphere.vertex_count(), 7))},
     };
     for (const auto& [mesh, f] : cases) {
-        const auto a = reeb::build_reeb_graph(*mesh, f, {reeb::ReebAlgorithm::sweep, false, {}});
+        const auto a =
+            reeb::build_reeb_graph(*mesh, f, {reeb::ReebAlgorithm::sweep, false, {}, {}});
         const auto b =
-            reeb::build_reeb_graph(*mesh, f, {reeb::ReebAlgorithm::contour_tree, false, {}});
+            reeb::build_reeb_graph(*mesh, f, {reeb::ReebAlgorithm::contour_tree, false, {}, {}});
         REQUIRE(reeb::check_reeb_graph(b, f).empty());
         CHECK(a.node_vertices == b.node_vertices);
         CHECK(a.node_kinds == b.node_kinds);
@@ -453,6 +454,55 @@ TEST_CASE("A tree's field may be taken away once the events are ordered", "[reeb
     wrong.field_read = [&] { std::vector<float>().swap(torus_field); };
     CHECK_THROWS_WITH(reeb::build_reeb_graph(torus, torus_field, wrong),
                       Catch::Contains("said to be a tree"));
+}
+
+TEST_CASE("The contour tree's sweeps let their caller park the vertex lists and nodes", "[reeb]") {
+    // pipeline::segment parks the graph's vertex lists, their offsets and the vertices' nodes
+    // on disk through the join and split sweeps. A quantized field makes plateaus (nodes of
+    // several vertices), whose links the sweeps read vertex by vertex: from the nodes around
+    // them listed before, not from the arrays taken away.
+    const auto globe_dem = io::read_dem(test::sample("moon_ldem1_global.tif"));
+    const auto sphere = mesh::dem_to_mesh(globe_dem);
+    const auto torus = test::torus_mesh(3, 1, 24, 16, true);  // loops: the sweep after all
+    for (const TriangleMesh* mesh : {&sphere, &torus}) {
+        const auto f = quantized(test::noise_field(mesh->vertex_count(), 7));
+        const auto held = reeb::build_reeb_graph(*mesh, f);
+        std::size_t plateaus = 0;
+        for (std::size_t n = 0; n < held.node_count(); ++n)
+            plateaus += held.node_vertex_offsets[n + 1] - held.node_vertex_offsets[n] > 1;
+        CHECK(plateaus > 10);
+        std::map<const void*, std::vector<std::int32_t>> aside;
+        std::multiset<std::size_t> sizes;
+        int parks = 0, restores = 0;
+        reeb::ReebOptions options;
+        options.sweeps.park = [&](std::vector<std::int32_t>& v) {
+            ++parks;
+            sizes.insert(v.size());
+            aside[&v].swap(v);  // read while away, they would be empty
+        };
+        options.sweeps.restore = [&](std::vector<std::int32_t>& v) {
+            ++restores;
+            CHECK(v.empty());
+            REQUIRE(aside.count(&v) == 1);
+            v.swap(aside[&v]);
+            aside.erase(&v);
+        };
+        const auto taken = reeb::build_reeb_graph(*mesh, f, options);
+        CHECK(parks == 3);
+        CHECK(restores == 3);
+        CHECK(aside.empty());
+        const std::size_t nv = mesh->vertex_count();
+        CHECK(sizes == std::multiset<std::size_t>{nv, nv, held.node_count() + 1});
+        REQUIRE(reeb::check_reeb_graph(taken, f).empty());
+        CHECK(taken.node_values == held.node_values);
+        CHECK(taken.node_kinds == held.node_kinds);
+        CHECK(taken.node_lower_links == held.node_lower_links);
+        CHECK(taken.node_upper_links == held.node_upper_links);
+        CHECK(taken.node_vertices == held.node_vertices);
+        CHECK(taken.vertex_nodes == held.vertex_nodes);
+        CHECK(taken.arcs == held.arcs);
+        CHECK(taken.arc_nodes == held.arc_nodes);
+    }
 }
 
 TEST_CASE("The Reeb graph's progress is monotone, on the caller's thread, whatever the threads",

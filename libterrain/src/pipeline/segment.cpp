@@ -206,7 +206,8 @@ void compute_field(SegmentResult& result, const SegmentOptions& options,
 }
 
 reeb::ReebGraph compute_reeb(SegmentResult& result, const ProgressFn& progress, bool known_tree,
-                             const std::function<void()>& field_read) {
+                             const std::function<void()>& field_read,
+                             const reeb::ArrayParking& sweeps) {
     const auto t0 = clock::now();
     auto& mesh = result.input.mesh;
     // A DEM mesh frees its triangles (24 bytes a pixel) once no stage needs them at random,
@@ -221,6 +222,7 @@ reeb::ReebGraph compute_reeb(SegmentResult& result, const ProgressFn& progress, 
     reeb::ReebOptions reeb_options;
     reeb_options.known_tree = known_tree;
     reeb_options.field_read = field_read;
+    reeb_options.sweeps = sweeps;
     auto graph = reeb::build_reeb_graph(mesh, result.field, reeb_options,
                                         scaled_progress(progress, 0.1, 0.95));
     // Only the count of critical nodes is reported: summarize() would also count the graph's
@@ -398,8 +400,14 @@ SegmentResult segment(Input input, const SegmentOptions& options, const Progress
     result.add_time("reeb", since(tp));  // (which it precedes: the times stay in run order)
     // The field waits on disk too once the Reeb graph's events are ordered (the contour tree
     // does not read it): the Reeb graph's peak of memory is in the contour tree.
-    auto graph = compute_reeb(result, scaled_progress(progress, 0.21, 0.4), tree,
-                              [&] { parked.park(result.field, {}, 0, 0); });
+    // The graph's vertex lists and vertices' nodes wait too through the contour tree's join
+    // and split sweeps (its peak), which do not read them.
+    reeb::ArrayParking sweeps;
+    sweeps.park = [&](std::vector<std::int32_t>& v) { parked.park(v, {}, 0, 0); };
+    sweeps.restore = [&](std::vector<std::int32_t>& v) { parked.restore(v, {}, 0, 0); };
+    auto graph = compute_reeb(
+        result, scaled_progress(progress, 0.21, 0.4), tree,
+        [&] { parked.park(result.field, {}, 0, 0); }, sweeps);
     const auto ta = clock::now();
     parked.restore(mesh.vertex_areas, progress, 0.4, 0.4);
     result.add_time("reeb", since(ta));

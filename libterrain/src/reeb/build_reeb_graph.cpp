@@ -44,7 +44,7 @@ ReebGraph build_reeb_graph(const TriangleMesh& mesh, const std::vector<float>& f
     internal::order_events(mesh, field, g, scaled_progress(progress, 0, 0.2));
     const bool given_away = options.known_tree && options.field_read;
     if (given_away) options.field_read();  // (the contour tree does not read the field)
-    if (internal::contour_tree(mesh, g, progress)) {
+    if (internal::contour_tree(mesh, g, progress, options.sweeps)) {
         report_progress(progress, 1.0, "reeb");
         return g;
     }

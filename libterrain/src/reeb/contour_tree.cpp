@@ -97,7 +97,8 @@ bool loop_free_by_components(const TriangleMesh& mesh, const ProgressFn& progres
     return true;
 }
 
-bool contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& progress) {
+bool contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& progress,
+                  const ArrayParking& parking) {
     const std::size_t nn = g.node_count();
     g.node_lower_links.assign(nn, 1);
     g.node_upper_links.assign(nn, 1);
@@ -105,6 +106,30 @@ bool contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& prog
     std::vector<LinkCounts> vertex_links;
     std::vector<LinkReps> reps =
         link_components(mesh, g, vertex_links, general, scaled_progress(progress, 0.2, 0.3));
+    // A node whose link a sweep reads vertex by vertex (kSeveral on a side: a plateau, more
+    // than two link components, a vertex of very high degree; few on a terrain) has the nodes
+    // around it listed here, in the order the sweep reads them (its vertices', each one's
+    // neighbours' in order), and their list's number in the second representative of such a
+    // side. The sweeps then read neither the graph's vertex lists, its vertices' nodes nor the
+    // mesh, and the caller may park the first two through them.
+    std::vector<std::size_t> around_offsets(1, 0);
+    std::vector<i32> around;
+    for (std::size_t e = 0; e < nn; ++e) {
+        LinkReps& r = reps[e];
+        if (r.lower[0] != kSeveral && r.upper[0] != kSeveral) continue;
+        const auto list = static_cast<i32>(around_offsets.size() - 1);
+        if (r.lower[0] == kSeveral) r.lower[1] = list;
+        if (r.upper[0] == kSeveral) r.upper[1] = list;
+        for (i32 i = g.node_vertex_offsets[e]; i < g.node_vertex_offsets[e + 1]; ++i)
+            for (const i32 w : mesh.neighbors_of(idx(g.node_vertices[idx(i)])))
+                around.push_back(g.vertex_nodes[idx(w)]);
+        around_offsets.push_back(around.size());
+    }
+    if (parking.on()) {
+        parking.park(g.node_vertices);
+        parking.park(g.node_vertex_offsets);
+        parking.park(g.vertex_nodes);
+    }
     // Node e's upper representatives once the join sweep has moved them (below).
     const auto upper_reps = [&](std::size_t e) -> std::array<i32, 2>& {
         return e % 2 == 0 ? reps[e / 2].lower : reps[e / 2].upper;
@@ -231,15 +256,12 @@ bool contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& prog
             children[idx(e)][side] = 0;
             if (rep[0] == kNone) continue;
             roots.clear();
-            for (i32 i = g.node_vertex_offsets[idx(e)]; i < g.node_vertex_offsets[idx(e) + 1];
-                 ++i) {
-                const i32 v = g.node_vertices[idx(i)];
-                for (const i32 w : mesh.neighbors_of(idx(v))) {
-                    const i32 n = g.vertex_nodes[idx(w)];
-                    if (ascending ? n >= e : n <= e) continue;
-                    const i32 c = find(n);
-                    if (std::find(roots.begin(), roots.end(), c) == roots.end()) roots.push_back(c);
-                }
+            const std::size_t list = idx(rep[1]);  // (rep[0] is kSeveral)
+            for (std::size_t i = around_offsets[list]; i < around_offsets[list + 1]; ++i) {
+                const i32 n = around[i];
+                if (ascending ? n >= e : n <= e) continue;
+                const i32 c = find(n);
+                if (std::find(roots.begin(), roots.end(), c) == roots.end()) roots.push_back(c);
             }
             i32 cur = e;
             for (const i32 c : roots) cur = join(cur, c, e);
@@ -256,6 +278,13 @@ bool contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& prog
     sweep(false, split_parent);
     detail::release(swept);
     detail::release(reps);  // (16 bytes a node: what the arcs below are made beside)
+    detail::release(around);
+    detail::release(around_offsets);
+    if (parking.on()) {
+        parking.restore(g.vertex_nodes);
+        parking.restore(g.node_vertex_offsets);
+        parking.restore(g.node_vertices);
+    }
     const auto components = std::count(join_parent.begin(), join_parent.end(), kNone);
     if (components == 1 ? !one_component_loop_free(mesh) : !loop_free_by_components(mesh))
         return false;

@@ -19,7 +19,9 @@ bool loop_free_by_components(const TriangleMesh& mesh, const ProgressFn& progres
 
 // The Reeb graph of the field whose events order_events put in g, when the mesh has no loops
 // (then it is the contour tree). Returns false, leaving the graph half made, when the mesh
-// has handles or holes.
-bool contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& progress);
+// has handles or holes. `parking`: g's vertex lists, offsets and vertices' nodes are parked
+// through the join and split sweeps, which do not read them (ReebOptions::sweeps).
+bool contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& progress,
+                  const ArrayParking& parking = {});
 
 }  // namespace terrain::reeb::internal

@@ -165,9 +165,11 @@ void compute_field(SegmentResult& result, const SegmentOptions& options,
 // mesh's triangles are released after it (TriangleMesh::release_triangles). `known_tree`:
 // the caller has found the mesh a tree (reeb::reeb_is_tree); then, or when this finds it,
 // `field_read` is called once the graph reads result.field no more (reeb::ReebOptions), and
-// the caller may take the field away until this returns.
+// the caller may take the field away until this returns. `sweeps`: the graph's vertex lists
+// and vertices' nodes may be parked through the contour tree's sweeps (reeb::ReebOptions).
 reeb::ReebGraph compute_reeb(SegmentResult& result, const ProgressFn& progress = {},
-                             bool known_tree = false, const std::function<void()>& field_read = {});
+                             bool known_tree = false, const std::function<void()>& field_read = {},
+                             const reeb::ArrayParking& sweeps = {});
 
 // One scale: the graph simplified with options.simplify and the regions grown on it.
 struct ScaleResult {

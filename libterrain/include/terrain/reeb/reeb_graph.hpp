@@ -109,6 +109,14 @@ enum class ReebAlgorithm {
     contour_tree,  // join and split trees merged: only for disks and spheres (no loops)
 };
 
+// Arrays a caller may take away while a stage does not read them: `park(v)` may take v's
+// values away (to disk: pipeline::segment), `restore(v)` must put back the same values before
+// they are read again. Used only when both are given.
+struct ArrayParking {
+    std::function<void(std::vector<std::int32_t>&)> park, restore;
+    bool on() const { return park && restore; }
+};
+
 struct ReebOptions {
     ReebAlgorithm algorithm = ReebAlgorithm::automatic;
     // For a caller that would rather not hold the field while the graph is made: when the mesh
@@ -118,6 +126,10 @@ struct ReebOptions {
     // said to be a tree that has handles or holes is then an error.
     bool known_tree = false;
     std::function<void()> field_read;
+    // The contour tree's join and split sweeps read neither the graph's vertex lists and
+    // offsets nor its vertices' nodes (12 bytes a vertex, at the Reeb graph's peak of memory):
+    // they are handed to `sweeps.park` before the sweeps and to `sweeps.restore` after.
+    ArrayParking sweeps;
 };
 
 // True when every connected component of the mesh is a disk or a sphere, so that the Reeb
