@@ -547,25 +547,31 @@ TEST_CASE("A graph handed over lets its caller set the mesh's areas aside once t
 
 TEST_CASE("A graph handed over lets its caller park the vertices' nodes until the output",
           "[simplify]") {
+    // Parked: the graph's vertices' nodes (from the copy of the nodes) and the working copy's
+    // new numbers of the nodes (from the copy of the arcs), both given back after the
+    // cancellations, the new numbers once the working copy is freed.
     const auto& s = vesta();
     const auto o = paper_thresholds();
-    const auto lent = reeb::simplify(s.mesh, reeb::build_reeb_graph(s.mesh, s.si), o);
-    std::vector<std::int32_t> aside;
+    const auto graph = reeb::build_reeb_graph(s.mesh, s.si);
+    const auto lent = reeb::simplify(s.mesh, graph, o);
+    std::map<const void*, std::vector<std::int32_t>> aside;
     int parks = 0, restores = 0;
     double last = 0;
-    std::size_t parked_size = 0;
+    std::multiset<std::size_t> parked_sizes;
     reeb::VertexNodesParking parking;
     parking.park = [&](std::vector<std::int32_t>& v) {
         ++parks;
         CHECK(last < 0.5);  // before the cancellations
-        parked_size = v.size();
-        aside.swap(v);  // read while away, they would be empty
+        parked_sizes.insert(v.size());
+        aside[&v].swap(v);  // read while away, they would be empty
     };
     parking.restore = [&](std::vector<std::int32_t>& v) {
         ++restores;
         CHECK(last > 0.5);  // after the cancellations
         CHECK(v.empty());
-        v.swap(aside);
+        REQUIRE(aside.count(&v) == 1);
+        v.swap(aside[&v]);
+        aside.erase(&v);
     };
     const auto progress = [&](double f, std::string_view) {
         last = f;
@@ -573,9 +579,10 @@ TEST_CASE("A graph handed over lets its caller park the vertices' nodes until th
     };
     const auto given =
         reeb::simplify(s.mesh, reeb::build_reeb_graph(s.mesh, s.si), o, progress, {}, parking);
-    CHECK(parks == 1);
-    CHECK(restores == 1);
-    CHECK(parked_size == s.mesh.vertex_count());
+    CHECK(parks == 2);
+    CHECK(restores == 2);
+    CHECK(aside.empty());
+    CHECK(parked_sizes == std::multiset<std::size_t>{s.mesh.vertex_count(), graph.node_count()});
     check_same_result(given, lent);
     // Given back wrong: one error, not a read out of bounds.
     last = 0;

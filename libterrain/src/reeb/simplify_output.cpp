@@ -23,11 +23,11 @@ using detail::find_root;
 
 void WorkingGraph::write_result(SimplifyResult& result, const ProgressFn& progress) {
     const std::size_t nn = input_nodes_, nl = regular_.size();
-    // Its passes: the fates (0 to 0.2), the new numbers (to 0.3), the arcs (to 0.4), the
+    // Its passes: the fates (0 to 0.2), the arcs (to 0.3), the new numbers (to 0.4), the
     // input's vertex lists made again (to 0.5), the vertices and their values (to 1).
     using detail::PassProgress;
-    const PassProgress fates(progress, 0, 0.2, "simplify"), numbers(progress, 0.2, 0.3, "simplify"),
-        arcs(progress, 0.3, 0.4, "simplify");
+    const PassProgress fates(progress, 0, 0.2, "simplify"), arcs(progress, 0.2, 0.3, "simplify"),
+        numbers(progress, 0.3, 0.4, "simplify");
     // code[i]: for an absorbed node, the critical node that finally took it (nodes are
     // only absorbed into critical nodes); for a remaining node, -2 - its new id.
     // A listed node's forward: the fate of its set's root (kNone for a list still there).
@@ -46,11 +46,54 @@ void WorkingGraph::write_result(SimplifyResult& result, const ProgressFn& progre
         const i32 f = fate(regular_[p].forward);
         code[idx(critical_count_) + p] = f == kNone || code[idx(f)] == kNone ? f : code[idx(f)];
     }
+    // What the output reads of the working graph, taken out: the nodes that remain (by their
+    // index here, in order) and the arcs that live, with their lists (a few thousand nodes on
+    // a simplified grid). The working graph then goes, before the new numbers come back
+    // (parked through the cancellations) and the arrays of every node and vertex are made:
+    // the peak of the simplification's memory.
+    struct Remaining {
+        i32 index = kNone;  // here
+        float value = 0;
+        NodeKind kind = NodeKind::regular;
+        std::uint8_t lower = 1, upper = 1;  // link counts, for a critical node changed
+        bool changed = false;
+    };
+    std::vector<Remaining> remaining;
+    for (std::size_t i = 0; i < code.size(); ++i) {
+        if (code[i] != kNone) continue;
+        Remaining r;
+        r.index = static_cast<i32>(i);
+        r.value = value(r.index);
+        if (i < idx(critical_count_) && (critical_[i].flags & kCritical)) {
+            const i32 d = down(r.index), u = up(r.index);
+            r.kind = d == 0 ? NodeKind::minimum : u == 0 ? NodeKind::maximum : NodeKind::saddle;
+            r.changed = (critical_[i].flags & kModified) != 0;
+            r.lower = static_cast<std::uint8_t>(std::min(d, 255));
+            r.upper = static_cast<std::uint8_t>(std::min(u, 255));
+        }
+        remaining.push_back(r);
+    }
+    std::vector<std::array<i32, 2>> live_ends;  // the arcs that live, in order
+    std::vector<i32> live_offsets(1, 0), live_nodes;
+    for (std::size_t a = 0; a < arcs_.size(); ++a) {
+        arcs.at(a, arcs_.size());
+        const Arc& arc = arcs_[a];
+        if (arc.set == kNone) continue;
+        live_ends.push_back(ends(static_cast<i32>(a)));
+        for (i32 r = arc.head; r != kNone; r = next(r)) live_nodes.push_back(r);
+        live_offsets.push_back(static_cast<i32>(live_nodes.size()));
+    }
+    release_working_graph();
+    if (map_parked_.restore) {
+        map_parked_.restore(node_map_);
+        if (node_map_.size() != nn)
+            throw Error("simplify", "the new numbers came back with the wrong size");
+    }
     // The remaining nodes are numbered in the order of the old ones; node_map_ takes each old
     // node's new node (first -2 - the node that took it, for the absorbed ones).
     std::vector<std::array<i32, 2>> kept;  // {old node, internal index} by new id
     std::vector<std::uint8_t> gone;        // old nodes absorbed by another
-    detail::assign_in_slices(gone, nn, std::uint8_t{0}, made(0.2));
+    detail::assign_in_slices(gone, nn, std::uint8_t{0}, made(0.3));
     for (std::size_t n = 0; n < nn; ++n) {
         numbers.at(n, nn);
         if (n + kAhead < nn) __builtin_prefetch(&code[idx(node_map_[n + kAhead])]);
@@ -65,6 +108,8 @@ void WorkingGraph::write_result(SimplifyResult& result, const ProgressFn& progre
         node_map_[n] = -2 - c;
     }
     const std::size_t count = kept.size();
+    if (count != remaining.size())
+        throw Error("simplify", "internal: the remaining nodes are not one an old node");
     for (std::size_t n = 0; n < nn; ++n)
         if (node_map_[n] < 0) node_map_[n] = -2 - code[idx(-2 - node_map_[n])];
     ReebGraph& out = result.graph;
@@ -75,17 +120,14 @@ void WorkingGraph::write_result(SimplifyResult& result, const ProgressFn& progre
     out.node_arcs.assign(count, kNone);
     for (std::size_t nid = 0; nid < count; ++nid) {
         const auto [n, i] = kept[nid];
-        out.node_values[nid] = value(i);
-        if (i >= critical_count_ || !(critical_[idx(i)].flags & kCritical)) continue;
-        const i32 d = down(i), u = up(i);
-        out.node_kinds[nid] = d == 0   ? NodeKind::minimum
-                              : u == 0 ? NodeKind::maximum
-                                       : NodeKind::saddle;
-        const bool unchanged = !(critical_[idx(i)].flags & kModified);
-        out.node_lower_links[nid] =
-            unchanged ? g_.node_lower_links[idx(n)] : static_cast<std::uint8_t>(std::min(d, 255));
-        out.node_upper_links[nid] =
-            unchanged ? g_.node_upper_links[idx(n)] : static_cast<std::uint8_t>(std::min(u, 255));
+        const auto at =
+            std::lower_bound(remaining.begin(), remaining.end(), i,
+                             [](const Remaining& r, i32 index) { return r.index < index; });
+        out.node_values[nid] = at->value;
+        if (at->kind == NodeKind::regular) continue;
+        out.node_kinds[nid] = at->kind;
+        out.node_lower_links[nid] = at->changed ? at->lower : g_.node_lower_links[idx(n)];
+        out.node_upper_links[nid] = at->changed ? at->upper : g_.node_upper_links[idx(n)];
     }
     if (owned_) {  // a graph handed over: what is read no more goes
         detail::release(owned_->node_lower_links);
@@ -94,25 +136,22 @@ void WorkingGraph::write_result(SimplifyResult& result, const ProgressFn& progre
     // The arcs that remain, with their regular nodes from the lower end up.
     const auto new_id = [&](i32 i) { return -2 - code[idx(i)]; };
     out.arc_offsets.assign(1, 0);
-    for (std::size_t a = 0; a < arcs_.size(); ++a) {
-        arcs.at(a, arcs_.size());
-        const Arc& arc = arcs_[a];
-        if (arc.set == kNone) continue;
+    for (std::size_t k = 0; k < live_ends.size(); ++k) {
         const i32 id = static_cast<i32>(out.arcs.size());
-        const auto& e = ends(static_cast<i32>(a));
-        out.arcs.push_back({new_id(e[0]), new_id(e[1])});
-        for (i32 r = arc.head; r != kNone; r = next(r)) {
-            const i32 nid = new_id(r);
+        out.arcs.push_back({new_id(live_ends[k][0]), new_id(live_ends[k][1])});
+        for (i32 p = live_offsets[k]; p < live_offsets[k + 1]; ++p) {
+            const i32 nid = new_id(live_nodes[idx(p)]);
             out.arc_nodes.push_back(nid);
             out.node_arcs[idx(nid)] = id;
         }
         out.arc_offsets.push_back(static_cast<i32>(out.arc_nodes.size()));
     }
-    // The working graph is done: it goes before the arrays of every vertex are made (the
-    // peak of the simplification's memory).
     detail::release(code);
     detail::release(kept);
-    release_working_graph();
+    detail::release(remaining);
+    detail::release(live_ends);
+    detail::release(live_offsets);
+    detail::release(live_nodes);
     const std::size_t nv = input_vertices_;
     if (parked_.restore) {
         parked_.restore(owned_->vertex_nodes);

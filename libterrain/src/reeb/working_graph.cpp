@@ -274,11 +274,26 @@ WorkingGraph::WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big
             parked_.park(owned->vertex_nodes);
         }
     }
-    // Arc a joins its lower then its upper end, a in order.
-    detail::assign_in_slices(arcs_, na, Arc{}, PassProgress(progress, 0.6, 0.7, "simplify"));
+    // Arc a joins its lower then its upper end, a in order. As with the critical nodes, the
+    // arcs' records are written in order into a block reserved, not filled, first, and the
+    // input's arcs, offsets and listed nodes go back to the system behind the pass: the end
+    // of this pass is the simplification's peak of memory.
+    arcs_.reserve(na);
+    report_progress(progress, 0.7, "simplify");
+    detail::PagesBehind ends_behind, offsets_behind_a, listed_behind;
+    if (owned) {
+        ends_behind = detail::PagesBehind(g.arcs.data());
+        offsets_behind_a = detail::PagesBehind(g.arc_offsets.data());
+        listed_behind = detail::PagesBehind(g.arc_nodes.data());
+    }
     for (std::size_t a = 0; a < na; ++a) {
         arcs.at(a, na);
-        Arc& arc = arcs_[a];
+        if ((a & 0x3fff) == 0) {  // (what arcs before a held is read for the last time)
+            ends_behind.before(g.arcs.data() + a);
+            offsets_behind_a.before(g.arc_offsets.data() + a);
+            listed_behind.before(g.arc_nodes.data() + g.arc_offsets[a]);
+        }
+        Arc& arc = arcs_.emplace_back();
         if (a + kAhead < na)
             for (const i32 e : g.arcs[a + kAhead]) __builtin_prefetch(&node_map_[idx(e)]);
         if (a + kAhead / 2 < na)
@@ -308,6 +323,12 @@ WorkingGraph::WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big
         detail::release(owned->arc_nodes);
     }
     detail::release(placed);
+    // The new numbers are read again only by write_result, once the working graph is freed:
+    // they may wait elsewhere through the cancellations (4 bytes a node).
+    if (owned && parking.park && parking.restore) {
+        map_parked_ = parking;
+        map_parked_.park(node_map_);
+    }
     // The lists' sets, made once the input's arcs are freed (the copy's end is the peak of
     // the simplification's memory).
     detail::assign_in_slices(set_parent_, na, kNone, PassProgress(progress, 1, 1, "simplify"));

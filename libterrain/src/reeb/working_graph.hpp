@@ -374,7 +374,8 @@ class WorkingGraph {
     // vertex_nodes (4 bytes a vertex): write_result makes the same lists again from them, once
     // the working graph is freed.
     bool lists_from_vertex_nodes_ = false;
-    VertexNodesParking parked_;  // set when owned's vertex nodes are parked
+    VertexNodesParking parked_;      // set when owned's vertex nodes are parked
+    VertexNodesParking map_parked_;  // set when node_map_ is parked (after the copy)
     // Frees the records, runs, arcs, sets and big nodes (write_result, once the arcs are out).
     void release_working_graph();
     std::size_t moves_ = 0;  // link() calls

@@ -70,10 +70,10 @@ SimplifyResult simplify(const TriangleMesh& mesh, const ReebGraph& graph,
 // were ascending, as build_reeb_graph makes them), wait unread from the working copy's nodes to
 // the output. `park` is called with them then (before the copy of the arcs, the peak) and may
 // take them away; `restore` is called with that vector before they are read again and must put
-// back the same values (pipeline::segment parks them on disk).
-struct VertexNodesParking {
-    std::function<void(std::vector<std::int32_t>&)> park, restore;
-};
+// back the same values (pipeline::segment parks them on disk). The working copy's own new
+// numbers of the graph's nodes (4 bytes a node) wait the same way through the cancellations,
+// to the output, which reads them once the working copy is freed.
+using VertexNodesParking = ArrayParking;
 SimplifyResult simplify(const TriangleMesh& mesh, ReebGraph&& graph, const SimplifyOptions& options,
                         const ProgressFn& progress = {},
                         const std::function<void()>& areas_read = {},
