@@ -202,6 +202,12 @@ void compute_field(SegmentResult& result, const SegmentOptions& options,
     const auto t0 = clock::now();
     result.field =
         field::vertex_field(result.input.mesh, result.dem(), field_options(options), progress);
+    if (options.field == "shape-index") {
+        result.shape_index_method =
+            field::shape_index_method(result.input.mesh, options.shape_index);
+        result.shape_index_window =
+            field::shape_index_window(result.input.mesh, options.shape_index);
+    }
     result.add_time("field", since(t0));
 }
 
@@ -588,11 +594,17 @@ void write_run_json(const SegmentResult& result, const std::string& input_path,
         .field("absorbed", options.absorbed)
         .field("format", options.format)
         .field("frame", to_string(result.input.mesh.frame));
-    if (options.field == "shape-index")
+    if (options.field == "shape-index") {
+        const auto& mesh = result.input.mesh;
         j.field("shape_index_method",
-                field::shape_index_method(result.input.mesh, options.shape_index))
+                !result.shape_index_method.empty()
+                    ? result.shape_index_method
+                    : std::string(field::shape_index_method(mesh, options.shape_index)))
             .field("shape_index_window",
-                   field::shape_index_window(result.input.mesh, options.shape_index));
+                   !result.shape_index_window.empty()
+                       ? result.shape_index_window
+                       : std::string(field::shape_index_window(mesh, options.shape_index)));
+    }
     if (options.field == "sdf")
         j.field("rays", options.rays)
             .field("cone_angle_degrees", options.cone_angle_degrees)

@@ -137,7 +137,10 @@ MeshCounts mesh_counts(const TriangleMesh& mesh);
 // region table and adjacency graph, the counts and the time of each stage.
 struct SegmentResult {
     Input input;
-    std::vector<float> field;         // per mesh vertex, as computed
+    std::vector<float> field;  // per mesh vertex, as computed
+    // The shape index's method and window as compute_field took them (run.json), named while
+    // the mesh is whole: the mesh's arrays may be freed before run.json is written.
+    std::string shape_index_method, shape_index_window;
     std::size_t critical_before = 0;  // critical nodes of the unsimplified Reeb graph
     std::size_t parked_bytes = 0;     // the most bytes parked on disk at once (segment())
     // Bytes parked while the field is computed and while the regions are grown (segment()).
