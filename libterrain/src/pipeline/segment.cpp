@@ -543,8 +543,10 @@ std::vector<std::string> write_segment_directory(SegmentResult& result,
     const bool deferred = write.release_memory && result.input.dem;
     // The files of a DEM read the labels, the field and the pixel maps, not the mesh's
     // positions, areas, triangles or adjacency (about 17 bytes a pixel): they go first.
-    if (deferred) release_mesh_geometry(result);
-    if (deferred) out.deferred_preview = &preview;
+    if (deferred) {
+        release_mesh_geometry(result);
+        out.deferred_preview = &preview;
+    }
     const auto paths =
         io::write_segment_outputs(dir, result.input.mesh, result.field, result.segmentation.labels,
                                   result.regions, result.dem(), out, progress);

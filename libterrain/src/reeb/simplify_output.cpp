@@ -84,7 +84,7 @@ void WorkingGraph::write_result(SimplifyResult& result, const ProgressFn& progre
         live_offsets.push_back(static_cast<i32>(live_nodes.size()));
     }
     release_working_graph();
-    if (map_parked_.restore) {
+    if (map_parked_.on()) {
         map_parked_.restore(node_map_);
         if (node_map_.size() != nn)
             throw Error("simplify", "the new numbers came back with the wrong size");

@@ -269,7 +269,7 @@ WorkingGraph::WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big
             detail::release(owned->vertex_nodes);
         }
         // Read again only by write_result: they may wait elsewhere through the peak.
-        if (lists_from_vertex_nodes_ && parking.park && parking.restore) {
+        if (lists_from_vertex_nodes_ && parking.on()) {
             parked_ = parking;
             parked_.park(owned->vertex_nodes);
         }
@@ -325,7 +325,7 @@ WorkingGraph::WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big
     detail::release(placed);
     // The new numbers are read again only by write_result, once the working graph is freed:
     // they may wait elsewhere through the cancellations (4 bytes a node).
-    if (owned && parking.park && parking.restore) {
+    if (owned && parking.on()) {
         map_parked_ = parking;
         map_parked_.park(node_map_);
     }
