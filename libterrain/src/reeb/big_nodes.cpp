@@ -18,7 +18,7 @@ void Simplifier::promote_pending(bool initial) {
         CriticalNode& c = critical_[idx(n)];
         if (!(c.flags & kPending)) continue;
         c.flags = static_cast<std::uint8_t>(c.flags & ~kPending);
-        if (c.forward != kNone || !(c.flags & kCritical) || c.size < big_degree_) continue;
+        if (forward(n) != kNone || !(c.flags & kCritical) || i32(c.size) < big_degree_) continue;
         make_big(n);
         BigNode& b = big_of(n);
         for (const auto& [arc, keys] : b.keys) {
@@ -174,7 +174,7 @@ void Simplifier::update_reps() {
     for (const i32 n : dirty_big_) {
         CriticalNode& c = critical_[idx(n)];
         c.flags = static_cast<std::uint8_t>(c.flags & ~kDirty);
-        if (!(c.flags & kBig) || c.forward != kNone) continue;  // gone, or made regular
+        if (!(c.flags & kBig) || forward(n) != kNone) continue;  // gone, or made regular
         BigNode& b = big_of(n);
         const i32 r = b.rep;
         bool full = b.full;
@@ -248,12 +248,12 @@ void Simplifier::hand_over(i32 keep, i32 gone, bool midpoint) {
     release_run(k);
     k.size = g.size;
     k.down = keep_down + g.down;
-    k.offset = g.offset;
+    k.slot[0] = g.slot[0];
     k.flags = static_cast<std::uint8_t>((k.flags | kBig) & ~kPending);
     g.flags = static_cast<std::uint8_t>(g.flags & ~(kBig | kPending));
-    g.offset = 0;
     g.size = 0;
     g.down = 0;
+    absorb(gone, keep);  // (its forward takes the slot its set was in)
     clear_waits(keep);  // gone's arcs are all looked at again, as cancel() does for moved arcs
     for (const i32 b : own_) {
         const i32 other = other_end(b, keep);
@@ -291,7 +291,7 @@ std::string Simplifier::check_big_nodes(const std::vector<i32>* only) const {
         const i32 n = only ? (*only)[i] : static_cast<i32>(i);
         const CriticalNode& c = critical_[idx(n)];
         if (!(c.flags & kBig)) continue;
-        if (c.forward != kNone) return at("a big node was absorbed but kept its set", n, kNone);
+        if (forward(n) != kNone) return at("a big node was absorbed but kept its set", n, kNone);
         const BigNode& b = big_of(n);
         if (static_cast<i32>(b.keys.size()) != c.size) return at("degree", n, kNone);
         i32 below = 0;

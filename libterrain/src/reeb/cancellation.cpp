@@ -81,7 +81,7 @@ bool Simplifier::regularize(i32 n, std::vector<i32>& out) {
     release_run(k);
     k.down = 0;
     k.flags &= ~kCritical;
-    k.forward = -2 - L.set;
+    set_forward(n, -2 - L.set);
     prev(n) = L.tail;
     next(n) = U.head;
     if (L.tail == kNone)
@@ -203,7 +203,6 @@ void Simplifier::cancel(i32 a, SimplifyResult& result) {
     --critical_[idx(hi)].down;
     absorb_list(arc, keep, false);
     arc.set = kNone;
-    absorb(gone, keep);
     std::vector<i32>& touched = touched_;
     touched.clear();
     // keep_full: every arc of a big keep may have a new key or candidacy; keep_clear: they are
@@ -211,13 +210,15 @@ void Simplifier::cancel(i32 a, SimplifyResult& result) {
     bool keep_full = false, keep_clear = false;
     const bool handed_over = big(gone) && (!big(keep) || degree(gone) > degree(keep));
     if (handed_over) {
-        hand_over(keep, gone, midpoint);
+        hand_over(keep, gone, midpoint);  // (absorbs gone)
         keep_full = true;
     } else {
+        // gone's arcs read before it is absorbed: its forward takes the slots they were in.
         arcs_at(gone, touched);
         critical_[idx(gone)].size = 0;
         release_run(critical_[idx(gone)]);
         critical_[idx(gone)].down = 0;
+        absorb(gone, keep);
         for (const i32 b : touched) {
             const auto& e = ends(b);  // gone's ends now name keep
             link(b, keep);

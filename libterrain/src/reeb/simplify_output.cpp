@@ -38,7 +38,7 @@ void WorkingGraph::write_result(SimplifyResult& result, const ProgressFn& progre
     const auto made = [&](double at) { return PassProgress(progress, at, at, "simplify"); };
     std::vector<i32> code;
     detail::assign_in_slices(code, idx(critical_count_) + nl, i32{0}, made(0));
-    for (std::size_t k = 0; k < idx(critical_count_); ++k) code[k] = fate(critical_[k].forward);
+    for (std::size_t k = 0; k < idx(critical_count_); ++k) code[k] = fate(forward_of(critical_[k]));
     for (std::size_t k = 0; k < idx(critical_count_); ++k)
         if (code[k] != kNone) code[k] = find_root(code, code[k]);
     for (std::size_t p = 0; p < nl; ++p) {

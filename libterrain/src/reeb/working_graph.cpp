@@ -44,17 +44,17 @@ void WorkingGraph::make_big(i32 n) {
         slot = static_cast<i32>(big_.size());
         big_.emplace_back();
     }
-    c.offset = slot;
+    c.slot[0] = slot;
     c.flags = static_cast<std::uint8_t>((c.flags | kBig) & ~kPending);
     for (const i32 b : arcs) big_insert(n, b);
 }
 
 void WorkingGraph::release_big(CriticalNode& c) {
-    BigNode& b = big_[idx(c.offset)];
+    BigNode& b = big_[idx(c.slot[0])];
     b = BigNode{};
-    free_big_.push_back(c.offset);
+    free_big_.push_back(c.slot[0]);
     c.flags = static_cast<std::uint8_t>(c.flags & ~(kBig | kPending));
-    c.offset = 0;
+    c.slot[0] = 0;
 }
 
 WorkingGraph::BigNode::Keys WorkingGraph::keys_of(i32 b, i32 n) const {
@@ -306,7 +306,7 @@ WorkingGraph::WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big
         for (i32 p = g.arc_offsets[a]; p < g.arc_offsets[a + 1]; ++p) {
             const i32 r =
                 placed[idx(p)] ? critical_count_ + p : node_map_[idx(g.arc_nodes[idx(p)])];
-            forward(r) = -2 - arc.set;
+            set_forward(r, -2 - arc.set);
             if (arc.tail == kNone) {
                 arc.head = r;
             } else {

@@ -28,6 +28,7 @@
 
 #include "../core/indices.hpp"
 #include "arc_measures.hpp"
+#include "terrain/core/error.hpp"
 #include "terrain/core/progress.hpp"
 #include "terrain/reeb/simplify.hpp"
 
@@ -74,25 +75,29 @@ class WorkingGraph {
 
   protected:
     // A critical node (one of the first critical_count_): its fields and its `size` arcs, the
-    // newest last, with room for kInline << shift (see arc_run()). 48 bytes: about half the
-    // vertices of a noisy grid are critical, and a 64-byte record with 8 arcs inline was
-    // both larger (8 bytes a pixel more at the simplification's peak) and slower (bench_reeb,
-    // 4 M vertices: 1.27-1.37 s against 1.02-1.20 s): most nodes have 1 to 4 arcs.
-    static constexpr i32 kInline = 4;
-    struct alignas(16) CriticalNode {
+    // newest last, with room for kInline << shift (see arc_run()). 32 bytes, two to a cache
+    // line and never across one: about half the vertices of a noisy grid are critical, and
+    // the 48-byte record before it (4 arcs inline, every field a word of its own) held 8
+    // bytes a pixel more at the simplification's peak. Most nodes have 1 to 3 arcs (an
+    // extremum 1, a saddle 3). Its three slots are, by its state:
+    //   - a node with arcs, shift == 0 and not big: its arcs;
+    //   - a node with a run in arena_ (shift > 0) or big (kBig): slot[0] is the run's offset
+    //     or its BigNode;
+    //   - a node absorbed or in an arc's list (kForwarded, it has no arcs then): slot[0] is
+    //     its forward (see RegularNode), slot[1] and slot[2] its neighbours in the list.
+    static constexpr i32 kInline = 3;
+    // Arcs a node may hold (the bits of `size`): more throws terrain::Error.
+    static constexpr i32 kMaxDegree = (1 << 26) - 1;
+    struct alignas(32) CriticalNode {
         double area = 0;  // its vertices' and its absorbed nodes' area
         float value = 0;
-        mutable i32 forward = kNone;  // the node that absorbed it (live() shortens the path)
-        i32 size = 0;
-        i32 down = 0;            // its arcs whose upper end it is
-        i32 offset = 0;          // its run in arena_ when shift > 0
-        std::uint8_t shift = 0;  // room for kInline << shift arcs
-        std::uint8_t flags = 0;  // kCritical, kModified
-        // Its run while shift == 0; once it is regular (no arcs), its previous and next node
-        // in its arc's list.
-        std::array<i32, kInline> own{};
+        std::uint32_t size : 26 = 0;   // its arcs
+        std::uint32_t shift : 6 = 0;   // room for kInline << shift arcs
+        std::uint32_t down : 26 = 0;   // its arcs whose upper end it is
+        std::uint32_t flags : 6 = 0;   // kCritical, kModified, kBig, kPending, kDirty, kForwarded
+        mutable std::array<i32, kInline> slot{};  // (live() shortens forward paths)
     };
-    static_assert(sizeof(CriticalNode) == 48);
+    static_assert(sizeof(CriticalNode) == 32);
     // A node's `forward`: the critical node that absorbed it; for a node in a list, -2 - the
     // set of its list (see Arc::set); kNone for a critical node.
     struct RegularNode {
@@ -115,6 +120,8 @@ class WorkingGraph {
     };
     static_assert(sizeof(Arc) == 32);
     static constexpr std::uint8_t kCritical = 1, kModified = 2;
+    // kForwarded: its forward is set (slot[0]): it was absorbed, or it is in an arc's list.
+    static constexpr std::uint8_t kForwarded = 32;
     // kBig: its arcs are in big_[offset]; kPending: it has reached big_degree_ arcs and is
     // made big at the next safe point (Simplifier::promote_pending); kDirty: it waits in
     // Simplifier's list of big nodes whose candidate needs a new look.
@@ -151,16 +158,29 @@ class WorkingGraph {
         return n < critical_count_ ? critical_[idx(n)].value
                                    : regular_[idx(n - critical_count_)].value;
     }
-    i32& forward(i32 n) {
-        return n < critical_count_ ? critical_[idx(n)].forward
+    static i32 forward_of(const CriticalNode& c) {
+        return (c.flags & kForwarded) ? c.slot[0] : kNone;
+    }
+    i32 forward(i32 n) const {
+        return n < critical_count_ ? forward_of(critical_[idx(n)])
                                    : regular_[idx(n - critical_count_)].forward;
     }
+    // (A critical node's slots hold its arcs no more: it has none once absorbed or listed.)
+    void set_forward(i32 n, i32 f) {
+        if (n < critical_count_) {
+            CriticalNode& c = critical_[idx(n)];
+            c.slot[0] = f;
+            c.flags |= kForwarded;
+        } else {
+            regular_[idx(n - critical_count_)].forward = f;
+        }
+    }
     i32& prev(i32 n) {
-        return n < critical_count_ ? critical_[idx(n)].own[0]
+        return n < critical_count_ ? critical_[idx(n)].slot[1]
                                    : regular_[idx(n - critical_count_)].prev;
     }
     i32& next(i32 n) {
-        return n < critical_count_ ? critical_[idx(n)].own[1]
+        return n < critical_count_ ? critical_[idx(n)].slot[2]
                                    : regular_[idx(n - critical_count_)].next;
     }
 
@@ -168,20 +188,21 @@ class WorkingGraph {
     // critical nodes name the node that took them in `forward`.
     i32 live(i32 n) const {
         // (each step halves the path: a node handed over many times is found in a few steps)
-        while (critical_[idx(n)].forward >= 0) {
-            const i32 f = critical_[idx(n)].forward;
-            const i32 ff = critical_[idx(f)].forward;
-            if (ff >= 0) critical_[idx(n)].forward = ff;
+        for (;;) {
+            const CriticalNode& c = critical_[idx(n)];
+            const i32 f = forward_of(c);
+            if (f < 0) return n;
+            const i32 ff = forward_of(critical_[idx(f)]);
+            if (ff >= 0) c.slot[0] = ff;
             n = f;
         }
-        return n;
     }
     // Arc b's {lower, upper} ends, live: ends naming an absorbed node (arcs handed over in a
     // big node's set, see above) are set to the node that took it.
     const std::array<i32, 2>& ends(i32 b) const {
         auto& e = arcs_[idx(b)].end;
         for (i32& n : e)
-            if (critical_[idx(n)].forward >= 0) n = live(n);
+            if (forward_of(critical_[idx(n)]) >= 0) n = live(n);
         return e;
     }
     i32 other_end(i32 b, i32 n) const {
@@ -189,8 +210,8 @@ class WorkingGraph {
         return e[0] == n ? e[1] : e[0];
     }
     bool big(i32 n) const { return (critical_[idx(n)].flags & kBig) != 0; }
-    BigNode& big_of(i32 n) { return big_[idx(critical_[idx(n)].offset)]; }
-    const BigNode& big_of(i32 n) const { return big_[idx(critical_[idx(n)].offset)]; }
+    BigNode& big_of(i32 n) { return big_[idx(critical_[idx(n)].slot[0])]; }
+    const BigNode& big_of(i32 n) const { return big_[idx(critical_[idx(n)].slot[0])]; }
     // Whether arc b is queued through a big end's candidate rather than on its own.
     bool managed(i32 b) const {
         const auto& e = ends(b);
@@ -198,9 +219,11 @@ class WorkingGraph {
     }
 
     // A critical node's arcs, the newest last: in its record while they fit, else in the arena.
-    i32* arc_run(CriticalNode& c) { return c.shift == 0 ? c.own.data() : arena_.data() + c.offset; }
+    i32* arc_run(CriticalNode& c) {
+        return c.shift == 0 ? c.slot.data() : arena_.data() + c.slot[0];
+    }
     const i32* arc_run(const CriticalNode& c) const {
-        return c.shift == 0 ? c.own.data() : arena_.data() + c.offset;
+        return c.shift == 0 ? c.slot.data() : arena_.data() + c.slot[0];
     }
     // The arcs at a critical node, newest first (a big node's: below it, then above it,
     // nearest first).
@@ -228,6 +251,8 @@ class WorkingGraph {
     void link(i32 a, i32 n) {
         ++moves_;
         CriticalNode& c = critical_[idx(n)];
+        if (c.size == kMaxDegree)
+            throw Error("simplify", "a node has more arcs than the working graph can hold (2^26)");
         if (c.flags & kBig) {
             big_insert(n, a);
             ++c.size;
@@ -242,7 +267,7 @@ class WorkingGraph {
             const i32 offset = take_run(shift);
             std::copy_n(arc_run(c), c.size, arena_.data() + offset);
             release_run(c);
-            c.offset = offset;
+            c.slot[0] = offset;
             c.shift = shift;
         }
         arc_run(c)[c.size++] = a;
@@ -274,7 +299,7 @@ class WorkingGraph {
             return;
         }
         if (c.shift == 0) return;
-        free_runs_[c.shift].push_back(c.offset);
+        free_runs_[c.shift].push_back(c.slot[0]);
         c.shift = 0;
     }
     // A run with room for kInline << shift arcs: a freed one, or a new one at the arena's end.
@@ -329,7 +354,7 @@ class WorkingGraph {
     }
     // Node n's vertices (and everything already forwarded to it) join the critical node keep.
     void absorb(i32 n, i32 keep) {
-        forward(n) = keep;
+        set_forward(n, keep);
         critical_[idx(keep)].area += area(n);
     }
     // The regular nodes of an arc join keep, their area at once (the output tells them);
