@@ -77,6 +77,48 @@ TEST_CASE("Parked arrays come back the same and leave no file", "[pipeline][park
     CHECK(a == a0);
 }
 
+TEST_CASE("Parked arrays read back give their disk back, and the next ones reuse it",
+          "[pipeline][park]") {
+    const auto dir = terrain::test::scratch_dir("parked_arrays_reuse");
+    std::vector<std::int32_t> a(300000), b(200000), c(150000);
+    std::iota(a.begin(), a.end(), 1);
+    std::iota(b.begin(), b.end(), -500000);
+    std::iota(c.begin(), c.end(), 77);
+    const auto a0 = a, b0 = b, c0 = c;
+    const std::size_t ab = (a.size() + b.size()) * 4, bb = b.size() * 4, cb = c.size() * 4;
+    constexpr std::size_t kBlock = 4096;  // (a file system's block: each array may take parts of
+                                          // two more)
+    ParkedArrays parked(dir.string(), 0);
+    parked.decide(1);
+    REQUIRE(parked.on());
+    CHECK(parked.disk_bytes() == 0);
+    REQUIRE(parked.park(a, {}, 0, 1));
+    REQUIRE(parked.park(b, {}, 0, 1));
+    CHECK(parked.file_peak() == ab);
+    CHECK(parked.disk_bytes() >= ab);
+    // a read back: its bytes go back to the disk (a hole before b), b's stay.
+    parked.restore(a, {}, 0, 1);
+    CHECK(a == a0);
+    CHECK(parked.disk_bytes() >= bb);
+    CHECK(parked.disk_bytes() <= bb + 2 * kBlock);
+    // c fits in a's place: the file grows no longer.
+    REQUIRE(parked.park(c, {}, 0, 1));
+    CHECK(parked.file_peak() == ab);
+    CHECK(parked.disk_bytes() <= bb + cb + 4 * kBlock);
+    // a again does not fit before b any more: after it.
+    REQUIRE(parked.park(a, {}, 0, 1));
+    CHECK(parked.file_peak() == ab + a0.size() * 4);
+    parked.restore(b, {}, 0, 1);
+    parked.restore(a, {}, 0, 1);  // the last one: the file is cut after c
+    CHECK(parked.disk_bytes() <= cb + kBlock);
+    parked.restore(c, {}, 0, 1);
+    CHECK(a == a0);
+    CHECK(b == b0);
+    CHECK(c == c0);
+    CHECK(parked.parked_bytes() == 0);
+    CHECK(parked.disk_bytes() == 0);
+}
+
 TEST_CASE("A file that cannot grow leaves the arrays in memory, those parked come back",
           "[pipeline][park]") {
     // A full disk, played by a file size limit (the write fails with EFBIG; SIGXFSZ ignored).

@@ -157,6 +157,10 @@ TEST_CASE("pipeline::segment gives the DEM back bit for bit, floats or not", "[p
         // growing, alone each time.
         CHECK(result.parked_field == (std::string(field) == "height" ? 0 : dem_bytes));
         CHECK(result.parked_growing == dem_bytes);
+        // The file holds no more than the most parked at once: an array read back leaves a
+        // gap the next ones fill (appended, the file would hold the DEM twice, the areas
+        // twice, the sweeps' lists).
+        CHECK(result.parked_file == result.parked_bytes);
         const auto held = pipeline::segment(pipeline::input_from_dem(dem, "map"), holding);
         CHECK(result.label_pixels() == held.label_pixels());
         CHECK(result.field == held.field);
@@ -174,6 +178,7 @@ TEST_CASE("pipeline::segment gives the DEM back bit for bit, floats or not", "[p
         CHECK(held.parked_bytes == 0);
         CHECK(held.parked_field == 0);
         CHECK(held.parked_growing == 0);
+        CHECK(held.parked_file == 0);
         CHECK(std::distance(fs::directory_iterator(parking.park_directory), {}) == 0);
     }
 }

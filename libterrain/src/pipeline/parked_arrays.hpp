@@ -6,7 +6,10 @@
 // back and may evict, and they are read back, the same bytes, before the growing.
 //
 // The file is unlinked as soon as it is made (O_TMPFILE, or a named file removed at once), so
-// nothing is left behind whatever ends the process. A directory that refuses the file, or a
+// nothing is left behind whatever ends the process. It holds what is parked now, not all that
+// was ever parked: an array read back gives its bytes back to the disk (a hole punched, the
+// file cut after the last array still parked), and the next array parked goes in the first
+// gap it fits between those still there. A directory that refuses the file, or a
 // write that fails (a full disk), parks nothing more: the arrays stay in memory and the run
 // goes on, the same. A read that fails throws terrain::Error: the data would be lost.
 // Not installed.
@@ -58,6 +61,11 @@ class ParkedArrays {
     }
     // Bytes parked now.
     std::size_t parked_bytes() const;
+    // The file's largest length so far: the most disk the parked arrays took at once (gaps
+    // between them included).
+    std::size_t file_peak() const { return file_peak_; }
+    // The disk space the file holds now (its allocated blocks; 0 without a file).
+    std::size_t disk_bytes() const;
 
   private:
     struct Entry {
@@ -69,14 +77,20 @@ class ParkedArrays {
     void read(const Entry& e, void* data, const ProgressFn& progress, double begin, double end);
     const Entry* find(const void* owner) const;
     void forget(const void* owner);
+    // Where an array of `bytes` goes: the first gap between the arrays parked that holds it,
+    // else after the last of them.
+    std::uint64_t place(std::uint64_t bytes) const;
+    // The end of the last array parked (0 for none); cut() cuts the file there.
+    std::uint64_t parked_end() const;
+    void cut();
 
     std::string dir_;
     std::size_t min_bytes_;
     int fd_ = -1;
     bool full_ = false;      // a write failed: nothing more is parked
     bool decided_ = false;   // decide() was called
-    std::uint64_t end_ = 0;  // the file's length
-    std::vector<Entry> entries_;
+    std::uint64_t file_peak_ = 0;
+    std::vector<Entry> entries_;  // by offset
 };
 
 }  // namespace terrain::pipeline::internal

@@ -480,6 +480,7 @@ SegmentResult segment(Input input, const SegmentOptions& options, const Progress
     // On a DEM, with the regions of valid pixels in no triangle (segment::label_pixels).
     result.segmentation.region_count = static_cast<std::uint32_t>(result.regions.regions.size());
     result.add_time("grow", placing + scale.grow_seconds + since(t1));
+    result.parked_file = parked.file_peak();
     return result;
 }
 
@@ -629,6 +630,7 @@ void write_run_json(const SegmentResult& result, const std::string& input_path,
         .field("parked_bytes", result.parked_bytes)
         .field("parked_bytes_field", result.parked_field)
         .field("parked_bytes_growing", result.parked_growing)
+        .field("parked_file_bytes", result.parked_file)
         .end_object();
     j.key("timings_seconds").begin_object();
     double total = 0;

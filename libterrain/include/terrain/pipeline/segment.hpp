@@ -145,6 +145,8 @@ struct SegmentResult {
     std::size_t parked_bytes = 0;     // the most bytes parked on disk at once (segment())
     // Bytes parked while the field is computed and while the regions are grown (segment()).
     std::size_t parked_field = 0, parked_growing = 0;
+    // The parked file's largest length: the most disk the run took at once (segment()).
+    std::size_t parked_file = 0;
     reeb::ReebSummary after;  // the simplified graph of the segmentation
     // Its region_count counts every region of the table: on a DEM, after the vertices'
     // regions, those of valid pixels in no triangle (segment::label_pixels).
