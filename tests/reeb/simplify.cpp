@@ -480,6 +480,14 @@ TEST_CASE("A graph handed over gives the result of the same graph lent, plateaus
             std::reverse(g.node_vertices.begin() + g.node_vertex_offsets[plateau],
                          g.node_vertices.begin() + g.node_vertex_offsets[plateau + 1]);
         const auto lent = reeb::simplify(s.mesh, g, o);
+        // Without the rewritten field: the same graph and absorbed vertices, no field.
+        reeb::SimplifyOptions unwritten = o;
+        unwritten.rewrite_field = false;
+        auto without = reeb::simplify(s.mesh, g, unwritten);
+        CHECK(without.field.empty());
+        REQUIRE(lent.field.size() == s.mesh.vertex_count());
+        without.field = lent.field;
+        check_same_result(without, lent);
         const auto given = reeb::simplify(s.mesh, std::move(g), o);
         check_same_result(given, lent);
         CHECK(g.node_vertices.capacity() == 0);

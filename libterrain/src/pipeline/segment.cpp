@@ -135,6 +135,7 @@ double parse_area(const std::string& text, const std::string& option) {
 
 reeb::SimplifyOptions simplify_options(const SegmentOptions& options, const TriangleMesh& mesh) {
     reeb::SimplifyOptions out = options.simplify;
+    out.rewrite_field = false;  // (the regions grow on the graph and the field as computed)
     if (!options.min_area.empty())
         out.area_ratio = reeb::area_ratio_for_area(mesh, parse_area(options.min_area));
     return out;
@@ -438,7 +439,7 @@ SegmentResult segment(Input input, const SegmentOptions& options, const Progress
         if (parked.park(v, {}, 0, 0)) result.parked_bytes = parked.parked_bytes();
     };
     vertex_nodes.restore = [&](std::vector<std::int32_t>& v) { parked.restore(v, {}, 0, 0); };
-    const auto simplified = reeb::simplify(
+    auto simplified = reeb::simplify(
         result.input.mesh, std::move(graph), thresholds, scaled_progress(progress, 0.41, 0.6),
         [&] {
             if (parked.park(mesh.vertex_areas, {}, 0, 0))
@@ -472,6 +473,9 @@ SegmentResult segment(Input input, const SegmentOptions& options, const Progress
     result.after = scale.after;
     result.divided = scale.divided;
     result.add_time("simplify", scale.simplify_seconds);
+    // The simplified graph, its rewritten field and its absorbed flags are read no more: they
+    // go before the DEM comes back as doubles for the region graph (the growing's peak).
+    simplified = reeb::SimplifyResult{};
     const auto t1 = clock::now();
     if (result.input.dem) restore_dem(scaled_progress(progress, 0.9, 0.905));
     result.regions = segment::region_graph(

@@ -164,6 +164,7 @@ SweepResult run_sweep(Input input, const std::vector<ScaleSpec>& specs,
             const auto s0 = clock::now();
             SegmentOptions scale_options = options;
             scale_options.simplify.area_ratio = specs[i].ratio;
+            scale_options.simplify.rewrite_field = false;  // (nor does a sweep read it)
             scale_options.min_area.clear();
             auto simplified = reeb::simplify(base.input.mesh, i == 0 ? graph : finer.graph,
                                              scale_options.simplify);

@@ -111,7 +111,7 @@ void Simplifier::run(const ProgressFn& progress, SimplifyResult& result) {
     queue_.release();  // the output is the peak of memory: the queue is done
     detail::release(waiting_);
     report_progress(progress, kOutputStart, "simplify");
-    write_result(result, scaled_progress(progress, kOutputStart, 1));
+    write_result(result, options_.rewrite_field, scaled_progress(progress, kOutputStart, 1));
     report_progress(progress, 1.0, "simplify");
 }
 

@@ -21,7 +21,8 @@ namespace terrain::reeb::internal {
 
 using detail::find_root;
 
-void WorkingGraph::write_result(SimplifyResult& result, const ProgressFn& progress) {
+void WorkingGraph::write_result(SimplifyResult& result, bool rewrite_field,
+                                const ProgressFn& progress) {
     const std::size_t nn = input_nodes_, nl = regular_.size();
     // Its passes: the fates (0 to 0.2), the arcs (to 0.3), the new numbers (to 0.4), the
     // input's vertex lists made again (to 0.5), the vertices and their values (to 1).
@@ -199,7 +200,7 @@ void WorkingGraph::write_result(SimplifyResult& result, const ProgressFn& progre
     detail::assign_in_slices(out.node_vertices, g_.node_vertices.size(), i32{0}, made(0.5));
     detail::assign_in_slices(out.vertex_nodes, nv, i32{0}, made(0.5));
     detail::assign_in_slices(result.absorbed, nv, std::uint8_t{0}, made(0.5));
-    detail::assign_in_slices(result.field, nv, 0.0f, made(0.5));
+    if (rewrite_field) detail::assign_in_slices(result.field, nv, 0.0f, made(0.5));
     tbb::task_group grouped;
     grouped.run([&] {
         for (std::size_t n = 0; n < nn; ++n) {
@@ -223,7 +224,7 @@ void WorkingGraph::write_result(SimplifyResult& result, const ProgressFn& progre
                     const i32 v = g_.node_vertices[idx(i)];
                     out.vertex_nodes[idx(v)] = nid;
                     result.absorbed[idx(v)] = gone[n];
-                    result.field[idx(v)] = value;
+                    if (rewrite_field) result.field[idx(v)] = value;
                 }
             }
         });

@@ -66,7 +66,8 @@ class WorkingGraph {
 
     // The simplified graph and the rewritten field (simplify_output.cpp). The working graph is
     // freed as it goes: nothing else may be asked of it after.
-    void write_result(SimplifyResult& result, const ProgressFn& progress = {});
+    // `rewrite_field`: whether result.field is made.
+    void write_result(SimplifyResult& result, bool rewrite_field, const ProgressFn& progress = {});
     // The input graph is handed over (simplify(ReebGraph&&)): write_result frees it as it
     // reads it for the last time, and leaves it empty.
     void own_input(ReebGraph& g) { owned_ = &g; }

@@ -107,7 +107,8 @@ void check_options(const SegmentOptions& options);
 // otherwise.
 double parse_area(const std::string& text, const std::string& option = "--min-area");
 // The simplification thresholds applied on `mesh`: options.simplify, with the area ratio
-// given by options.min_area when it is set.
+// given by options.min_area when it is set, without the rewritten field (the segmentation
+// does not read it).
 reeb::SimplifyOptions simplify_options(const SegmentOptions& options, const TriangleMesh& mesh);
 
 // What the caller should tell the user, once, about a DEM's georeference before segmenting

@@ -21,11 +21,16 @@ namespace terrain::reeb {
 struct SimplifyOptions {
     double persistence = 0;  // cancel arcs with |f(n1) - f(n2)| below this (field units)
     double area_ratio = 0;   // percent: cancel arcs whose area ratio is below area_ratio/100
+    // Whether SimplifyResult::field is made (4 bytes a vertex). The growing reads the
+    // simplified graph's node values and the field as computed, never the rewritten one:
+    // pipeline::segment asks for it only when it writes it.
+    bool rewrite_field = true;
 };
 
 struct SimplifyResult {
     ReebGraph graph;           // the simplified graph, nodes renumbered
     std::vector<float> field;  // the rewritten field: each vertex takes its node's value
+                               // (empty unless SimplifyOptions::rewrite_field)
     // Per vertex, 1 when a cancellation handed its original node to another node (an extremum
     // absorbed into a saddle, regular nodes left outside their arc's new range, ...): these
     // vertices sit in a node that is not their own, at a value that is not theirs. The
