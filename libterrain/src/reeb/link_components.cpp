@@ -63,7 +63,8 @@ std::pair<int, int> LinkCounter::count_star(const ReebGraph& g, i32 e, std::size
 }
 
 std::vector<LinkReps> link_components(const TriangleMesh& mesh, const ReebGraph& g,
-                                      std::vector<LinkCounts>& vertex_links,
+                                      std::vector<std::uint8_t>& lower_links,
+                                      std::vector<std::uint8_t>& upper_links,
                                       std::vector<char>& general, const ProgressFn& progress,
                                       std::size_t parts) {
     const std::size_t nv = mesh.vertex_count(), nn = g.node_count();
@@ -79,10 +80,10 @@ std::vector<LinkReps> link_components(const TriangleMesh& mesh, const ReebGraph&
     // The stars are gathered for a part of the vertices at a time, each part in a pass over
     // every triangle, and read for those vertices: their records (24 bytes a vertex) are then
     // not whole beside the nodes' representatives (16 bytes a node), which set the Reeb graph's
-    // peak of memory. Two parts on large meshes: one more pass over the triangles, 12 bytes a
-    // vertex less. (What a star gathers is the same in any part: its own triangles.) An
-    // empty mesh: one part of nothing.
-    if (parts == 0) parts = nv >= kPartedStars ? 2 : 1;
+    // peak of memory. Three parts on large meshes: two more passes over the triangles, 16
+    // bytes a vertex less. (What a star gathers is the same in any part: its own triangles.)
+    // An empty mesh: one part of nothing.
+    if (parts == 0) parts = nv >= kPartedStars ? 3 : 1;
     parts = std::max<std::size_t>(1, std::min(parts, nv));
     std::vector<Star> stars;
     std::size_t lo = 0, hi = 0;  // the part's vertices
@@ -150,7 +151,9 @@ std::vector<LinkReps> link_components(const TriangleMesh& mesh, const ReebGraph&
         const bool interior = s.triangles == degree;
         const int lower = (above == 0 && interior && below > 0) ? 1 : below - s.lower_edges;
         const int upper = (below == 0 && interior && above > 0) ? 1 : above - s.upper_edges;
-        vertex_links[v] = {static_cast<std::uint8_t>(lower), static_cast<std::uint8_t>(upper)};
+        // (A single-vertex node: its bytes are written from this vertex only.)
+        lower_links[idx(n)] = static_cast<std::uint8_t>(lower);
+        upper_links[idx(n)] = static_cast<std::uint8_t>(upper);
         auto side = [&](int count, i32 some, int runs, i32 first, i32 second) {
             if (count <= 1) return std::array<i32, 2>{count == 0 ? kNone : some, kNone};
             if (count == 2 && runs == 2)
@@ -180,7 +183,6 @@ std::vector<LinkReps> link_components(const TriangleMesh& mesh, const ReebGraph&
                 reps, nn, LinkReps{},
                 detail::PassProgress(progress, at(0.6), at(0.65), "reeb: links"));
             general.assign(nn, 0);
-            vertex_links.resize(nv);
         }
         detail::parallel_slices(hi - lo, std::size_t{1} << 14, progress, at(0.65), at(1.0),
                                 "reeb: links", [&](const tbb::blocked_range<std::size_t>& r) {

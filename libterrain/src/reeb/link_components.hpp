@@ -57,15 +57,17 @@ struct LinkReps {
 // or a path (boundary), so a part of it has as many components as vertices minus edges,
 // except the whole cycle (one). Going round an interior vertex counter-clockwise, each run of
 // lower (upper) link vertices starts right after an upper (lower) one: the triangle holding
-// that step names the run's first vertex, its representative. Gives the link counts of those
-// vertices in `vertex_links`; `general` marks the nodes left to a LinkCounter.
+// that step names the run's first vertex, its representative. Writes the link counts of
+// those nodes in `lower_links` and `upper_links` (a byte a node, sized by the caller: the
+// graph's own node_lower_links and node_upper_links, whose other entries it leaves);
+// `general` marks the nodes left to a LinkCounter.
 // The stars of the triangles are gathered for `parts` parts of the vertices one after the
-// other, a pass over the triangles each (0: one part below kPartedStars vertices, else two):
-// the same results, less memory at once.
-using LinkCounts = std::array<std::uint8_t, 2>;
+// other, a pass over the triangles each (0: one part below kPartedStars vertices, else
+// three): the same results, less memory at once.
 inline constexpr std::size_t kPartedStars = std::size_t{1} << 22;
 std::vector<LinkReps> link_components(const TriangleMesh& mesh, const ReebGraph& g,
-                                      std::vector<LinkCounts>& vertex_links,
+                                      std::vector<std::uint8_t>& lower_links,
+                                      std::vector<std::uint8_t>& upper_links,
                                       std::vector<char>& general, const ProgressFn& progress = {},
                                       std::size_t parts = 0);
 
