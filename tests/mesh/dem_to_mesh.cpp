@@ -503,6 +503,53 @@ TEST_CASE("dem_to_mesh: the same mesh whatever the thread count", "[mesh]") {
     }
 }
 
+TEST_CASE("dem_to_mesh: triangles released before the areas and the adjacency, the same mesh",
+          "[mesh]") {
+    // With release_triangles, the areas, the directions and the irregular vertices' lists walk
+    // the triangles from the grid (in bands of rows on the threads): the same as from the
+    // triangles held, at 1 and 2 threads, and the triangles made again are the same. A grid
+    // with split pinches keeps its triangles. A crop, a global grid (seam and poles: irregular
+    // vertices), a grid with holes and pinches, one with isolated pixels only.
+    const auto ring = [](int c, int r) {
+        const int dc = c % 20 - 10, dr = r % 15 - 7;
+        return std::abs(dc) <= 1 && std::abs(dr) <= 1 && (dc != 0 || dr != 0);
+    };
+    const auto wave = [](int c, int r) { return std::sin(c * 0.3) * std::cos(r * 0.2) * 10; };
+    const std::vector<Dem> dems{
+        io::read_dem(test::sample("moon_ldem4_copernicus.tif")),
+        io::read_dem(test::sample("moon_ldem1_global.tif")),
+        grid_dem(97, 61, 1.0,
+                 [&](int c, int r) {
+                     const bool hole = (c * 7 + r * 13) % 11 == 0 || (c % 9 == 4 && r % 5 == 2);
+                     return ring(c, r) || hole ? kNaN : wave(c, r);
+                 }),
+        grid_dem(83, 70, 1.0, [&](int c, int r) { return ring(c, r) ? kNaN : wave(c, r); })};
+    mesh::DemToMeshOptions releasing;
+    releasing.release_triangles = true;
+    for (const Dem& dem : dems) {
+        const auto held = mesh::dem_to_mesh(dem);
+        for (const int threads : {1, 2}) {
+            INFO(dem.width << " x " << dem.height << ", " << threads << " threads");
+            tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+            auto released = mesh::dem_to_mesh(dem, releasing);
+            CHECK(released.triangles_released() == (held.pinched_vertices == 0));
+            CHECK(released.triangle_count() == held.triangle_count());
+            CHECK(released.vertex_areas == held.vertex_areas);
+            CHECK(released.neighbor_directions == held.neighbor_directions);
+            CHECK(released.irregular_vertices == held.irregular_vertices);
+            CHECK(released.irregular_offsets == held.irregular_offsets);
+            CHECK(released.irregular_neighbors == held.irregular_neighbors);
+            CHECK(released.grid_edges == held.grid_edges);
+            CHECK(released.positions == held.positions);
+            CHECK(released.pixel_vertex == held.pixel_vertex);
+            released.restore_triangles();
+            CHECK_FALSE(released.triangles_released());
+            CHECK(released.triangles == held.triangles);
+        }
+    }
+    CHECK(mesh::dem_to_mesh(dems[1], releasing).irregular_vertices.size() > 0);  // seam, poles
+}
+
 TEST_CASE("dem_to_mesh: frames and refusals", "[mesh]") {
     const Dem local = io::read_dem(test::sample("mars_hirise_crop.tif"));
     mesh::DemToMeshOptions body;

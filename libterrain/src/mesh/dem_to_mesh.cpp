@@ -379,6 +379,9 @@ TriangleMesh dem_to_mesh(const Dem& dem, const DemToMeshOptions& options,
     // The pixels' vertices after those changes, in the same memory.
     fill_pixel_to_vertex(mesh, dem, vertex_of);
     mesh.pixel_vertex = std::move(vertex_of);
+    // (24 bytes a pixel less at the mesh's peak, the end of its areas and adjacency.)
+    if (options.release_triangles && mesh.pinched_vertices == 0 && dem.width >= 3)
+        mesh.release_triangles();
     report_progress(progress, 0.7, "mesh");
     finish_grid_mesh(mesh, scaled_progress(progress, 0.7, 1));
     report_progress(progress, 1.0, "mesh");

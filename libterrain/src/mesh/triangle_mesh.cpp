@@ -80,6 +80,17 @@ bool TriangleMesh::release_triangles() {
     return true;
 }
 
+void TriangleMesh::restore_triangles() {
+    if (!triangles_released()) return;
+    std::vector<std::array<std::int32_t, 3>> made;
+    made.reserve(released_triangles_);
+    detail::for_each_triangle(*this, [&](std::size_t, const auto& t) { made.push_back(t); });
+    if (made.size() != released_triangles_)
+        throw Error("mesh", "internal: the triangles made again are not those released");
+    triangles = std::move(made);
+    released_triangles_ = 0;
+}
+
 bool TriangleMesh::release_positions() {
     if (positions_released()) return true;
     if (positions.empty() || !grid_describes_it()) return false;
@@ -192,9 +203,9 @@ std::size_t pack_sorted_lists(std::vector<std::int32_t>& lists,
     return write;
 }
 
-// What gather(i, out) pushes into `out` for each triangle i, by 64 slices of the triangles on
-// every thread: each slice's items in triangle order, so that reading the slices one after the
-// other reads them in the order of one pass.
+// What gather(i, out) pushes into `out` for each triangle i (or each row of blocks i), by 64
+// slices of them on every thread: each slice's items in triangle order, so that reading the
+// slices one after the other reads them in the order of one pass.
 template <class T, class Gather>
 std::vector<std::vector<T>> gather_by_slices(std::size_t nt, const Gather& gather) {
     constexpr std::size_t kSlices = 64;
@@ -227,7 +238,9 @@ void set_vertex_areas(TriangleMesh& mesh, const detail::PassProgress& areas) {
 // rows on every thread add their triangles to their pixel rows but the first; the last row's
 // sums, still partial, wait in `seam` for the next band, which adds its first block row to
 // them once every band is done.
-void add_areas_by_bands(TriangleMesh& mesh, int rows, const std::vector<std::size_t>& row_first,
+// emit_row(row, f) calls f(triangle) for each triangle of block row `row`, in order.
+template <class EmitRow>
+void add_areas_by_bands(TriangleMesh& mesh, int rows, const EmitRow& emit_row,
                         const ProgressFn& progress, double begin, double end) {
     const std::size_t W = static_cast<std::size_t>(mesh.grid_width);
     constexpr int kBandRows = 16;
@@ -240,12 +253,10 @@ void add_areas_by_bands(TriangleMesh& mesh, int rows, const std::vector<std::siz
     };
     // f(pixel, third) for each corner of block row `row`'s triangles, in order.
     const auto corners = [&](int row, const auto& f) {
-        for (std::size_t i = row_first[std::size_t(row)]; i < row_first[std::size_t(row) + 1];
-             ++i) {
-            const auto& t = mesh.triangles[i];
+        emit_row(row, [&](const std::array<std::int32_t, 3>& t) {
             const double third = triangle_area(mesh, t) / 3.0;
             for (const auto v : t) f(pixel_of(v), third);
-        }
+        });
     };
     // Pixel row `row`'s sums (W doubles from `sums`) to its vertices.
     const auto put_row = [&](std::size_t row, const double* sums) {
@@ -298,6 +309,15 @@ bool set_grid_vertex_areas(TriangleMesh& mesh, const ProgressFn& progress, doubl
     const std::int64_t W = mesh.grid_width;
     const std::size_t nt = mesh.triangles.size();
     const int rows = mesh.grid_height - 1;
+    // Triangles released (dem_to_mesh's release_triangles): made again row by row from the
+    // grid, in the order they had, which has no split pinch.
+    if (detail::rows_of_triangles(mesh)) {
+        add_areas_by_bands(
+            mesh, rows,
+            [&](int row, const auto& f) { detail::for_each_row_triangle(mesh, row, f); },
+            progress, begin, end);
+        return true;
+    }
     const auto pixel_row = [&](std::int32_t v) {
         return static_cast<std::int64_t>(mesh.vertex_pixel[std::size_t(v)]) / W;
     };
@@ -326,7 +346,14 @@ bool set_grid_vertex_areas(TriangleMesh& mesh, const ProgressFn& progress, doubl
                                           [&](std::size_t i) { return block_row(i) < row; });
     if (mesh.pinched_vertices == 0 &&
         mesh.pixel_vertex.size() == std::size_t(W) * std::size_t(mesh.grid_height)) {
-        add_areas_by_bands(mesh, rows, row_first, progress, begin, end);
+        add_areas_by_bands(
+            mesh, rows,
+            [&](int row, const auto& f) {
+                for (std::size_t i = row_first[std::size_t(row)];
+                     i < row_first[std::size_t(row) + 1]; ++i)
+                    f(mesh.triangles[i]);
+            },
+            progress, begin, end);
         return true;
     }
     std::vector<double> area(mesh.positions.size(), 0.0);
@@ -440,6 +467,9 @@ std::vector<std::array<std::int32_t, 2>> uniform_ranges(const TriangleMesh& mesh
 void finish_grid_mesh(TriangleMesh& mesh, const ProgressFn& progress) {
     const std::int64_t W = mesh.grid_width;
     const std::size_t n = mesh.positions.size(), nt = mesh.triangles.size();
+    // Triangles released (dem_to_mesh's release_triangles, no split pinch): each pass walks
+    // them from the grid, a row of blocks at a time.
+    const bool by_rows = detail::rows_of_triangles(mesh);
     if (W < 3 || mesh.vertex_pixel.size() != n ||
         mesh.pixel_vertex.size() != std::size_t(mesh.grid_width) * std::size_t(mesh.grid_height)) {
         finish_mesh(mesh, progress);
@@ -469,11 +499,7 @@ void finish_grid_mesh(TriangleMesh& mesh, const ProgressFn& progress) {
     for (const auto pole : mesh.pole_vertices)
         if (pole >= 0) irregular[std::size_t(pole)] = 1;
     // (On every thread: a vertex's bits are an OR and its mark a flag, the same in any order.)
-    detail::parallel_slices(
-        nt, std::size_t{4096}, progress, 0.35, 0.6, "mesh",
-        [&](const tbb::blocked_range<std::size_t>& r) {
-            for (std::size_t i = r.begin(); i < r.end(); ++i) {
-                const auto& t = mesh.triangles[i];
+    const auto mark = [&](const std::array<std::int32_t, 3>& t) {
                 for (int k = 0; k < 3; ++k) {
                     const auto a = static_cast<std::size_t>(t[k]);
                     const std::int64_t pa = mesh.vertex_pixel[a];
@@ -489,8 +515,15 @@ void finish_grid_mesh(TriangleMesh& mesh, const ProgressFn& progress) {
                                 static_cast<std::uint8_t>(1u << d), std::memory_order_relaxed);
                     }
                 }
-            }
-        });
+    };
+    if (by_rows)
+        detail::for_each_triangle_by_bands(mesh, progress, 0.35, 0.6, "mesh", mark);
+    else
+        detail::parallel_slices(nt, std::size_t{4096}, progress, 0.35, 0.6, "mesh",
+                                [&](const tbb::blocked_range<std::size_t>& r) {
+                                    for (std::size_t i = r.begin(); i < r.end(); ++i)
+                                        mark(mesh.triangles[i]);
+                                });
     // A vertex is regular when its neighbours, read off the grid in the directions' order,
     // come in increasing order (not so across the seam, or next to a pinch's copy).
     mesh.neighbor_directions = std::move(bits);
@@ -523,13 +556,22 @@ void finish_grid_mesh(TriangleMesh& mesh, const ProgressFn& progress) {
     const std::size_t ni = mesh.irregular_vertices.size();
     // Their corners (rank, the two other corners), gathered by slices of triangles on every
     // thread in triangle order within each, then listed slice by slice: the order of one pass.
-    auto corners = gather_by_slices<std::array<std::int32_t, 3>>(nt, [&](std::size_t i, auto& out) {
-        const auto& t = mesh.triangles[i];
+    const auto gather = [&](const std::array<std::int32_t, 3>& t, auto& out) {
         for (int k = 0; k < 3; ++k)
             if (irregular[std::size_t(t[k])])
                 out.push_back(
                     {static_cast<std::int32_t>(rank(t[k])), t[(k + 1) % 3], t[(k + 2) % 3]});
-    });
+    };
+    auto corners = by_rows ? gather_by_slices<std::array<std::int32_t, 3>>(
+                                 std::size_t(mesh.grid_height - 1),
+                                 [&](std::size_t row, auto& out) {
+                                     detail::for_each_row_triangle(
+                                         mesh, int(row), [&](const auto& t) { gather(t, out); });
+                                 })
+                           : gather_by_slices<std::array<std::int32_t, 3>>(
+                                 nt, [&](std::size_t i, auto& out) {
+                                     gather(mesh.triangles[i], out);
+                                 });
     report_progress(progress, 0.95, "mesh");
     std::vector<std::uint32_t> offsets(ni + 1, 0);
     for (const auto& list : corners)
@@ -779,48 +821,54 @@ std::size_t remove_unreferenced_vertices(TriangleMesh& mesh, const ProgressFn& p
     // Its passes: the corners (0 to 0.4), the vertices (to 0.6), the corners again (to 1).
     const detail::PassProgress kept(progress, 0.4, 0.6, "mesh"),
         renumbered(progress, 0.6, 1, "mesh");
-    const std::size_t nt = mesh.triangles.size();
-    std::vector<std::int32_t> remap(mesh.positions.size(), -1);
-    // The corners marked on every thread (each mark the same 0), then counted: a whole grid
-    // has no vertex to remove, and is left as it is.
+    const std::size_t nt = mesh.triangles.size(), nv = mesh.positions.size();
+    // The corners marked in a bitmap on every thread (an OR, the same in any order), then
+    // counted: a whole grid has no vertex to remove, and is left as it is. A vertex's new
+    // number is the count of marked vertices before it: the marks before its word (counted
+    // once) and in its word. (A number a vertex beside the triangles was 4 bytes a pixel more
+    // at the mesh's peak.)
+    std::vector<std::uint64_t> used((nv + 63) / 64, 0);
     detail::parallel_slices(nt, std::size_t{4096}, progress, 0, 0.4, "mesh",
                             [&](const tbb::blocked_range<std::size_t>& r) {
                                 for (std::size_t i = r.begin(); i < r.end(); ++i)
                                     for (auto v : mesh.triangles[i])
-                                        std::atomic_ref<std::int32_t>(remap[std::size_t(v)])
-                                            .store(0, std::memory_order_relaxed);
+                                        std::atomic_ref<std::uint64_t>(used[std::size_t(v) / 64])
+                                            .fetch_or(std::uint64_t{1} << (std::size_t(v) % 64),
+                                                      std::memory_order_relaxed);
                             });
-    const std::size_t unused = tbb::parallel_reduce(
-        tbb::blocked_range<std::size_t>(0, remap.size(), std::size_t{1} << 16), std::size_t{0},
-        [&](const tbb::blocked_range<std::size_t>& r, std::size_t sum) {
-            for (std::size_t v = r.begin(); v < r.end(); ++v) sum += remap[v] < 0;
-            return sum;
-        },
-        std::plus<>());
+    std::vector<std::uint32_t> before(used.size() + 1, 0);
+    for (std::size_t w = 0; w < used.size(); ++w)
+        before[w + 1] = before[w] + static_cast<std::uint32_t>(std::popcount(used[w]));
+    const std::size_t unused = nv - before.back();
     if (unused == 0) {
         report_progress(progress, 1, "mesh");
         return 0;
     }
+    const auto marked = [&](std::size_t v) { return (used[v / 64] >> (v % 64)) & 1; };
+    const auto remap = [&](std::int32_t v) {
+        const auto u = std::size_t(v);
+        const std::uint64_t lower = used[u / 64] & ((std::uint64_t{1} << (u % 64)) - 1);
+        return static_cast<std::int32_t>(before[u / 64] + std::popcount(lower));
+    };
     const bool pixels = !mesh.vertex_pixel.empty();
     std::int32_t next = 0;
-    for (std::size_t v = 0; v < remap.size(); ++v) {
-        kept.at(v, remap.size());
-        if (remap[v] < 0) continue;
-        remap[v] = next;
+    for (std::size_t v = 0; v < nv; ++v) {
+        kept.at(v, nv);
+        if (!marked(v)) continue;
         mesh.positions[next] = mesh.positions[v];
         if (pixels) mesh.vertex_pixel[next] = mesh.vertex_pixel[v];
         ++next;
     }
-    const std::size_t removed = remap.size() - std::size_t(next);
     mesh.positions.resize(next);
     if (pixels) mesh.vertex_pixel.resize(next);
     for (std::size_t i = 0; i < nt; ++i) {
         renumbered.at(i, nt);
-        for (auto& v : mesh.triangles[i]) v = remap[v];
+        for (auto& v : mesh.triangles[i]) v = remap(v);
     }
+    // (A pole vertex in no triangle is removed too: it names none then.)
     for (auto& pv : mesh.pole_vertices)
-        if (pv >= 0) pv = remap[pv];
-    return removed;
+        if (pv >= 0) pv = marked(std::size_t(pv)) ? remap(pv) : -1;
+    return unused;
 }
 
 }  // namespace terrain

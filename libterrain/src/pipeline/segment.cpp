@@ -65,6 +65,9 @@ Input load_input(const std::string& path, const InputOptions& options, const Pro
     const double read_seconds = since(t0);
     mesh::DemToMeshOptions mesh_options;
     mesh_options.frame = frame;
+    // pipeline::segment frees the triangles of a tree before the field (below): they may go
+    // before the mesh's areas and adjacency, unless the SDF is to cast rays through them.
+    mesh_options.release_triangles = options.planned_segment && options.planned_field != "sdf";
     const auto t1 = clock::now();
     Input input;
     input.mesh = mesh::dem_to_mesh(dem, mesh_options, scaled_progress(progress, 0.3, 1));
@@ -362,9 +365,14 @@ SegmentResult segment(Input input, const SegmentOptions& options, const Progress
     auto& mesh = result.input.mesh;
     const auto tf = clock::now();
     const auto kind = field::parse_field_kind(options.field);
-    const bool tree = kind != field::FieldKind::sdf && mesh.triangles_releasable() &&
-                      reeb::reeb_is_tree(mesh, scaled_progress(progress, 0, 0.02));
-    if (tree) mesh.release_triangles();
+    const bool tree =
+        kind != field::FieldKind::sdf &&
+        (mesh.triangles_released() || mesh.triangles_releasable()) &&
+        reeb::reeb_is_tree(mesh, scaled_progress(progress, 0, 0.02));
+    if (tree)
+        mesh.release_triangles();
+    else
+        mesh.restore_triangles();  // (released by load_input: the Reeb graph reads them)
     result.add_time("field", since(tf));
     // The DEM's values (as floats when they all are floats), then the field and the mesh's
     // pixel maps, wait unread through the stages that do not read them: parked on disk

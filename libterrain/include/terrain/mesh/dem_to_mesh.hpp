@@ -17,6 +17,11 @@ namespace terrain::mesh {
 struct DemToMeshOptions {
     std::optional<MeshFrame> frame;  // body or map; unset: default_frame(dem)
     bool close_global = true;        // close the seam and the poles of a global grid
+    // Release the triangles (TriangleMesh::release_triangles) before the areas and the
+    // adjacency are made, which then walk them from the grid: for a caller that reads them
+    // only through detail::for_each_triangle, or makes them again (restore_triangles). Not
+    // done for a grid with a split pinch or fewer than 3 columns.
+    bool release_triangles = false;
 };
 
 // body for planetary and geographic CRSs, map for projected Earth CRSs and local grids.

@@ -119,6 +119,9 @@ struct TriangleMesh {
     // grid, in order. Returns false, keeping them, for a mesh that cannot (read from a file).
     bool release_triangles();
     bool triangles_released() const { return released_triangles_ > 0; }
+    // Makes the triangles released again from the grid (the same ones, in the same order);
+    // nothing to do when it holds them.
+    void restore_triangles();
     // Whether release_triangles would free them (a DEM mesh that holds them).
     bool triangles_releasable() const;
     std::array<double, 3> position(std::size_t v) const {
