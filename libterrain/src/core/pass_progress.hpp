@@ -45,11 +45,13 @@ class PassProgress {
     std::string_view message_;
 };
 
-// v becomes n copies of value, with the capacity n (as std::vector<T>(n, value)).
+// v becomes n copies of value, with the capacity n (as std::vector<T>(n, value)), or `room`
+// when larger (reserved, not touched: no page of it resident until used).
 template <class T>
-void assign_in_slices(std::vector<T>& v, std::size_t n, const T& value, const PassProgress& pass) {
+void assign_in_slices(std::vector<T>& v, std::size_t n, const T& value, const PassProgress& pass,
+                      std::size_t room = 0) {
     std::vector<T>().swap(v);
-    v.reserve(n);
+    v.reserve(std::max(n, room));
     constexpr std::size_t kSlice = std::size_t{1} << 18;
     for (std::size_t at = 0; at < n;) {
         pass.at(at, n);

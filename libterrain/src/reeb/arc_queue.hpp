@@ -36,12 +36,15 @@ class ArcQueue {
     // Room for every arc's first key is reserved, not touched: the pages of the keys seeded
     // become resident as they are written, and no growth copies them (a copy was half as
     // many keys again, at the peak of the simplification's memory).
+    // The heap's room too (each arc is in it at most once), untouched until used: it never
+    // grows by a copy of itself, which at its peak was its size again.
     void init(std::size_t arcs) {
         slot_.assign(arcs, detail::kNone);
         sorted_.reserve(arcs);
+        heap_.reserve(arcs);
     }
     std::size_t bytes() const {
-        return heap_.capacity() * sizeof(std::uint64_t) + slot_.capacity() * sizeof(i32) +
+        return heap_.size() * sizeof(std::uint64_t) + slot_.capacity() * sizeof(i32) +
                sorted_.capacity() * sizeof(std::uint64_t);
     }
     void release() {

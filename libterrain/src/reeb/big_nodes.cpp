@@ -46,7 +46,7 @@ void Simplifier::queue_through_big_end(i32 b) {
         queue_.erase(b);
         arcs_[idx(b)].queued = kNotQueued;
     }
-    waiting_[idx(b)] = queued ? 0 : 1;
+    waiting_[idx(b)] = !queued;
 }
 
 void Simplifier::mark_dirty(i32 n) {
@@ -88,19 +88,19 @@ void Simplifier::mark_full(i32 n) {
 void Simplifier::clear_waits(i32 n) {
     BigNode& b = big_of(n);
     for (const i32 w : b.waiting)
-        if (b.keys.count(w)) waiting_[idx(w)] = 0;
+        if (b.keys.count(w)) waiting_[idx(w)] = false;
     b.waiting.clear();
 }
 
 void Simplifier::set_waiting(i32 b) {
-    waiting_[idx(b)] = 1;
+    waiting_[idx(b)] = true;
     const auto e = ends(b);
     for (int i = 0; i < 2; ++i)
         if (big(e[i]) && (i == 0 || e[1] != e[0])) big_of(e[i]).waiting.push_back(b);
 }
 
 void Simplifier::consider_managed(i32 a) {
-    waiting_[idx(a)] = 0;
+    waiting_[idx(a)] = false;
     const auto e = ends(a);
     bool rep = false;
     for (const i32 n : e)
@@ -254,7 +254,7 @@ void Simplifier::hand_over(i32 keep, i32 gone, bool midpoint) {
     g.size = 0;
     g.down = 0;
     absorb(gone, keep);  // (its forward takes the slot its set was in)
-    clear_waits(keep);  // gone's arcs are all looked at again, as cancel() does for moved arcs
+    clear_waits(keep);   // gone's arcs are all looked at again, as cancel() does for moved arcs
     for (const i32 b : own_) {
         const i32 other = other_end(b, keep);
         link(b, keep);

@@ -36,7 +36,7 @@ class Simplifier : WorkingGraph {
                        areas_read, parking),
           options_(options) {
         queue_.init(arcs_.size());
-        waiting_.assign(arcs_.size(), 0);
+        waiting_.assign(arcs_.size(), false);
     }
 
     // Slices of the simplification's progress, by their measured cost on global grids: the
@@ -164,10 +164,10 @@ class Simplifier : WorkingGraph {
     ArcQueue queue_;
     std::size_t pushed_ = 0;
     std::vector<i32> touched_, all_, merged_;
-    std::vector<i32> turned_;            // far ends of the arcs fit_arc turned around
-    std::vector<std::uint8_t> waiting_;  // per arc with a big end: out of the queue
-    std::vector<i32> dirty_big_;         // big nodes flagged kDirty
-    std::vector<i32> own_, fit_;         // hand_over()'s scratch
+    std::vector<i32> turned_;     // far ends of the arcs fit_arc turned around
+    std::vector<bool> waiting_;   // per arc with a big end: out of the queue (a bit an arc)
+    std::vector<i32> dirty_big_;  // big nodes flagged kDirty
+    std::vector<i32> own_, fit_;  // hand_over()'s scratch
     bool check_steps_ = false;
     std::vector<i32> updated_;  // with check_steps_: the big nodes update_reps() looked at
     std::string check_failure_;

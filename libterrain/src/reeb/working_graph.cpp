@@ -128,9 +128,10 @@ std::size_t WorkingGraph::working_bytes() const {
     for (const auto& f : free_runs_) freed += f.capacity() * sizeof(i32);
     // A big node's arc: three set entries and a map entry, about 48 bytes each.
     for (const BigNode& b : big_) freed += b.keys.size() * 4 * 48 + b.bb.size() * 48;
+    // (The arena and the sets by their size: their room is reserved ahead, untouched.)
     return critical_.capacity() * sizeof(CriticalNode) + regular_.capacity() * sizeof(RegularNode) +
-           arcs_.capacity() * sizeof(Arc) + arena_.capacity() * sizeof(i32) + freed +
-           (set_parent_.capacity() + set_fate_.capacity() + node_map_.capacity()) * sizeof(i32);
+           arcs_.capacity() * sizeof(Arc) + arena_.size() * sizeof(i32) + freed +
+           (set_parent_.size() + set_fate_.size() + node_map_.capacity()) * sizeof(i32);
 }
 
 namespace {
@@ -279,6 +280,9 @@ WorkingGraph::WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big
     // input's arcs, offsets and listed nodes go back to the system behind the pass: the end
     // of this pass is the simplification's peak of memory.
     arcs_.reserve(na);
+    // (The arena's room reserved ahead, untouched until used: runs taken through the
+    // cancellations then copy no arena, which held its old and its new block at once.)
+    arena_.reserve(2 * na);
     report_progress(progress, 0.7, "simplify");
     detail::PagesBehind ends_behind, offsets_behind_a, listed_behind;
     if (owned) {
@@ -330,9 +334,13 @@ WorkingGraph::WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big
         map_parked_.park(node_map_);
     }
     // The lists' sets, made once the input's arcs are freed (the copy's end is the peak of
-    // the simplification's memory).
-    detail::assign_in_slices(set_parent_, na, kNone, PassProgress(progress, 1, 1, "simplify"));
-    detail::assign_in_slices(set_fate_, na, kNone, PassProgress(progress, 1, 1, "simplify"));
+    // the simplification's memory), with room for as many new sets again, reserved and not
+    // touched: a set made by a cancellation then copies no array (a vector growing copies
+    // itself, and holds its old and its new block at once).
+    detail::assign_in_slices(set_parent_, na, kNone, PassProgress(progress, 1, 1, "simplify"),
+                             2 * na);
+    detail::assign_in_slices(set_fate_, na, kNone, PassProgress(progress, 1, 1, "simplify"),
+                             2 * na);
 }
 
 }  // namespace terrain::reeb::internal

@@ -92,10 +92,10 @@ class WorkingGraph {
     struct alignas(32) CriticalNode {
         double area = 0;  // its vertices' and its absorbed nodes' area
         float value = 0;
-        std::uint32_t size : 26 = 0;   // its arcs
-        std::uint32_t shift : 6 = 0;   // room for kInline << shift arcs
-        std::uint32_t down : 26 = 0;   // its arcs whose upper end it is
-        std::uint32_t flags : 6 = 0;   // kCritical, kModified, kBig, kPending, kDirty, kForwarded
+        std::uint32_t size : 26 = 0;  // its arcs
+        std::uint32_t shift : 6 = 0;  // room for kInline << shift arcs
+        std::uint32_t down : 26 = 0;  // its arcs whose upper end it is
+        std::uint32_t flags : 6 = 0;  // kCritical, kModified, kBig, kPending, kDirty, kForwarded
         mutable std::array<i32, kInline> slot{};  // (live() shortens forward paths)
     };
     static_assert(sizeof(CriticalNode) == 32);
@@ -123,7 +123,7 @@ class WorkingGraph {
     static constexpr std::uint8_t kCritical = 1, kModified = 2;
     // kForwarded: its forward is set (slot[0]): it was absorbed, or it is in an arc's list.
     static constexpr std::uint8_t kForwarded = 32;
-    // kBig: its arcs are in big_[offset]; kPending: it has reached big_degree_ arcs and is
+    // kBig: its arcs are in big_[slot[0]]; kPending: it has reached big_degree_ arcs and is
     // made big at the next safe point (Simplifier::promote_pending); kDirty: it waits in
     // Simplifier's list of big nodes whose candidate needs a new look.
     static constexpr std::uint8_t kBig = 4, kPending = 8, kDirty = 16;
