@@ -650,8 +650,8 @@ TEST_CASE("Link components are the same gathered in parts of the vertices", "[re
             const std::size_t nn = g.node_count();
             std::vector<std::uint8_t> lower_one(nn, 7), upper_one(nn, 7);
             std::vector<char> general_one;
-            const auto one = reeb::internal::link_components(*mesh, g, lower_one, upper_one,
-                                                             general_one, {}, 1);
+            const auto one =
+                reeb::internal::link_components(*mesh, g, lower_one, upper_one, general_one, {}, 1);
             // Those it counts are the graph's (build_reeb_graph's), but at Reeb-regular nodes.
             bool counted = true;
             for (std::size_t n = 0; n < nn; ++n)

@@ -314,8 +314,8 @@ bool set_grid_vertex_areas(TriangleMesh& mesh, const ProgressFn& progress, doubl
     if (detail::rows_of_triangles(mesh)) {
         add_areas_by_bands(
             mesh, rows,
-            [&](int row, const auto& f) { detail::for_each_row_triangle(mesh, row, f); },
-            progress, begin, end);
+            [&](int row, const auto& f) { detail::for_each_row_triangle(mesh, row, f); }, progress,
+            begin, end);
         return true;
     }
     const auto pixel_row = [&](std::int32_t v) {
@@ -500,21 +500,20 @@ void finish_grid_mesh(TriangleMesh& mesh, const ProgressFn& progress) {
         if (pole >= 0) irregular[std::size_t(pole)] = 1;
     // (On every thread: a vertex's bits are an OR and its mark a flag, the same in any order.)
     const auto mark = [&](const std::array<std::int32_t, 3>& t) {
-                for (int k = 0; k < 3; ++k) {
-                    const auto a = static_cast<std::size_t>(t[k]);
-                    const std::int64_t pa = mesh.vertex_pixel[a];
-                    for (int j = 1; j < 3; ++j) {
-                        const std::int32_t b = t[(k + j) % 3];
-                        const std::int64_t pb = mesh.vertex_pixel[std::size_t(b)];
-                        const int d = direction(pb - pa);
-                        if (d < 0 || mesh.pixel_vertex[std::size_t(pb)] != b)
-                            std::atomic_ref<std::uint8_t>(irregular[a])
-                                .store(1, std::memory_order_relaxed);
-                        else
-                            std::atomic_ref<std::uint8_t>(bits[a]).fetch_or(
-                                static_cast<std::uint8_t>(1u << d), std::memory_order_relaxed);
-                    }
-                }
+        for (int k = 0; k < 3; ++k) {
+            const auto a = static_cast<std::size_t>(t[k]);
+            const std::int64_t pa = mesh.vertex_pixel[a];
+            for (int j = 1; j < 3; ++j) {
+                const std::int32_t b = t[(k + j) % 3];
+                const std::int64_t pb = mesh.vertex_pixel[std::size_t(b)];
+                const int d = direction(pb - pa);
+                if (d < 0 || mesh.pixel_vertex[std::size_t(pb)] != b)
+                    std::atomic_ref<std::uint8_t>(irregular[a]).store(1, std::memory_order_relaxed);
+                else
+                    std::atomic_ref<std::uint8_t>(bits[a]).fetch_or(
+                        static_cast<std::uint8_t>(1u << d), std::memory_order_relaxed);
+            }
+        }
     };
     if (by_rows)
         detail::for_each_triangle_by_bands(mesh, progress, 0.35, 0.6, "mesh", mark);
@@ -562,16 +561,15 @@ void finish_grid_mesh(TriangleMesh& mesh, const ProgressFn& progress) {
                 out.push_back(
                     {static_cast<std::int32_t>(rank(t[k])), t[(k + 1) % 3], t[(k + 2) % 3]});
     };
-    auto corners = by_rows ? gather_by_slices<std::array<std::int32_t, 3>>(
-                                 std::size_t(mesh.grid_height - 1),
-                                 [&](std::size_t row, auto& out) {
-                                     detail::for_each_row_triangle(
-                                         mesh, int(row), [&](const auto& t) { gather(t, out); });
-                                 })
-                           : gather_by_slices<std::array<std::int32_t, 3>>(
-                                 nt, [&](std::size_t i, auto& out) {
-                                     gather(mesh.triangles[i], out);
-                                 });
+    auto corners = by_rows
+                       ? gather_by_slices<std::array<std::int32_t, 3>>(
+                             std::size_t(mesh.grid_height - 1),
+                             [&](std::size_t row, auto& out) {
+                                 detail::for_each_row_triangle(
+                                     mesh, int(row), [&](const auto& t) { gather(t, out); });
+                             })
+                       : gather_by_slices<std::array<std::int32_t, 3>>(
+                             nt, [&](std::size_t i, auto& out) { gather(mesh.triangles[i], out); });
     report_progress(progress, 0.95, "mesh");
     std::vector<std::uint32_t> offsets(ni + 1, 0);
     for (const auto& list : corners)

@@ -66,11 +66,10 @@ bool ParkedArrays::write(const void* owner, const void* data, std::size_t count,
         report_progress(progress, begin + (end - begin) * double(done) / double(total), "park");
     }
     const Entry e{owner, at, count, size};
-    entries_.insert(std::upper_bound(entries_.begin(), entries_.end(), e,
-                                     [](const Entry& a, const Entry& b) {
-                                         return a.offset < b.offset;
-                                     }),
-                    e);
+    entries_.insert(
+        std::upper_bound(entries_.begin(), entries_.end(), e,
+                         [](const Entry& a, const Entry& b) { return a.offset < b.offset; }),
+        e);
     file_peak_ = std::max(file_peak_, at + total);
     return true;
 }
@@ -117,7 +116,9 @@ std::uint64_t ParkedArrays::parked_end() const {
     return last.offset + last.count * last.size;
 }
 
-void ParkedArrays::cut() { (void)::ftruncate(fd_, static_cast<off_t>(parked_end())); }
+void ParkedArrays::cut() {
+    (void)::ftruncate(fd_, static_cast<off_t>(parked_end()));
+}
 
 std::uint64_t ParkedArrays::place(std::uint64_t bytes) const {
     std::uint64_t at = 0;

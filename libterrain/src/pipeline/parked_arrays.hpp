@@ -87,8 +87,8 @@ class ParkedArrays {
     std::string dir_;
     std::size_t min_bytes_;
     int fd_ = -1;
-    bool full_ = false;      // a write failed: nothing more is parked
-    bool decided_ = false;   // decide() was called
+    bool full_ = false;     // a write failed: nothing more is parked
+    bool decided_ = false;  // decide() was called
     std::uint64_t file_peak_ = 0;
     std::vector<Entry> entries_;  // by offset
 };

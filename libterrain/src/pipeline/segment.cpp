@@ -365,10 +365,9 @@ SegmentResult segment(Input input, const SegmentOptions& options, const Progress
     auto& mesh = result.input.mesh;
     const auto tf = clock::now();
     const auto kind = field::parse_field_kind(options.field);
-    const bool tree =
-        kind != field::FieldKind::sdf &&
-        (mesh.triangles_released() || mesh.triangles_releasable()) &&
-        reeb::reeb_is_tree(mesh, scaled_progress(progress, 0, 0.02));
+    const bool tree = kind != field::FieldKind::sdf &&
+                      (mesh.triangles_released() || mesh.triangles_releasable()) &&
+                      reeb::reeb_is_tree(mesh, scaled_progress(progress, 0, 0.02));
     if (tree)
         mesh.release_triangles();
     else
