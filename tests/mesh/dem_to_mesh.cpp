@@ -435,27 +435,36 @@ TEST_CASE("dem_to_mesh: the adjacency on the grid is the triangles' adjacency", 
     }
 }
 
-TEST_CASE("dem_to_mesh: the same mesh whatever the thread count", "[mesh]") {
-    // A crop, a global grid (seam, collapsed poles), a grid with NoData holes and pinches, and
-    // one with isolated pixels only: the numbering, the bounds, the rows of triangles, the
-    // areas and the directions run on the threads. (Pixels alone in rings of NoData are
-    // isolated.)
+namespace {
+
+// A crop, a global grid (seam, collapsed poles), a grid with NoData holes and pinches, and one
+// with isolated pixels only (pixels alone in rings of NoData) and no pinch.
+std::vector<Dem> grids_of_every_kind() {
     const auto ring = [](int c, int r) {
         const int dc = c % 20 - 10, dr = r % 15 - 7;
         return std::abs(dc) <= 1 && std::abs(dr) <= 1 && (dc != 0 || dr != 0);
     };
     const auto wave = [](int c, int r) { return std::sin(c * 0.3) * std::cos(r * 0.2) * 10; };
-    std::vector<Dem> dems{
-        io::read_dem(test::sample("moon_ldem4_copernicus.tif")),
-        io::read_dem(test::sample("moon_ldem1_global.tif")),
-        grid_dem(97, 61, 1.0,
-                 [&](int c, int r) {
-                     const bool hole = (c * 7 + r * 13) % 11 == 0 || (c % 9 == 4 && r % 5 == 2);
-                     return ring(c, r) || hole ? kNaN : wave(c, r);
-                 }),
-        // (isolated pixels without pinches: the areas summed by bands that hold their rows'
-        // doubles only, the pixels without a vertex skipped)
-        grid_dem(83, 70, 1.0, [&](int c, int r) { return ring(c, r) ? kNaN : wave(c, r); })};
+    std::vector<Dem> dems;
+    dems.push_back(io::read_dem(test::sample("moon_ldem4_copernicus.tif")));
+    dems.push_back(io::read_dem(test::sample("moon_ldem1_global.tif")));
+    dems.push_back(grid_dem(97, 61, 1.0, [&](int c, int r) {
+        const bool hole = (c * 7 + r * 13) % 11 == 0 || (c % 9 == 4 && r % 5 == 2);
+        return ring(c, r) || hole ? kNaN : wave(c, r);
+    }));
+    // (isolated pixels without pinches: the areas summed by bands that hold their rows'
+    // doubles only, the pixels without a vertex skipped)
+    dems.push_back(
+        grid_dem(83, 70, 1.0, [&](int c, int r) { return ring(c, r) ? kNaN : wave(c, r); }));
+    return dems;
+}
+
+}  // namespace
+
+TEST_CASE("dem_to_mesh: the same mesh whatever the thread count", "[mesh]") {
+    // The numbering, the bounds, the rows of triangles, the areas and the directions run on
+    // the threads.
+    const std::vector<Dem> dems = grids_of_every_kind();
     for (const Dem& dem : dems) {
         TriangleMesh one, two;
         {
@@ -510,20 +519,7 @@ TEST_CASE("dem_to_mesh: triangles released before the areas and the adjacency, t
     // triangles held, at 1 and 2 threads, and the triangles made again are the same. A grid
     // with split pinches keeps its triangles. A crop, a global grid (seam and poles: irregular
     // vertices), a grid with holes and pinches, one with isolated pixels only.
-    const auto ring = [](int c, int r) {
-        const int dc = c % 20 - 10, dr = r % 15 - 7;
-        return std::abs(dc) <= 1 && std::abs(dr) <= 1 && (dc != 0 || dr != 0);
-    };
-    const auto wave = [](int c, int r) { return std::sin(c * 0.3) * std::cos(r * 0.2) * 10; };
-    const std::vector<Dem> dems{
-        io::read_dem(test::sample("moon_ldem4_copernicus.tif")),
-        io::read_dem(test::sample("moon_ldem1_global.tif")),
-        grid_dem(97, 61, 1.0,
-                 [&](int c, int r) {
-                     const bool hole = (c * 7 + r * 13) % 11 == 0 || (c % 9 == 4 && r % 5 == 2);
-                     return ring(c, r) || hole ? kNaN : wave(c, r);
-                 }),
-        grid_dem(83, 70, 1.0, [&](int c, int r) { return ring(c, r) ? kNaN : wave(c, r); })};
+    const std::vector<Dem> dems = grids_of_every_kind();
     mesh::DemToMeshOptions releasing;
     releasing.release_triangles = true;
     for (const Dem& dem : dems) {
