@@ -7,6 +7,7 @@
 #include <bit>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <utility>
 #include <vector>
 
@@ -21,7 +22,8 @@ using detail::i32;
 // first candidates, sorted once and read in order (most of them are cancelled with the key
 // they started with), and a 4-ary min-heap for the keys set later, each arc at most once there
 // (re-keying moves its entry). An arc re-keyed or dropped leaves its sorted entry behind: the
-// caller, who knows each arc's current key, skips such entries.
+// caller skips such entries (a sorted entry stands while its arc is queued and not in the
+// heap: every key set after the first goes to the heap).
 class ArcQueue {
   public:
     static constexpr std::uint64_t kEmpty = ~std::uint64_t{0};  // above any key
@@ -37,20 +39,23 @@ class ArcQueue {
     // become resident as they are written, and no growth copies them (a copy was half as
     // many keys again, at the peak of the simplification's memory).
     // The heap's room too (each arc is in it at most once), untouched until used: it never
-    // grows by a copy of itself, which at its peak was its size again.
+    // grows by a copy of itself, which at its peak was its size again. The heap's slots are
+    // made once the first keys are sorted and cut to their arc ids (seal()): the sort is the
+    // peak of the cancellations' memory.
     void init(std::size_t arcs) {
-        slot_.assign(arcs, detail::kNone);
+        arcs_ = arcs;
         sorted_.reserve(arcs);
         heap_.reserve(arcs);
     }
     std::size_t bytes() const {
         return heap_.size() * sizeof(std::uint64_t) + slot_.capacity() * sizeof(i32) +
-               sorted_.capacity() * sizeof(std::uint64_t);
+               (sealed_ ? count_ * sizeof(std::uint32_t) : sorted_.size() * sizeof(std::uint64_t));
     }
     void release() {
         detail::release(slot_);
         detail::release(heap_);
         detail::release(sorted_);
+        count_ = next_ = 0;
     }
     // The first candidates, in increasing arc order, then sorted by seal().
     void seed(std::uint64_t key) { sorted_.push_back(key); }
@@ -77,21 +82,46 @@ class ArcQueue {
         for (std::size_t b = 0; b < kBuckets; ++b)
             std::sort(sorted_.begin() + static_cast<std::ptrdiff_t>(begin[b]),
                       sorted_.begin() + static_cast<std::ptrdiff_t>(begin[b + 1]));
+        // Sorted, each entry keeps only its arc id (4 bytes), written over the front half of
+        // the keys in order (entry k's id lands on bytes a key before it or k itself held,
+        // already read); the back half's pages go back to the system. The caller knows each
+        // arc's key: an entry's is its arc's while the arc is queued outside the heap.
+        count_ = sorted_.size();
+        unsigned char* const bytes = reinterpret_cast<unsigned char*>(sorted_.data());
+        for (std::size_t k = 0; k < count_; ++k) {
+            const auto id = static_cast<std::uint32_t>(sorted_[k]);
+            std::memcpy(bytes + k * sizeof(id), &id, sizeof(id));
+        }
+        detail::PagesBehind(bytes + count_ * sizeof(std::uint32_t))
+            .before(bytes + count_ * sizeof(std::uint64_t));
+        sealed_ = true;
         next_ = 0;
-        behind_ = detail::PagesBehind(sorted_.data());
+        behind_ = detail::PagesBehind(bytes);
+        slot_.assign(arcs_, detail::kNone);
     }
-    // The next sorted entry (kEmpty after the last), and the one `ahead` places further.
-    std::uint64_t sorted_front() const { return next_ < sorted_.size() ? sorted_[next_] : kEmpty; }
-    std::uint64_t sorted_ahead(std::size_t ahead) const {
-        return next_ + ahead < sorted_.size() ? sorted_[next_ + ahead] : kEmpty;
+    // The arc of the next sorted entry (kNone after the last), and of the one `ahead` places
+    // further.
+    i32 sorted_front() const { return sorted_ahead(0); }
+    i32 sorted_ahead(std::size_t ahead) const {
+        if (next_ + ahead >= count_) return detail::kNone;
+        std::uint32_t id;
+        std::memcpy(&id, reinterpret_cast<const unsigned char*>(sorted_.data()) +
+                             (next_ + ahead) * sizeof(id),
+                    sizeof(id));
+        return static_cast<i32>(id);
     }
     // (The entries passed are read no more: their pages go back to the system as the
-    // cancellations go, 8 bytes a first candidate, about 4 a pixel on a noisy grid.)
+    // cancellations go, 4 bytes a first candidate.)
     void skip_sorted() {
-        if ((++next_ & 0xffff) == 0) behind_.before(sorted_.data() + next_);
+        if ((++next_ & 0xffff) == 0)
+            behind_.before(reinterpret_cast<const unsigned char*>(sorted_.data()) +
+                           next_ * sizeof(std::uint32_t));
     }
+    // Whether arc a has an entry in the heap (its sorted entry, if any, is then stale).
+    bool in_heap(i32 a) const { return slot_[detail::idx(a)] != detail::kNone; }
+    void prefetch_slot(i32 a) const { __builtin_prefetch(&slot_[detail::idx(a)]); }
     // Entries still queued (sorted ones to come and the heap's), stale ones included.
-    std::size_t pending() const { return sorted_.size() - next_ + heap_.size(); }
+    std::size_t pending() const { return count_ - next_ + heap_.size(); }
     std::uint64_t top() const { return heap_.empty() ? kEmpty : heap_.front(); }
     // Queues arc `key & 0xffffffff` with this key, or moves it there.
     void set(std::uint64_t key) {
@@ -164,8 +194,10 @@ class ArcQueue {
 
     std::vector<std::uint64_t> heap_;
     std::vector<i32> slot_;  // each arc's slot in heap_, kNone when not there
-    std::vector<std::uint64_t> sorted_;
-    std::size_t next_ = 0;  // sorted_[next_ ..] are still to come
+    std::vector<std::uint64_t> sorted_;  // the first keys; once sealed, count_ arc ids
+    std::size_t arcs_ = 0, count_ = 0;
+    bool sealed_ = false;
+    std::size_t next_ = 0;  // entries next_.. are still to come
     detail::PagesBehind behind_;
 };
 

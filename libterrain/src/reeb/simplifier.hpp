@@ -94,17 +94,21 @@ class Simplifier : WorkingGraph {
         return key;
     }
     // The smallest current key queued, taken out (entries left behind are dropped on the way);
-    // kEmpty when none is left.
+    // kEmpty when none is left. A sorted entry stands while its arc is queued outside the
+    // heap, with the key it was seeded with (every key set later goes to the heap).
     std::uint64_t take() {
         const auto current = [&](std::uint64_t key) {
             return arcs_[key & 0xffffffffu].queued == key >> 32;
         };
         for (;;) {
-            std::uint64_t s = queue_.sorted_front();
-            while (s != ArcQueue::kEmpty && !current(s)) {
+            i32 a = queue_.sorted_front();
+            while (a != kNone && (arcs_[idx(a)].queued == kNotQueued || queue_.in_heap(a))) {
                 queue_.skip_sorted();
-                s = queue_.sorted_front();
+                a = queue_.sorted_front();
             }
+            const std::uint64_t s =
+                a == kNone ? ArcQueue::kEmpty
+                           : std::uint64_t{arcs_[idx(a)].queued} << 32 | static_cast<std::uint32_t>(a);
             const std::uint64_t h = queue_.top();
             if (s == ArcQueue::kEmpty && h == ArcQueue::kEmpty) return ArcQueue::kEmpty;
             if (s < h) {

@@ -115,11 +115,14 @@ void Simplifier::run(const ProgressFn& progress, SimplifyResult& result) {
     report_progress(progress, 1.0, "simplify");
 }
 
-// The sorted entries ahead: their arcs first, then (nearer) their ends.
+// The sorted entries ahead: their arcs (and heap slots) first, then (nearer) their ends.
 void Simplifier::prefetch_candidates_ahead() const {
-    const std::uint64_t far = queue_.sorted_ahead(kAhead), near = queue_.sorted_ahead(4);
-    if (far != ArcQueue::kEmpty) __builtin_prefetch(&arcs_[idx(ArcQueue::arc_of(far))]);
-    if (near != ArcQueue::kEmpty) prefetch_ends(idx(ArcQueue::arc_of(near)));
+    const i32 far = queue_.sorted_ahead(kAhead), near = queue_.sorted_ahead(4);
+    if (far != kNone) {
+        __builtin_prefetch(&arcs_[idx(far)]);
+        queue_.prefetch_slot(far);
+    }
+    if (near != kNone) prefetch_ends(idx(near));
 }
 
 }  // namespace internal
