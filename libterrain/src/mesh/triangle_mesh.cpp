@@ -1,6 +1,7 @@
 #include "terrain/mesh/triangle_mesh.hpp"
 #include "../core/disjoint_sets.hpp"
 #include "../core/pass_progress.hpp"
+#include "../core/ranked_bits.hpp"
 #include "../core/release.hpp"
 #include "grid_triangles.hpp"
 #include "terrain/core/error.hpp"
@@ -685,31 +686,25 @@ std::size_t split_pinched_vertices(TriangleMesh& mesh, std::int32_t* first_pinch
     // With may_pinch, the vertices looked at are a bit each, a word of 64 of them with the
     // count of those before it: a vertex's rank is that count and the bits below its own.
     // (An array of ranks was 4 bytes a pixel at the mesh's peak, for a few vertices.)
-    std::vector<std::uint64_t> looked;
-    std::vector<std::uint32_t> before;  // by word
+    detail::RankedBits looked;
     std::size_t looked_at = n;
     if (may_pinch) {  // (asked on every thread, a word each; counted in order)
-        const std::size_t words = (n + 63) / 64;
-        detail::assign_in_slices(looked, words, std::uint64_t{0}, counted);
-        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, words, std::size_t{1} << 8),
+        counted.at(0, 1);
+        looked = detail::RankedBits(n);
+        auto& words = looked.words();
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, words.size(), std::size_t{1} << 8),
                           [&](const tbb::blocked_range<std::size_t>& r) {
                               for (std::size_t w = r.begin(); w < r.end(); ++w)
                                   for (std::size_t v = 64 * w; v < std::min(n, 64 * w + 64); ++v)
-                                      if (may_pinch(v)) looked[w] |= std::uint64_t{1} << (v % 64);
+                                      if (may_pinch(v)) words[w] |= std::uint64_t{1} << (v % 64);
                           });
-        before.resize(words);
-        looked_at = 0;
-        for (std::size_t w = 0; w < words; ++w) {
-            before[w] = static_cast<std::uint32_t>(looked_at);
-            looked_at += static_cast<std::size_t>(std::popcount(looked[w]));
-        }
+        looked.count();
+        looked_at = looked.members();
     }
     const auto rank = [&](std::int32_t v) -> std::int32_t {
         if (!may_pinch) return v;
-        const std::size_t w = std::size_t(v) / 64;
-        const std::uint64_t bit = std::uint64_t{1} << (std::size_t(v) % 64);
-        if ((looked[w] & bit) == 0) return -1;
-        return static_cast<std::int32_t>(before[w] + std::popcount(looked[w] & (bit - 1)));
+        if (!looked.test(std::size_t(v))) return -1;
+        return static_cast<std::int32_t>(looked.rank(std::size_t(v)));
     };
     // The corners at vertices looked at, (rank, triangle): with may_pinch (a few vertices of a
     // large grid) gathered by slices of triangles on every thread, in triangle order within
@@ -825,28 +820,25 @@ std::size_t remove_unreferenced_vertices(TriangleMesh& mesh, const ProgressFn& p
     // number is the count of marked vertices before it: the marks before its word (counted
     // once) and in its word. (A number a vertex beside the triangles was 4 bytes a pixel more
     // at the mesh's peak.)
-    std::vector<std::uint64_t> used((nv + 63) / 64, 0);
+    detail::RankedBits used(nv);
+    auto& words = used.words();
     detail::parallel_slices(nt, std::size_t{4096}, progress, 0, 0.4, "mesh",
                             [&](const tbb::blocked_range<std::size_t>& r) {
                                 for (std::size_t i = r.begin(); i < r.end(); ++i)
                                     for (auto v : mesh.triangles[i])
-                                        std::atomic_ref<std::uint64_t>(used[std::size_t(v) / 64])
+                                        std::atomic_ref<std::uint64_t>(words[std::size_t(v) / 64])
                                             .fetch_or(std::uint64_t{1} << (std::size_t(v) % 64),
                                                       std::memory_order_relaxed);
                             });
-    std::vector<std::uint32_t> before(used.size() + 1, 0);
-    for (std::size_t w = 0; w < used.size(); ++w)
-        before[w + 1] = before[w] + static_cast<std::uint32_t>(std::popcount(used[w]));
-    const std::size_t unused = nv - before.back();
+    used.count();
+    const std::size_t unused = nv - used.members();
     if (unused == 0) {
         report_progress(progress, 1, "mesh");
         return 0;
     }
-    const auto marked = [&](std::size_t v) { return (used[v / 64] >> (v % 64)) & 1; };
+    const auto marked = [&](std::size_t v) { return used.test(v); };
     const auto remap = [&](std::int32_t v) {
-        const auto u = std::size_t(v);
-        const std::uint64_t lower = used[u / 64] & ((std::uint64_t{1} << (u % 64)) - 1);
-        return static_cast<std::int32_t>(before[u / 64] + std::popcount(lower));
+        return static_cast<std::int32_t>(used.rank(std::size_t(v)));
     };
     const bool pixels = !mesh.vertex_pixel.empty();
     std::int32_t next = 0;

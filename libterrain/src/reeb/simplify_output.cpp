@@ -37,16 +37,23 @@ void WorkingGraph::write_result(SimplifyResult& result, bool rewrite_field,
     };
     // (Large blocks made a slice at a time, with heartbeats: their first touch is slow.)
     const auto made = [&](double at) { return PassProgress(progress, at, at, "simplify"); };
+    // The critical nodes' codes first; a regular node's is written over its forward (read no
+    // more), and joins the array once the rest of the working graph is gone: the working
+    // graph and a code for every node at once were the peak of the simplification's memory.
+    const std::size_t nc = idx(critical_count_);
     std::vector<i32> code;
-    detail::assign_in_slices(code, idx(critical_count_) + nl, i32{0}, made(0));
-    for (std::size_t k = 0; k < idx(critical_count_); ++k) code[k] = fate(forward_of(critical_[k]));
-    for (std::size_t k = 0; k < idx(critical_count_); ++k)
+    detail::assign_in_slices(code, nc, i32{0}, made(0), nc + nl);  // (room for all)
+    for (std::size_t k = 0; k < nc; ++k) code[k] = fate(forward_of(critical_[k]));
+    for (std::size_t k = 0; k < nc; ++k)
         if (code[k] != kNone) code[k] = find_root(code, code[k]);
     for (std::size_t p = 0; p < nl; ++p) {
         fates.at(p, nl);
         const i32 f = fate(regular_[p].forward);
-        code[idx(critical_count_) + p] = f == kNone || code[idx(f)] == kNone ? f : code[idx(f)];
+        regular_[p].forward = f == kNone || code[idx(f)] == kNone ? f : code[idx(f)];
     }
+    const auto code_of = [&](std::size_t i) {
+        return i < nc ? code[i] : regular_[i - nc].forward;
+    };
     // What the output reads of the working graph, taken out: the nodes that remain (by their
     // index here, in order) and the arcs that live, with their lists (a few thousand nodes on
     // a simplified grid). The working graph then goes, before the new numbers come back
@@ -60,8 +67,8 @@ void WorkingGraph::write_result(SimplifyResult& result, bool rewrite_field,
         bool changed = false;
     };
     std::vector<Remaining> remaining;
-    for (std::size_t i = 0; i < code.size(); ++i) {
-        if (code[i] != kNone) continue;
+    for (std::size_t i = 0; i < nc + nl; ++i) {
+        if (code_of(i) != kNone) continue;
         Remaining r;
         r.index = static_cast<i32>(i);
         r.value = value(r.index);
@@ -85,6 +92,16 @@ void WorkingGraph::write_result(SimplifyResult& result, bool rewrite_field,
         live_offsets.push_back(static_cast<i32>(live_nodes.size()));
     }
     release_working_graph();
+    // The regular nodes' codes join the array (in its room), and their records go, their
+    // pages given back behind the copy.
+    {
+        detail::PagesBehind behind(regular_.data());
+        for (std::size_t p = 0; p < nl; ++p) {
+            code.push_back(regular_[p].forward);
+            if ((p & 0xffff) == 0) behind.before(regular_.data() + p);
+        }
+    }
+    detail::release(regular_);
     if (map_parked_.on()) {
         map_parked_.restore(node_map_);
         if (node_map_.size() != nn)

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "../core/pass_progress.hpp"
+#include "../core/ranked_bits.hpp"
 #include "../core/release.hpp"
 #include "terrain/core/error.hpp"
 
@@ -112,7 +113,6 @@ bool WorkingGraph::refresh(i32 n, i32 b) {
 
 void WorkingGraph::release_working_graph() {
     detail::release(critical_);
-    detail::release(regular_);
     detail::release(arena_);
     for (auto& f : free_runs_) detail::release(f);
     detail::release(set_parent_);
@@ -182,11 +182,10 @@ WorkingGraph::WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big
     owned_ = owned;
     if (owned) detail::release(owned->node_arcs);  // not read here
     // node_map_[n]: arc ends marked, the other regular nodes of the lists by their position in
-    // arc_nodes (`placed` says which positions hold their node); then the new numbers.
+    // arc_nodes; then the new numbers.
     constexpr i32 kEnd = -2;
     detail::assign_in_slices(node_map_, nn, kNone, PassProgress(progress, 0, 0.03, "simplify"));
     for (const auto& e : g.arcs) node_map_[idx(e[0])] = node_map_[idx(e[1])] = kEnd;
-    std::vector<char> placed(nl, 0);
     for (std::size_t p = 0; p < nl; ++p) {
         lists.at(p, nl);
         const i32 r = g.arc_nodes[p];
@@ -197,10 +196,15 @@ WorkingGraph::WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big
                                         " is an arc end or in two arcs' lists");
         if (g.node_kinds[idx(r)] != NodeKind::regular) continue;
         node_map_[idx(r)] = static_cast<i32>(p);
-        placed[p] = 1;
     }
-    critical_count_ = 0;
-    for (const i32 i : node_map_) critical_count_ += i < 0;
+    // The critical nodes (arc ends, and critical nodes in lists) as a bit each: a critical
+    // node's new number is its rank among them, which the arcs' pass reads instead of
+    // node_map_ (4 bytes a node, parked before it).
+    detail::RankedBits critical_nodes(nn);
+    for (std::size_t n = 0; n < nn; ++n)
+        if (node_map_[n] < 0) critical_nodes.set(n);
+    critical_nodes.count();
+    critical_count_ = static_cast<i32>(critical_nodes.members());
     // The regular nodes' records are written in list order, at random: made whole first (a
     // slice at a time: a large block's first touch is slow, docs/performance.md). The
     // critical nodes' are written in order by the nodes' pass: their pages are touched as it
@@ -257,6 +261,15 @@ WorkingGraph::WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big
     }
     total_area_ = mesh_area_or_one(total_area_);
     if (areas_read) areas_read();  // (before the arcs: their copy's end is the peak)
+    // The new numbers are read again only by write_result, once the working graph is freed:
+    // they may wait elsewhere through the arcs' copy (the peak) and the cancellations.
+    if (owned && parking.on()) {
+        map_parked_ = parking;
+        map_parked_.park(node_map_);
+    }
+    const auto critical_number = [&](i32 n) {
+        return static_cast<i32>(critical_nodes.rank(idx(n)));
+    };
     if (owned) {                   // the nodes are copied
         detail::release(owned->node_values);
         detail::release(owned->node_kinds);
@@ -299,17 +312,18 @@ WorkingGraph::WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big
         }
         Arc& arc = arcs_.emplace_back();
         if (a + kAhead < na)
-            for (const i32 e : g.arcs[a + kAhead]) __builtin_prefetch(&node_map_[idx(e)]);
+            for (const i32 e : g.arcs[a + kAhead]) critical_nodes.prefetch(idx(e));
         if (a + kAhead / 2 < na)
             for (const i32 e : g.arcs[a + kAhead / 2])
-                __builtin_prefetch(&critical_[idx(node_map_[idx(e)])], 1);
-        arc.end = {node_map_[idx(g.arcs[a][0])], node_map_[idx(g.arcs[a][1])]};
+                __builtin_prefetch(&critical_[idx(critical_number(e))], 1);
+        arc.end = {critical_number(g.arcs[a][0]), critical_number(g.arcs[a][1])};
         for (const i32 e : arc.end) link(static_cast<i32>(a), e);
         ++critical_[idx(arc.end[1])].down;
         arc.set = static_cast<i32>(a);
         for (i32 p = g.arc_offsets[a]; p < g.arc_offsets[a + 1]; ++p) {
-            const i32 r =
-                placed[idx(p)] ? critical_count_ + p : node_map_[idx(g.arc_nodes[idx(p)])];
+            const i32 listed = g.arc_nodes[idx(p)];
+            const i32 r = critical_nodes.test(idx(listed)) ? critical_number(listed)
+                                                            : critical_count_ + p;
             set_forward(r, -2 - arc.set);
             if (arc.tail == kNone) {
                 arc.head = r;
@@ -325,13 +339,6 @@ WorkingGraph::WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big
         detail::release(owned->arcs);
         detail::release(owned->arc_offsets);
         detail::release(owned->arc_nodes);
-    }
-    detail::release(placed);
-    // The new numbers are read again only by write_result, once the working graph is freed:
-    // they may wait elsewhere through the cancellations (4 bytes a node).
-    if (owned && parking.on()) {
-        map_parked_ = parking;
-        map_parked_.park(node_map_);
     }
     // The lists' sets, made once the input's arcs are freed (the copy's end is the peak of
     // the simplification's memory), with room for as many new sets again, reserved and not
