@@ -48,11 +48,20 @@ bool enabled = false;
     return true;
 }();
 
-void* allocate(std::size_t n) {
-    if (n >= Blocks::kLarge && enabled)
+// A block of n bytes aligned to `align` (a power of two): a large block (2 MiB aligned) when
+// it may be one, else from malloc (aligned_alloc beyond malloc's own alignment), its size
+// counted. (Over-aligned types, as the simplification's 32-byte records, come through here too:
+// left to the system's allocator they were neither kept nor counted, and the kept blocks then
+// overran the peak by as much as those records took beyond what was counted.)
+void* allocate(std::size_t n, std::size_t align = __STDCPP_DEFAULT_NEW_ALIGNMENT__) {
+    if (n >= Blocks::kLarge && enabled && align <= Blocks::kAlign)
         if (void* p = blocks().allocate(n)) return p;
     for (;;) {
-        if (void* p = std::malloc(n == 0 ? 1 : n)) {
+        const std::size_t bytes = n == 0 ? 1 : n;
+        void* p = align <= __STDCPP_DEFAULT_NEW_ALIGNMENT__
+                      ? std::malloc(bytes)
+                      : std::aligned_alloc(align, (bytes + align - 1) / align * align);
+        if (p) {
             if (enabled) blocks().note_grown(malloc_usable_size(p));
             return p;
         }
@@ -88,4 +97,27 @@ void operator delete(void* p, std::size_t) noexcept {
 }
 void operator delete[](void* p, std::size_t) noexcept {
     release(p);
+}
+void* operator new(std::size_t n, std::align_val_t a) {
+    return allocate(n, static_cast<std::size_t>(a));
+}
+void* operator new[](std::size_t n, std::align_val_t a) {
+    return allocate(n, static_cast<std::size_t>(a));
+}
+void operator delete(void* p, std::align_val_t) noexcept {
+    release(p);
+}
+void operator delete[](void* p, std::align_val_t) noexcept {
+    release(p);
+}
+void operator delete(void* p, std::size_t, std::align_val_t) noexcept {
+    release(p);
+}
+void operator delete[](void* p, std::size_t, std::align_val_t) noexcept {
+    release(p);
+}
+
+// (tests/tools/big_blocks_probe.cpp) What the blocks hold now.
+terrain::cli::LargeBlocks<>::Counts terrain_large_block_counts() {
+    return blocks().counts();
 }

@@ -3,6 +3,9 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <array>
+#include <cstdio>
+#include <string>
 #include <cstdint>
 #include <cstring>
 #include <fstream>
@@ -278,3 +281,36 @@ TEST_CASE("a kept block counts only the pages its owner left resident") {
     CHECK(blocks.counts().kept_touched == 0);
     blocks.give_back();
 }
+
+#ifdef TERRAIN_BIG_BLOCKS_PROBE
+TEST_CASE("The program's operator new takes large blocks of over-aligned types too",
+          "[cli][memory]") {
+    // tests/tools/big_blocks_probe.cpp: 8 MiB of plain words, 16 MiB of 32-byte aligned
+    // records, 8 MiB of 4 KiB aligned pages, then a few small records; all freed.
+    const auto r = terrain::test::run_program(TERRAIN_BIG_BLOCKS_PROBE, {});
+    INFO(r.out << r.err);
+    REQUIRE(r.status == 0);
+    const auto line = [&](const std::string& step) {
+        const auto at = r.out.find(step + " used ");
+        REQUIRE(at != std::string::npos);
+        std::size_t used_blocks, used_bytes, kept_blocks, kept_bytes;
+        REQUIRE(std::sscanf(r.out.c_str() + at + step.size(), " used %zu %zu kept %zu %zu",
+                            &used_blocks, &used_bytes, &kept_blocks, &kept_bytes) == 4);
+        return std::array<std::size_t, 4>{used_blocks, used_bytes, kept_blocks, kept_bytes};
+    };
+    const auto start = line("start");
+    CHECK(line("plain")[0] == start[0] + 1);
+    CHECK(line("records")[0] == start[0] + 2);  // (32-byte alignment)
+    CHECK(line("records")[1] == start[1] + 24 * MiB);
+    CHECK(line("pages")[0] == start[0] + 3);  // (4 KiB alignment)
+    CHECK(line("small")[0] == start[0] + 3);  // (small blocks from malloc)
+    CHECK_THAT(r.out, Catch::Matchers::Contains("aligned 1 1 1"));
+    const auto freed = line("freed");
+    CHECK(freed[0] == start[0]);
+    // Kept for reuse, as many as fit under the peak.
+    CHECK(freed[2] > start[2]);
+    CHECK(freed[2] <= start[2] + 3);
+    CHECK(freed[3] > start[3] + 16 * MiB);
+    CHECK(freed[3] <= start[3] + 32 * MiB);
+}
+#endif
