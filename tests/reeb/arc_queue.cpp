@@ -59,7 +59,7 @@ TEST_CASE("The candidates' heap: set, re-key, erase and pop agree with a sorted 
     std::uniform_real_distribution<float> persistence(0.f, 50.f);
     ArcQueue q;
     q.init(n);
-    q.seal();  // no first keys: the heap alone
+    q.seal();                            // no first keys: the heap alone
     std::map<int, std::uint64_t> model;  // arc -> its key while queued
     const auto smallest = [&] {
         std::uint64_t m = ArcQueue::kEmpty;

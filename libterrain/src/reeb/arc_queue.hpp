@@ -105,9 +105,10 @@ class ArcQueue {
     i32 sorted_ahead(std::size_t ahead) const {
         if (next_ + ahead >= count_) return detail::kNone;
         std::uint32_t id;
-        std::memcpy(&id, reinterpret_cast<const unsigned char*>(sorted_.data()) +
-                             (next_ + ahead) * sizeof(id),
-                    sizeof(id));
+        std::memcpy(
+            &id,
+            reinterpret_cast<const unsigned char*>(sorted_.data()) + (next_ + ahead) * sizeof(id),
+            sizeof(id));
         return static_cast<i32>(id);
     }
     // (The entries passed are read no more: their pages go back to the system as the
@@ -193,7 +194,7 @@ class ArcQueue {
     }
 
     std::vector<std::uint64_t> heap_;
-    std::vector<i32> slot_;  // each arc's slot in heap_, kNone when not there
+    std::vector<i32> slot_;              // each arc's slot in heap_, kNone when not there
     std::vector<std::uint64_t> sorted_;  // the first keys; once sealed, count_ arc ids
     std::size_t arcs_ = 0, count_ = 0;
     bool sealed_ = false;

@@ -106,9 +106,9 @@ class Simplifier : WorkingGraph {
                 queue_.skip_sorted();
                 a = queue_.sorted_front();
             }
-            const std::uint64_t s =
-                a == kNone ? ArcQueue::kEmpty
-                           : std::uint64_t{arcs_[idx(a)].queued} << 32 | static_cast<std::uint32_t>(a);
+            const std::uint64_t s = a == kNone ? ArcQueue::kEmpty
+                                               : std::uint64_t{arcs_[idx(a)].queued} << 32 |
+                                                     static_cast<std::uint32_t>(a);
             const std::uint64_t h = queue_.top();
             if (s == ArcQueue::kEmpty && h == ArcQueue::kEmpty) return ArcQueue::kEmpty;
             if (s < h) {

@@ -51,9 +51,7 @@ void WorkingGraph::write_result(SimplifyResult& result, bool rewrite_field,
         const i32 f = fate(regular_[p].forward);
         regular_[p].forward = f == kNone || code[idx(f)] == kNone ? f : code[idx(f)];
     }
-    const auto code_of = [&](std::size_t i) {
-        return i < nc ? code[i] : regular_[i - nc].forward;
-    };
+    const auto code_of = [&](std::size_t i) { return i < nc ? code[i] : regular_[i - nc].forward; };
     // What the output reads of the working graph, taken out: the nodes that remain (by their
     // index here, in order) and the arcs that live, with their lists (a few thousand nodes on
     // a simplified grid). The working graph then goes, before the new numbers come back

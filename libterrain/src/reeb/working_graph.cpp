@@ -270,7 +270,7 @@ WorkingGraph::WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big
     const auto critical_number = [&](i32 n) {
         return static_cast<i32>(critical_nodes.rank(idx(n)));
     };
-    if (owned) {                   // the nodes are copied
+    if (owned) {  // the nodes are copied
         detail::release(owned->node_values);
         detail::release(owned->node_kinds);
         // The vertex lists or the vertices' nodes, whichever write_result will not read.
@@ -322,8 +322,8 @@ WorkingGraph::WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big
         arc.set = static_cast<i32>(a);
         for (i32 p = g.arc_offsets[a]; p < g.arc_offsets[a + 1]; ++p) {
             const i32 listed = g.arc_nodes[idx(p)];
-            const i32 r = critical_nodes.test(idx(listed)) ? critical_number(listed)
-                                                            : critical_count_ + p;
+            const i32 r =
+                critical_nodes.test(idx(listed)) ? critical_number(listed) : critical_count_ + p;
             set_forward(r, -2 - arc.set);
             if (arc.tail == kNone) {
                 arc.head = r;

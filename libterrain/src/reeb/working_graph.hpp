@@ -404,7 +404,7 @@ class WorkingGraph {
     VertexNodesParking map_parked_;  // set when node_map_ is parked (after the copy)
     // Frees the records, runs, arcs, sets and big nodes (write_result, once the arcs are out).
     void release_working_graph();  // all but regular_ (the output reads it after)
-    std::size_t moves_ = 0;  // link() calls
+    std::size_t moves_ = 0;        // link() calls
 };
 
 }  // namespace terrain::reeb::internal
