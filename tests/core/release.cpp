@@ -1,9 +1,12 @@
-// Pieces of memory given back behind a pass (core/release.hpp).
+// Pieces of memory given back behind a pass (core/release.hpp), and ranked bits
+// (core/ranked_bits.hpp).
 
 #include <catch2/catch.hpp>
 #include <cstdint>
+#include <random>
 #include <vector>
 
+#include "../../libterrain/src/core/ranked_bits.hpp"
 #include "../../libterrain/src/core/release.hpp"
 #include "support/test_support.hpp"
 
@@ -48,4 +51,28 @@ TEST_CASE("PagesBehind gives back the whole 2 MiB pieces before the pass, nothin
     PagesBehind none(nullptr);
     none.before(v.data() + v.size());
     CHECK(v[v.size() - 1] == 7);
+}
+
+TEST_CASE("Ranked bits: a member's rank is the count of members below it", "[core]") {
+    std::mt19937 rng(5);
+    // Sizes around the 64-bit words' edges, and members at both ends of words.
+    for (const std::size_t n : {std::size_t{1}, std::size_t{63}, std::size_t{64},
+                                std::size_t{65}, std::size_t{1000}, std::size_t{4097}}) {
+        terrain::detail::RankedBits bits(n);
+        std::vector<bool> model(n, false);
+        std::bernoulli_distribution member(0.3);
+        for (std::size_t i = 0; i < n; ++i)
+            if (i == 0 || i == n - 1 || i % 64 == 63 || member(rng)) {
+                bits.set(i);
+                model[i] = true;
+            }
+        bits.count();
+        std::size_t below = 0;
+        for (std::size_t i = 0; i < n; ++i) {
+            REQUIRE(bits.test(i) == model[i]);
+            REQUIRE(bits.rank(i) == below);
+            below += model[i];
+        }
+        CHECK(bits.members() == below);
+    }
 }
