@@ -56,8 +56,8 @@ TEST_CASE("PagesBehind gives back the whole 2 MiB pieces before the pass, nothin
 TEST_CASE("Ranked bits: a member's rank is the count of members below it", "[core]") {
     std::mt19937 rng(5);
     // Sizes around the 64-bit words' edges, and members at both ends of words.
-    for (const std::size_t n : {std::size_t{1}, std::size_t{63}, std::size_t{64},
-                                std::size_t{65}, std::size_t{1000}, std::size_t{4097}}) {
+    for (const std::size_t n : {std::size_t{1}, std::size_t{63}, std::size_t{64}, std::size_t{65},
+                                std::size_t{1000}, std::size_t{4097}}) {
         terrain::detail::RankedBits bits(n);
         std::vector<bool> model(n, false);
         std::bernoulli_distribution member(0.3);
