@@ -41,7 +41,8 @@ class ArcQueue {
     // The heap's room too (each arc is in it at most once), untouched until used: it never
     // grows by a copy of itself, which at its peak was its size again. The heap's slots are
     // made once the first keys are sorted and cut to their arc ids (seal()): the sort is the
-    // peak of the cancellations' memory.
+    // peak of the cancellations' memory. So the heap (set, erase, pop, in_heap) is used only
+    // after seal(), with no first keys if there are none.
     void init(std::size_t arcs) {
         arcs_ = arcs;
         sorted_.reserve(arcs);
