@@ -7,6 +7,8 @@
 //   - assign_in_slices, copy_in_slices: a large vector filled 2^18 elements at a time,
 //     reported after each: the first touch of a large block's pages is a silence of its own
 //     (about 3 s a GB measured on a virtual machine, 0.7 s for the adjacency of 4 M pixels).
+//     Its pages are touched first on every thread (touch_pages): a fresh page costs the same
+//     on each, so two threads take it in half the time.
 //   - parallel_slices: a parallel pass over n items cut into at most 64 consecutive slices,
 //     each run by tbb::parallel_for, reported after each. The body sees the same items as
 //     one parallel_for over the whole range, so the results do not change.
@@ -45,6 +47,25 @@ class PassProgress {
     std::string_view message_;
 };
 
+// The pages of [first, first + bytes) touched (a zero byte written in each), on every thread,
+// before a serial pass writes them all: the first touch of fresh memory costs about 2.4 s a GB
+// on one thread here, 1.2 on two (docs/performance.md, "Large blocks are made a slice at a
+// time"). The storage is raw (reserved, its elements not made yet) or about to be overwritten.
+inline void touch_pages(void* first, std::size_t bytes) {
+    constexpr std::size_t kPage = 4096, kChunk = std::size_t{2} << 20, kWorth = kChunk * 4;
+    if (bytes < kWorth) return;
+    auto* base = static_cast<unsigned char*>(first);
+    const std::size_t chunks = (bytes + kChunk - 1) / kChunk;
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks, 1),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                          for (std::size_t c = r.begin(); c < r.end(); ++c) {
+                              const std::size_t end = std::min(bytes, (c + 1) * kChunk);
+                              for (std::size_t at = c * kChunk; at < end; at += kPage)
+                                  *static_cast<volatile unsigned char*>(base + at) = 0;
+                          }
+                      });
+}
+
 // v becomes n copies of value, with the capacity n (as std::vector<T>(n, value)), or `room`
 // when larger (reserved, not touched: no page of it resident until used).
 template <class T>
@@ -52,6 +73,7 @@ void assign_in_slices(std::vector<T>& v, std::size_t n, const T& value, const Pa
                       std::size_t room = 0) {
     std::vector<T>().swap(v);
     v.reserve(std::max(n, room));
+    touch_pages(v.data(), n * sizeof(T));
     constexpr std::size_t kSlice = std::size_t{1} << 18;
     for (std::size_t at = 0; at < n;) {
         pass.at(at, n);
@@ -65,6 +87,7 @@ template <class T>
 void copy_in_slices(std::vector<T>& v, const T* first, std::size_t n, const PassProgress& pass) {
     std::vector<T>().swap(v);
     v.reserve(n);
+    touch_pages(v.data(), n * sizeof(T));
     constexpr std::size_t kSlice = std::size_t{1} << 18;
     for (std::size_t at = 0; at < n;) {
         pass.at(at, n);
