@@ -159,8 +159,10 @@ TEST_CASE("pipeline::segment gives the DEM back bit for bit, floats or not", "[p
         CHECK(result.parked_growing == dem_bytes);
         // The file holds no more than the most parked at once: an array read back leaves a
         // gap the next ones fill (appended, the file would hold the DEM twice, the areas
-        // twice, the sweeps' lists).
-        CHECK(result.parked_file == result.parked_bytes);
+        // twice, the sweeps' lists). Each of the 8 arrays starts on a 4 KiB block (the file
+        // is read and written around the page cache): at most a block's padding each.
+        CHECK(result.parked_file >= result.parked_bytes);
+        CHECK(result.parked_file <= result.parked_bytes + 8 * 4096);
         const auto held = pipeline::segment(pipeline::input_from_dem(dem, "map"), holding);
         CHECK(result.label_pixels() == held.label_pixels());
         CHECK(result.field == held.field);

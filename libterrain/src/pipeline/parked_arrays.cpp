@@ -8,6 +8,8 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cstdint>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <system_error>
@@ -20,6 +22,13 @@ namespace {
 
 // Bytes moved by one system call: a report after each.
 constexpr std::size_t kChunk = std::size_t{64} << 20;
+// The block direct transfers are aligned to, in memory and in the file, and the buffer that
+// moves the bytes of an array not so aligned (the large blocks of the program are).
+constexpr std::size_t kBlock = 4096, kBuffer = std::size_t{4} << 20;
+
+std::uint64_t round_up(std::uint64_t bytes) {
+    return (bytes + kBlock - 1) / kBlock * kBlock;
+}
 
 }  // namespace
 
@@ -28,6 +37,11 @@ ParkedArrays::ParkedArrays(std::string dir, std::size_t min_bytes)
 
 ParkedArrays::~ParkedArrays() {
     if (fd_ >= 0) ::close(fd_);
+    std::free(buffer_);
+}
+
+std::uint64_t ParkedArrays::Entry::end() const {
+    return offset + round_up(count * size);
 }
 
 void ParkedArrays::decide(std::size_t bytes) {
@@ -45,18 +59,63 @@ void ParkedArrays::decide(std::size_t bytes) {
         fd_ = ::mkstemp(name.data());
         if (fd_ >= 0) ::unlink(name.c_str());
     }
+    // Around the page cache where the file system allows it (not tmpfs).
+    if (fd_ >= 0) {
+        const int flags = ::fcntl(fd_, F_GETFL);
+        direct_ = flags >= 0 && ::fcntl(fd_, F_SETFL, flags | O_DIRECT) == 0;
+    }
+}
+
+long ParkedArrays::transfer(bool writing, char* data, std::size_t bytes, std::uint64_t offset) {
+    for (;;) {
+        if (direct_ && !buffer_) {
+            buffer_ = static_cast<char*>(std::aligned_alloc(kBlock, kBuffer));
+            if (!buffer_) direct_ = false;  // (then through the cache)
+        }
+        ssize_t n;
+        const auto moved = [&](char* at, std::size_t count) {
+            return writing ? ::pwrite(fd_, at, count, static_cast<off_t>(offset))
+                           : ::pread(fd_, at, count, static_cast<off_t>(offset));
+        };
+        if (!direct_) {
+            n = moved(data, bytes);
+        } else if (reinterpret_cast<std::uintptr_t>(data) % kBlock == 0 && bytes >= kBlock) {
+            n = moved(data, bytes / kBlock * kBlock);  // whole blocks, from where they are
+        } else {
+            // Through the buffer, in whole blocks: a last partial one padded (its bytes past
+            // the array unread).
+            const std::size_t count = std::min(bytes, kBuffer), whole = round_up(count);
+            if (writing) {
+                std::memcpy(buffer_, data, count);
+                std::memset(buffer_ + count, 0, whole - count);
+            }
+            n = moved(buffer_, whole);
+            if (n > 0) n = static_cast<ssize_t>(std::min(count, std::size_t(n)));
+            if (!writing && n > 0) std::memcpy(data, buffer_, std::size_t(n));
+        }
+        if (n < 0 && errno == EINTR) continue;
+        // A file system that took the flag but refuses the transfer: through the cache from
+        // now on (the blocks already moved read back the same either way).
+        if (n < 0 && errno == EINVAL && direct_) {
+            const int flags = ::fcntl(fd_, F_GETFL);
+            if (flags >= 0 && ::fcntl(fd_, F_SETFL, flags & ~O_DIRECT) == 0) {
+                direct_ = false;
+                continue;
+            }
+        }
+        return static_cast<long>(n);
+    }
 }
 
 bool ParkedArrays::write(const void* owner, const void* data, std::size_t count, std::size_t size,
                          const ProgressFn& progress, double begin, double end) {
     if (!on() || count == 0 || find(owner)) return false;
     const std::size_t total = count * size;
-    const std::uint64_t at = place(total);
-    const auto* bytes = static_cast<const char*>(data);
+    const std::uint64_t at = place(round_up(total));
+    auto* bytes = const_cast<char*>(static_cast<const char*>(data));  // (only read)
     for (std::size_t done = 0; done < total;) {
         const std::size_t n = std::min(kChunk, total - done);
-        const ssize_t w = ::pwrite(fd_, bytes + done, n, static_cast<off_t>(at + done));
-        if (w < 0 && errno == EINTR) continue;
+        const long w = transfer(true, bytes + done, n, at + done);
         if (w <= 0) {      // a full disk, say: nothing more is parked, this array stays
             full_ = true;  // (the file stays open: the arrays parked before are read back)
             if (at >= parked_end()) cut();  // (what was written of it goes)
@@ -70,7 +129,7 @@ bool ParkedArrays::write(const void* owner, const void* data, std::size_t count,
         std::upper_bound(entries_.begin(), entries_.end(), e,
                          [](const Entry& a, const Entry& b) { return a.offset < b.offset; }),
         e);
-    file_peak_ = std::max(file_peak_, at + total);
+    file_peak_ = std::max(file_peak_, at + round_up(total));
     return true;
 }
 
@@ -80,8 +139,7 @@ void ParkedArrays::read(const Entry& e, void* data, const ProgressFn& progress, 
     auto* bytes = static_cast<char*>(data);
     for (std::size_t done = 0; done < total;) {
         const std::size_t n = std::min(kChunk, total - done);
-        const ssize_t r = ::pread(fd_, bytes + done, n, static_cast<off_t>(e.offset + done));
-        if (r < 0 && errno == EINTR) continue;
+        const long r = transfer(false, bytes + done, n, e.offset + done);
         if (r <= 0)
             throw Error("segment", std::string("cannot read back the arrays parked on disk: ") +
                                        (r < 0 ? std::strerror(errno) : "the file is short"));
@@ -99,7 +157,7 @@ const ParkedArrays::Entry* ParkedArrays::find(const void* owner) const {
 void ParkedArrays::forget(const void* owner) {
     const Entry* e = find(owner);
     if (!e) return;
-    const std::uint64_t offset = e->offset, bytes = e->count * e->size;
+    const std::uint64_t offset = e->offset, bytes = e->end() - e->offset;
     std::erase_if(entries_, [&](const Entry& x) { return x.owner == owner; });
     // Its bytes go back to the disk (both best effort: a file system that cannot punch holes
     // keeps them until the file is cut or closed, and the next arrays reuse the gap).
@@ -112,8 +170,7 @@ void ParkedArrays::forget(const void* owner) {
 
 std::uint64_t ParkedArrays::parked_end() const {
     if (entries_.empty()) return 0;
-    const Entry& last = entries_.back();
-    return last.offset + last.count * last.size;
+    return entries_.back().end();
 }
 
 void ParkedArrays::cut() {
@@ -124,7 +181,7 @@ std::uint64_t ParkedArrays::place(std::uint64_t bytes) const {
     std::uint64_t at = 0;
     for (const Entry& e : entries_) {
         if (e.offset >= at + bytes) return at;
-        at = e.offset + e.count * e.size;
+        at = e.end();
     }
     return at;
 }

@@ -12,6 +12,13 @@
 // gap it fits between those still there. A directory that refuses the file, or a
 // write that fails (a full disk), parks nothing more: the arrays stay in memory and the run
 // goes on, the same. A read that fails throws terrain::Error: the data would be lost.
+//
+// The file is read and written around the page cache (O_DIRECT, each array at an offset of
+// whole blocks; an array not aligned in memory, and the last partial block of each, through an
+// aligned buffer of its own) where its file system allows it: pages of
+// the cache are fresh memory, whose first touch costs more on a virtual machine than the disk
+// itself (docs/performance.md, "Arrays parked on disk"), and the kernel's writing them back
+// later takes the cores the run needs. Elsewhere (tmpfs) the file goes through the cache.
 // Not installed.
 
 #include <cstddef>
@@ -20,6 +27,7 @@
 #include <type_traits>
 #include <vector>
 
+#include "../core/pass_progress.hpp"
 #include "terrain/core/progress.hpp"
 
 namespace terrain::pipeline::internal {
@@ -30,6 +38,8 @@ class ParkedArrays {
     // Arrays below `min_bytes` in all are not worth the file: parking them does nothing.
     ParkedArrays(std::string dir, std::size_t min_bytes);
     ~ParkedArrays();
+    // Whether the file bypasses the page cache (O_DIRECT).
+    bool direct() const { return direct_; }
     ParkedArrays(const ParkedArrays&) = delete;
     ParkedArrays& operator=(const ParkedArrays&) = delete;
 
@@ -54,7 +64,10 @@ class ParkedArrays {
     void restore(std::vector<T>& v, const ProgressFn& progress, double begin, double end) {
         const Entry* e = find(&v);
         if (!e) return;
-        std::vector<T> back(e->count);
+        std::vector<T> back;
+        back.reserve(e->count);
+        detail::touch_pages(back.data(), e->count * sizeof(T));
+        back.resize(e->count);
         read(*e, back.data(), progress, begin, end);
         v.swap(back);
         forget(&v);
@@ -71,7 +84,13 @@ class ParkedArrays {
     struct Entry {
         const void* owner;
         std::uint64_t offset, count, size;
+        // Where its bytes end, rounded up to whole blocks (each array starts on a block).
+        std::uint64_t end() const;
     };
+    // Moves up to `bytes` at `offset` of the file from or to `data` (when direct, whole blocks
+    // from `data` if aligned, else through the aligned buffer); returns the bytes moved
+    // (<= 0: failed).
+    long transfer(bool writing, char* data, std::size_t bytes, std::uint64_t offset);
     bool write(const void* owner, const void* data, std::size_t count, std::size_t size,
                const ProgressFn& progress, double begin, double end);
     void read(const Entry& e, void* data, const ProgressFn& progress, double begin, double end);
@@ -87,8 +106,10 @@ class ParkedArrays {
     std::string dir_;
     std::size_t min_bytes_;
     int fd_ = -1;
-    bool full_ = false;     // a write failed: nothing more is parked
-    bool decided_ = false;  // decide() was called
+    bool full_ = false;       // a write failed: nothing more is parked
+    bool decided_ = false;    // decide() was called
+    bool direct_ = false;     // O_DIRECT: moved through buffer_ in whole blocks
+    char* buffer_ = nullptr;  // (aligned, 4 MiB, made on first use)
     std::uint64_t file_peak_ = 0;
     std::vector<Entry> entries_;  // by offset
 };
