@@ -1,11 +1,16 @@
 // preview.png: the map (hillshade, field colours, region boundaries) and its frame (ticks,
 // colour bar, scale bar, north arrow, title and caption), drawn on a map_canvas.hpp Canvas.
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
 #include <numbers>
 #include <string>
 
@@ -38,54 +43,77 @@ std::array<double, 3> field_colour(double value) {
 
 // Hillshade (Horn's gradient, light from the north-west 45 degrees up), 1 on flat ground; the
 // relief is exaggerated when the tile is gentle, so that 90% of slopes stay under 25 degrees
-// at most and the shading is visible. NaN where the DEM has NoData.
-std::vector<float> hillshade(const Dem& dem) {
-    const auto d = describe_dem(dem);
-    const double dx = d.pixel_width_m > 0 ? d.pixel_width_m : std::abs(dem.transform[1]);
-    const double dy = d.pixel_height_m > 0 ? d.pixel_height_m : std::abs(dem.transform[5]);
-    const int W = dem.width, H = dem.height;
-    auto z = [&](int col, int row, double centre) {
-        col = std::clamp(col, 0, W - 1);
-        row = std::clamp(row, 0, H - 1);
-        const double v = dem.at(col, row);
-        return std::isnan(v) ? centre : dem.height_at(col, row);
-    };
-    std::vector<float> gx(dem.size(), 0.f), gy(dem.size(), 0.f);
-    std::vector<float> slopes;
-    slopes.reserve(dem.size());
-    for (int r = 0; r < H; ++r)
-        for (int c = 0; c < W; ++c) {
-            if (!dem.valid(c, r)) continue;
-            const double e = dem.height_at(c, r);
-            // East minus west, and north (row - 1) minus south.
-            const double east = z(c + 1, r - 1, e) + 2 * z(c + 1, r, e) + z(c + 1, r + 1, e);
-            const double west = z(c - 1, r - 1, e) + 2 * z(c - 1, r, e) + z(c - 1, r + 1, e);
-            const double north = z(c - 1, r - 1, e) + 2 * z(c, r - 1, e) + z(c + 1, r - 1, e);
-            const double south = z(c - 1, r + 1, e) + 2 * z(c, r + 1, e) + z(c + 1, r + 1, e);
-            const auto i = dem.index(c, r);
-            gx[i] = static_cast<float>((east - west) / (8 * dx));
-            gy[i] = static_cast<float>((north - south) / (8 * dy));
-            slopes.push_back(std::hypot(gx[i], gy[i]));
+// at most and the shading is visible. NaN where the DEM has NoData. The exaggeration reads
+// every pixel's slope (a parallel pass); the shade is then made where it is asked for, at the
+// pixels the preview shows (a global grid shows one in 36).
+class Hillshade {
+  public:
+    explicit Hillshade(const Dem& dem) : dem_(dem) {
+        const auto d = describe_dem(dem);
+        dx_ = d.pixel_width_m > 0 ? d.pixel_width_m : std::abs(dem.transform[1]);
+        dy_ = d.pixel_height_m > 0 ? d.pixel_height_m : std::abs(dem.transform[5]);
+        // Each pixel's slope (+infinity for NoData, after every valid one in order), and the
+        // 90th percentile of the valid ones.
+        std::vector<float> slopes(dem.size());
+        std::atomic<std::size_t> valid{0};
+        tbb::parallel_for(tbb::blocked_range<int>(0, dem.height, 16),
+                          [&](const tbb::blocked_range<int>& rows) {
+                              std::size_t here = 0;
+                              for (int r = rows.begin(); r < rows.end(); ++r)
+                                  for (int c = 0; c < dem.width; ++c) {
+                                      float& s = slopes[dem.index(c, r)];
+                                      if (!dem.valid(c, r)) {
+                                          s = std::numeric_limits<float>::infinity();
+                                          continue;
+                                      }
+                                      const auto [gx, gy] = gradient(c, r);
+                                      s = std::hypot(gx, gy);
+                                      ++here;
+                                  }
+                              valid += here;
+                          });
+        if (valid > 0) {
+            auto p90 = slopes.begin() + static_cast<std::ptrdiff_t>(valid * 9 / 10);
+            std::nth_element(slopes.begin(), p90, slopes.end());
+            if (*p90 > 0) exaggeration_ = std::clamp(std::tan(25 * kDegree) / *p90, 1.0, 10.0);
         }
-    double exaggeration = 1;
-    if (!slopes.empty()) {
-        auto p90 = slopes.begin() + static_cast<std::ptrdiff_t>(slopes.size() * 9 / 10);
-        std::nth_element(slopes.begin(), p90, slopes.end());
-        if (*p90 > 0) exaggeration = std::clamp(std::tan(25 * kDegree) / *p90, 1.0, 10.0);
     }
-    const double altitude = 45 * kDegree, azimuth = 315 * kDegree;
-    const double light[3] = {std::cos(altitude) * std::sin(azimuth),
-                             std::cos(altitude) * std::cos(azimuth), std::sin(altitude)};
-    std::vector<float> shade(dem.size(), std::nanf(""));
-    for (std::size_t i = 0; i < dem.size(); ++i) {
-        if (std::isnan(dem.values[i])) continue;
-        const double nx = -gx[i] * exaggeration, ny = -gy[i] * exaggeration;
+
+    // The shade of pixel (c, r).
+    float at(int c, int r) const {
+        if (std::isnan(dem_.values[dem_.index(c, r)])) return std::nanf("");
+        const double altitude = 45 * kDegree, azimuth = 315 * kDegree;
+        const double light[3] = {std::cos(altitude) * std::sin(azimuth),
+                                 std::cos(altitude) * std::cos(azimuth), std::sin(altitude)};
+        const auto [gx, gy] = gradient(c, r);
+        const double nx = -gx * exaggeration_, ny = -gy * exaggeration_;
         const double dot =
             (nx * light[0] + ny * light[1] + light[2]) / std::sqrt(nx * nx + ny * ny + 1);
-        shade[i] = static_cast<float>(std::max(0.0, dot) / light[2]);
+        return static_cast<float>(std::max(0.0, dot) / light[2]);
     }
-    return shade;
-}
+
+  private:
+    // Horn's gradient at a valid pixel: east minus west, and north (row - 1) minus south.
+    std::array<float, 2> gradient(int c, int r) const {
+        const int W = dem_.width, H = dem_.height;
+        const double e = dem_.height_at(c, r);
+        auto z = [&](int col, int row) {
+            col = std::clamp(col, 0, W - 1);
+            row = std::clamp(row, 0, H - 1);
+            const double v = dem_.at(col, row);
+            return std::isnan(v) ? e : dem_.height_at(col, row);
+        };
+        const double east = z(c + 1, r - 1) + 2 * z(c + 1, r) + z(c + 1, r + 1);
+        const double west = z(c - 1, r - 1) + 2 * z(c - 1, r) + z(c - 1, r + 1);
+        const double north = z(c - 1, r - 1) + 2 * z(c, r - 1) + z(c + 1, r - 1);
+        const double south = z(c - 1, r + 1) + 2 * z(c, r + 1) + z(c + 1, r + 1);
+        return {static_cast<float>((east - west) / (8 * dx_)),
+                static_cast<float>((north - south) / (8 * dy_))};
+    }
+
+    const Dem& dem_;
+    double dx_ = 1, dy_ = 1, exaggeration_ = 1;
+};
 
 // "12.5", "0.25", "120": `value` with the decimals that `step` needs.
 std::string degrees_text(double value, double step) {
@@ -302,37 +330,44 @@ PreviewImage render_preview(const Dem& dem, const std::vector<float>& field_pixe
     for (int x = 0; x < OW; ++x) src_col[std::size_t(x)] = std::min(W - 1, x * reduce / enlarge);
     for (int y = 0; y < OH; ++y) src_row[std::size_t(y)] = std::min(H - 1, y * reduce / enlarge);
 
-    const auto shade = hillshade(dem);
-    // Colour per source pixel once; the output picks.
-    std::vector<std::array<std::uint8_t, 4>> colour(dem.size(), {0, 0, 0, 0});
-    for (std::size_t i = 0; i < dem.size(); ++i) {
-        if (pixels[i] == 0 || std::isnan(shade[i]) || std::isnan(field_pixels[i])) continue;
-        const auto c = field_colour(field_pixels[i]);
-        const double light = 0.3 + 0.7 * std::min(1.3, static_cast<double>(shade[i]));
+    const Hillshade shade(dem);
+    // A source pixel's colour (transparent for NoData or no region).
+    const auto colour = [&](int c, int r) -> std::array<std::uint8_t, 4> {
+        const auto i = dem.index(c, r);
+        if (pixels[i] == 0 || std::isnan(field_pixels[i])) return {0, 0, 0, 0};
+        const float s = shade.at(c, r);
+        if (std::isnan(s)) return {0, 0, 0, 0};
+        const auto f = field_colour(field_pixels[i]);
+        const double light = 0.3 + 0.7 * std::min(1.3, static_cast<double>(s));
+        std::array<std::uint8_t, 4> rgba{0, 0, 0, 255};
         for (int k = 0; k < 3; ++k)
-            colour[i][std::size_t(k)] = static_cast<std::uint8_t>(
-                std::lround(std::clamp(c[std::size_t(k)] * light, 0.0, 255.0)));
-        colour[i][3] = 255;
-    }
+            rgba[std::size_t(k)] = static_cast<std::uint8_t>(
+                std::lround(std::clamp(f[std::size_t(k)] * light, 0.0, 255.0)));
+        return rgba;
+    };
     std::vector<std::uint8_t> image(static_cast<std::size_t>(OW) * OH * 4);
     auto label_at = [&](int x, int y) {
         return pixels[dem.index(src_col[std::size_t(x)], src_row[std::size_t(y)])];
     };
-    for (int y = 0; y < OH; ++y)
-        for (int x = 0; x < OW; ++x) {
-            const auto i = dem.index(src_col[std::size_t(x)], src_row[std::size_t(y)]);
-            auto rgba = colour[i];
-            // Region boundaries: a labelled pixel whose right or lower neighbour (in the
-            // output) is in another region; 1 output pixel wide.
-            const auto l = pixels[i];
-            if (l != 0 && rgba[3] != 0) {
-                const auto right = x + 1 < OW ? label_at(x + 1, y) : l;
-                const auto below = y + 1 < OH ? label_at(x, y + 1) : l;
-                if ((right != 0 && right != l) || (below != 0 && below != l)) rgba = {0, 0, 0, 255};
+    tbb::parallel_for(tbb::blocked_range<int>(0, OH, 8), [&](const tbb::blocked_range<int>& rows) {
+        for (int y = rows.begin(); y < rows.end(); ++y)
+            for (int x = 0; x < OW; ++x) {
+                const int c = src_col[std::size_t(x)], r = src_row[std::size_t(y)];
+                auto rgba = colour(c, r);
+                // Region boundaries: a labelled pixel whose right or lower neighbour (in the
+                // output) is in another region; 1 output pixel wide.
+                const auto l = pixels[dem.index(c, r)];
+                if (l != 0 && rgba[3] != 0) {
+                    const auto right = x + 1 < OW ? label_at(x + 1, y) : l;
+                    const auto below = y + 1 < OH ? label_at(x, y + 1) : l;
+                    if ((right != 0 && right != l) || (below != 0 && below != l))
+                        rgba = {0, 0, 0, 255};
+                }
+                std::copy(
+                    rgba.begin(), rgba.end(),
+                    image.begin() + static_cast<std::ptrdiff_t>((std::size_t(y) * OW + x) * 4));
             }
-            std::copy(rgba.begin(), rgba.end(),
-                      image.begin() + static_cast<std::ptrdiff_t>((std::size_t(y) * OW + x) * 4));
-        }
+    });
 
     return {OW, OH, std::move(image),
             map_frame(dem, OW, OH, double(reduce) / enlarge, caption, enlarge, reduce)};
