@@ -82,14 +82,11 @@ class Hillshade {
     // The shade of pixel (c, r).
     float at(int c, int r) const {
         if (std::isnan(dem_.values[dem_.index(c, r)])) return std::nanf("");
-        const double altitude = 45 * kDegree, azimuth = 315 * kDegree;
-        const double light[3] = {std::cos(altitude) * std::sin(azimuth),
-                                 std::cos(altitude) * std::cos(azimuth), std::sin(altitude)};
         const auto [gx, gy] = gradient(c, r);
         const double nx = -gx * exaggeration_, ny = -gy * exaggeration_;
         const double dot =
-            (nx * light[0] + ny * light[1] + light[2]) / std::sqrt(nx * nx + ny * ny + 1);
-        return static_cast<float>(std::max(0.0, dot) / light[2]);
+            (nx * light_[0] + ny * light_[1] + light_[2]) / std::sqrt(nx * nx + ny * ny + 1);
+        return static_cast<float>(std::max(0.0, dot) / light_[2]);
     }
 
   private:
@@ -111,8 +108,12 @@ class Hillshade {
                 static_cast<float>((north - south) / (8 * dy_))};
     }
 
+    static constexpr double kAltitude = 45 * kDegree, kAzimuth = 315 * kDegree;
     const Dem& dem_;
     double dx_ = 1, dy_ = 1, exaggeration_ = 1;
+    // The direction of the light (east, north, up).
+    const double light_[3] = {std::cos(kAltitude) * std::sin(kAzimuth),
+                              std::cos(kAltitude) * std::cos(kAzimuth), std::sin(kAltitude)};
 };
 
 // "12.5", "0.25", "120": `value` with the decimals that `step` needs.

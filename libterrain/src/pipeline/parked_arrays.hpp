@@ -65,9 +65,8 @@ class ParkedArrays {
         const Entry* e = find(&v);
         if (!e) return;
         std::vector<T> back;
-        back.reserve(e->count);
-        detail::touch_pages(back.data(), e->count * sizeof(T));
-        back.resize(e->count);
+        detail::assign_in_slices(back, e->count, T{},
+                                 detail::PassProgress(progress, begin, begin, "park"));
         read(*e, back.data(), progress, begin, end);
         v.swap(back);
         forget(&v);
@@ -108,7 +107,7 @@ class ParkedArrays {
     int fd_ = -1;
     bool full_ = false;       // a write failed: nothing more is parked
     bool decided_ = false;    // decide() was called
-    bool direct_ = false;     // O_DIRECT: moved through buffer_ in whole blocks
+    bool direct_ = false;     // O_DIRECT: moved in whole blocks (buffer_ when unaligned)
     char* buffer_ = nullptr;  // (aligned, 4 MiB, made on first use)
     std::uint64_t file_peak_ = 0;
     std::vector<Entry> entries_;  // by offset
