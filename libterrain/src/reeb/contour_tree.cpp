@@ -20,6 +20,7 @@
 
 #include "../core/disjoint_sets.hpp"
 #include "../core/indices.hpp"
+#include "../core/key_parts.hpp"
 #include "../core/pass_progress.hpp"
 #include "../core/release.hpp"
 #include "../mesh/grid_triangles.hpp"
@@ -353,35 +354,32 @@ bool contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& prog
     detail::assign_in_slices(up_off, nn + 1, 0, arcs_made(0.75));
     detail::assign_in_slices(up_to, nn, 0, arcs_made(0.75));
     detail::assign_in_slices(down_deg, nn, 0, arcs_made(0.75));
-    // Its passes over the nodes: 0.75 to 0.9, by sixths.
-    const auto pass = [&](int k) {
-        return detail::PassProgress(progress, 0.75 + 0.025 * k, 0.775 + 0.025 * k, "reeb: arcs");
+    // Its passes over the nodes: 0.75 to 0.9.
+    const auto span = [&](double from, double to) {
+        return detail::PassProgress(progress, from, to, "reeb: arcs");
     };
-    const auto p1 = pass(1), p3 = pass(3), p4 = pass(4), p5 = pass(5);
     constexpr std::size_t kGrain = std::size_t{1} << 14;  // the passes in parallel
     auto edge = [&](std::size_t x) {
         const i32 y = attach[x] >> 1, self = static_cast<i32>(x);
         return (attach[x] & 1) ? std::pair{self, y} : std::pair{y, self};
     };
-    // (The counts in parallel: increments, the same in any order.)
-    detail::parallel_slices(
-        nn, kGrain, progress, 0.75, 0.775, "reeb: arcs",
-        [&](const tbb::blocked_range<std::size_t>& r) {
-            for (std::size_t x = r.begin(); x < r.end(); ++x)
-                if (attach[x] != kNone) {
-                    const auto [lo, hi] = edge(x);
-                    std::atomic_ref(up_off[idx(lo) + 1]).fetch_add(1, std::memory_order_relaxed);
-                    std::atomic_ref(down_deg[idx(hi)]).fetch_add(1, std::memory_order_relaxed);
-                }
-        });
+    // The passes that write to random places go by parts of the places (key_parts.hpp): in
+    // parallel, each place written in the serial order. Critical nodes are the arcs' ends.
+    const auto lower_end = [&](std::size_t x) -> std::int64_t {
+        return attach[x] == kNone ? -1 : edge(x).first;
+    };
+    detail::scatter_by_key_parts(nn, nn, span(0.75, 0.76), lower_end,
+                                 [&](std::size_t, std::size_t lo) { ++up_off[lo + 1]; });
+    detail::scatter_by_key_parts(
+        nn, nn, span(0.76, 0.775),
+        [&](std::size_t x) -> std::int64_t { return attach[x] == kNone ? -1 : edge(x).second; },
+        [&](std::size_t, std::size_t hi) { ++down_deg[hi]; });
     std::partial_sum(up_off.begin(), up_off.end(), up_off.begin());
     {
         std::vector<i32> fill(up_off.begin(), up_off.end() - 1);
-        for (std::size_t x = 0; x < nn; ++x)
-            if (p1.at(x, nn); attach[x] != kNone) {
-                const auto [lo, hi] = edge(x);
-                up_to[idx(fill[idx(lo)]++)] = hi;
-            }
+        detail::scatter_by_key_parts(
+            nn, nn, span(0.775, 0.8), lower_end,
+            [&](std::size_t x, std::size_t lo) { up_to[idx(fill[lo]++)] = edge(x).second; });
     }
     g.node_kinds.assign(nn, NodeKind::regular);
     // (Each node its own entries: in parallel.)
@@ -402,55 +400,90 @@ bool contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& prog
             }
         });
     detail::release(down_deg);  // (the kinds are known: read no more)
-    // Arcs in the order of their lower nodes, then of their up-edges. A regular node takes the
-    // arc of the edge below it; `below` holds that edge as the regular node under it, or as
-    // -2 - arc when the edge leaves a critical node. One pass in increasing order then fills in
-    // every regular node (its lower neighbour comes first), so no chain is followed.
+    // Arcs in the order of their lower nodes, then of their up-edges: a critical node's first
+    // arc is the number of up-edges of the critical nodes before it (held in node_arcs until
+    // the regular nodes take their arcs there). A regular node takes the arc of the edge
+    // below it; `below` holds that edge as the regular node under it, or as -2 - arc when the
+    // edge leaves a critical node.
     auto critical = [&](i32 n) { return g.node_kinds[idx(n)] != NodeKind::regular; };
     std::vector<i32>& below = attach;  // attach is no longer needed
-    g.arcs.clear();
-    {  // (one arc for each edge up from a critical node: reserved, not grown by doubling)
-        std::size_t arcs = 0;
-        for (std::size_t n = 0; n < nn; ++n)
-            if (critical(static_cast<i32>(n))) arcs += idx(up_off[n + 1] - up_off[n]);
-        g.arcs.reserve(arcs);
-    }
-    for (std::size_t lo = 0; lo < nn; ++lo) {
-        p3.at(lo, nn);
-        for (i32 k = up_off[lo]; k < up_off[lo + 1]; ++k) {
-            const i32 hi = up_to[idx(k)];
-            if (critical(static_cast<i32>(lo))) {
-                const i32 arc = static_cast<i32>(g.arcs.size());
-                g.arcs.push_back({static_cast<i32>(lo), critical(hi) ? hi : kNone});
-                if (!critical(hi)) below[idx(hi)] = -2 - arc;
-            } else if (!critical(hi)) {
-                below[idx(hi)] = static_cast<i32>(lo);
-            }
-        }
-    }
-    g.node_arcs.assign(nn, kNone);
-    g.arc_offsets.assign(g.arcs.size() + 1, 0);
+    detail::assign_in_slices(g.node_arcs, nn, kNone, arcs_made(0.825));
+    std::size_t arc_count = 0;
+    const auto counted = span(0.825, 0.835);
     for (std::size_t n = 0; n < nn; ++n) {
-        p4.at(n, nn);
-        if (critical(static_cast<i32>(n))) continue;
-        const i32 b = below[n];
-        const i32 arc = b >= 0 ? g.node_arcs[idx(b)] : -2 - b;
-        g.node_arcs[n] = arc;
-        ++g.arc_offsets[idx(arc) + 1];
-        const i32 hi = up_to[idx(up_off[n])];
-        if (critical(hi)) g.arcs[idx(arc)][1] = hi;
+        counted.at(n, nn);
+        if (!critical(static_cast<i32>(n))) continue;
+        g.node_arcs[n] = static_cast<i32>(arc_count);
+        arc_count += idx(up_off[n + 1] - up_off[n]);
     }
+    if (arc_count > std::size_t{INT32_MAX})
+        throw Error("reeb", "the graph has more arcs than 32-bit ids can name");
+    detail::assign_in_slices(g.arcs, arc_count, std::array<i32, 2>{kNone, kNone}, arcs_made(0.835));
+    // (Each critical node writes its own arcs, each regular node's `below` is written from
+    // its one edge below: in parallel.)
+    detail::parallel_slices(
+        nn, kGrain, progress, 0.835, 0.85, "reeb: arcs",
+        [&](const tbb::blocked_range<std::size_t>& r) {
+            for (std::size_t lo = r.begin(); lo < r.end(); ++lo) {
+                const bool from_critical = critical(static_cast<i32>(lo));
+                for (i32 k = up_off[lo]; k < up_off[lo + 1]; ++k) {
+                    const i32 hi = up_to[idx(k)];
+                    if (from_critical) {
+                        const i32 arc = g.node_arcs[lo] + (k - up_off[lo]);
+                        g.arcs[idx(arc)] = {static_cast<i32>(lo), critical(hi) ? hi : kNone};
+                        if (!critical(hi)) below[idx(hi)] = -2 - arc;
+                    } else if (!critical(hi)) {
+                        below[idx(hi)] = static_cast<i32>(lo);
+                    }
+                }
+            }
+        });
+    // A regular node whose edge below leaves a critical node knows its arc (in parallel);
+    // the others take their lower neighbour's, which comes first in one pass in increasing
+    // order: no chain is followed.
+    constexpr i32 kLater = -2;
+    detail::parallel_slices(nn, kGrain, progress, 0.85, 0.86, "reeb: arcs",
+                            [&](const tbb::blocked_range<std::size_t>& r) {
+                                for (std::size_t n = r.begin(); n < r.end(); ++n) {
+                                    if (critical(static_cast<i32>(n))) {
+                                        g.node_arcs[n] = kNone;
+                                        continue;
+                                    }
+                                    const i32 b = below[n];
+                                    g.node_arcs[n] = b >= 0 ? kLater : -2 - b;
+                                }
+                            });
+    const auto taken = span(0.86, 0.87);
+    for (std::size_t n = 0; n < nn; ++n) {
+        taken.at(n, nn);
+        if (g.node_arcs[n] == kLater) g.node_arcs[n] = g.node_arcs[idx(below[n])];
+    }
+    // Each arc's upper end, from its highest regular node (one an arc: in parallel).
+    detail::parallel_slices(nn, kGrain, progress, 0.87, 0.875, "reeb: arcs",
+                            [&](const tbb::blocked_range<std::size_t>& r) {
+                                for (std::size_t n = r.begin(); n < r.end(); ++n) {
+                                    const i32 arc = g.node_arcs[n];
+                                    if (arc == kNone) continue;
+                                    const i32 hi = up_to[idx(up_off[n])];
+                                    if (critical(hi)) g.arcs[idx(arc)][1] = hi;
+                                }
+                            });
     // (The tree's edges are arcs now: 12 bytes a node less beside the arcs' lists.)
     detail::release(attach);
     detail::release(up_off);
     detail::release(up_to);
+    const auto arc_of = [&](std::size_t n) -> std::int64_t { return g.node_arcs[n]; };
+    g.arc_offsets.assign(arc_count + 1, 0);
+    detail::scatter_by_key_parts(nn, arc_count, span(0.875, 0.885), arc_of,
+                                 [&](std::size_t, std::size_t arc) { ++g.arc_offsets[arc + 1]; });
     std::partial_sum(g.arc_offsets.begin(), g.arc_offsets.end(), g.arc_offsets.begin());
     g.arc_nodes.resize(idx(g.arc_offsets.back()));
     {
         std::vector<i32> fill(g.arc_offsets.begin(), g.arc_offsets.end() - 1);
-        for (std::size_t n = 0; n < nn; ++n)
-            if (p5.at(n, nn); !critical(static_cast<i32>(n)))
-                g.arc_nodes[idx(fill[idx(g.node_arcs[n])]++)] = static_cast<i32>(n);
+        detail::scatter_by_key_parts(nn, arc_count, span(0.885, 0.9), arc_of,
+                                     [&](std::size_t n, std::size_t arc) {
+                                         g.arc_nodes[idx(fill[arc]++)] = static_cast<i32>(n);
+                                     });
     }
     report_progress(progress, 0.9, "reeb: arcs");
     count_general_links(mesh, g, general, scaled_progress(progress, 0.9, 1));

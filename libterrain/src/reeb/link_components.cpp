@@ -127,7 +127,12 @@ std::vector<LinkReps> link_components(const TriangleMesh& mesh, const ReebGraph&
     // several vertices (a plateau) is written from its first vertex only.
     constexpr std::size_t kAhead = 16;  // the nodes' entries are written in random order
     const auto vertex = [&](std::size_t v, std::size_t end) {
-        if (v + kAhead < end) __builtin_prefetch(&reps[idx(node[v + kAhead])], 1);
+        if (v + kAhead < end) {
+            const std::size_t ahead = idx(node[v + kAhead]);
+            __builtin_prefetch(&reps[ahead], 1);
+            __builtin_prefetch(&lower_links[ahead], 1);
+            __builtin_prefetch(&upper_links[ahead], 1);
+        }
         const i32 n = node[v];
         const auto neighbours = mesh.neighbors_of(v);
         const auto degree = static_cast<i32>(neighbours.size());

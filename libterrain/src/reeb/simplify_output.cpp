@@ -12,6 +12,7 @@
 #include <numeric>
 
 #include "../core/disjoint_sets.hpp"
+#include "../core/key_parts.hpp"
 #include "../core/pass_progress.hpp"
 #include "../core/release.hpp"
 #include "terrain/core/error.hpp"
@@ -191,18 +192,17 @@ void WorkingGraph::write_result(SimplifyResult& result, bool rewrite_field,
         auto& offsets = owned_->node_vertex_offsets;
         auto& listed_vertices = owned_->node_vertices;
         const auto& of = owned_->vertex_nodes;
+        // (By parts of the nodes: in parallel, each list in vertex order, key_parts.hpp.)
+        const auto node_of = [&](std::size_t v) -> std::int64_t { return of[v]; };
         detail::assign_in_slices(offsets, nn + 1, i32{0}, made(0.4));
-        for (std::size_t v = 0; v < nv; ++v) {
-            counted.at(v, nv);
-            ++offsets[idx(of[v]) + 1];
-        }
+        detail::scatter_by_key_parts(nv, nn, counted, node_of,
+                                     [&](std::size_t, std::size_t n) { ++offsets[n + 1]; });
         std::partial_sum(offsets.begin(), offsets.end(), offsets.begin());
         detail::assign_in_slices(listed_vertices, nv, i32{0}, made(0.45));
         std::vector<i32> fill(offsets.begin(), offsets.end() - 1);
-        for (std::size_t v = 0; v < nv; ++v) {
-            listed.at(v, nv);
-            listed_vertices[idx(fill[idx(of[v])]++)] = static_cast<i32>(v);
-        }
+        detail::scatter_by_key_parts(nv, nn, listed, node_of, [&](std::size_t v, std::size_t n) {
+            listed_vertices[idx(fill[n]++)] = static_cast<i32>(v);
+        });
         detail::release(fill);
         detail::release(owned_->vertex_nodes);
     }

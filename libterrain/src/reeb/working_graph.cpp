@@ -5,6 +5,7 @@
 #include "working_graph.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <limits>
 #include <string>
 
@@ -176,8 +177,7 @@ WorkingGraph::WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big
     // Its passes: the lists (0 to 0.1), the nodes (to 0.6), the arcs (to 1), each with its
     // large blocks made a slice at a time (their first touch is slow, docs/performance.md).
     using detail::PassProgress;
-    const PassProgress lists(progress, 0.03, 0.1, "simplify"),
-        nodes(progress, 0.25, 0.6, "simplify"), arcs(progress, 0.7, 1, "simplify");
+    const PassProgress nodes(progress, 0.25, 0.6, "simplify"), arcs(progress, 0.7, 1, "simplify");
     const std::size_t nn = g.node_count(), na = g.arc_count(), nl = g.arc_nodes.size();
     owned_ = owned;
     if (owned) detail::release(owned->node_arcs);  // not read here
@@ -185,17 +185,56 @@ WorkingGraph::WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big
     // arc_nodes; then the new numbers.
     constexpr i32 kEnd = -2;
     detail::assign_in_slices(node_map_, nn, kNone, PassProgress(progress, 0, 0.03, "simplify"));
-    for (const auto& e : g.arcs) node_map_[idx(e[0])] = node_map_[idx(e[1])] = kEnd;
-    for (std::size_t p = 0; p < nl; ++p) {
-        lists.at(p, nl);
+    // (Both passes in parallel: every arc end takes the same mark, every listed node its own
+    // position, stored without a lock. A node listed twice or also an arc end is found by a
+    // second look, and the serial pass then names the first such node, as it always did.)
+    constexpr std::size_t kGrain = std::size_t{1} << 14;
+    const auto store = [](i32& to, i32 value) {
+        std::atomic_ref<i32>(to).store(value, std::memory_order_relaxed);
+    };
+    const auto load = [](i32& from) {
+        return std::atomic_ref<i32>(from).load(std::memory_order_relaxed);
+    };
+    detail::parallel_slices(na, kGrain, progress, 0.03, 0.03, "simplify",
+                            [&](const tbb::blocked_range<std::size_t>& r) {
+                                for (std::size_t a = r.begin(); a < r.end(); ++a)
+                                    for (const i32 e : g.arcs[a]) store(node_map_[idx(e)], kEnd);
+                            });
+    // (A critical node in a list keeps its neighbours in its record, which an arc end needs
+    // for its arcs.)
+    const auto listed_regular = [&](std::size_t p) {
         const i32 r = g.arc_nodes[p];
-        // (A critical node in a list keeps its neighbours in its record, which an arc end
-        // needs for its arcs.)
-        if (node_map_[idx(r)] != kNone)
-            throw Error("simplify", "the graph is not valid: node " + std::to_string(r) +
-                                        " is an arc end or in two arcs' lists");
-        if (g.node_kinds[idx(r)] != NodeKind::regular) continue;
-        node_map_[idx(r)] = static_cast<i32>(p);
+        return g.node_kinds[idx(r)] == NodeKind::regular && load(node_map_[idx(r)]) != kEnd;
+    };
+    std::atomic<bool> invalid{false};
+    detail::parallel_slices(nl, kGrain, progress, 0.03, 0.07, "simplify",
+                            [&](const tbb::blocked_range<std::size_t>& r) {
+                                for (std::size_t p = r.begin(); p < r.end(); ++p) {
+                                    if (!listed_regular(p)) {
+                                        if (load(node_map_[idx(g.arc_nodes[p])]) == kEnd)
+                                            invalid = true;
+                                        continue;
+                                    }
+                                    store(node_map_[idx(g.arc_nodes[p])], static_cast<i32>(p));
+                                }
+                            });
+    detail::parallel_slices(
+        nl, kGrain, progress, 0.07, 0.1, "simplify", [&](const tbb::blocked_range<std::size_t>& r) {
+            for (std::size_t p = r.begin(); p < r.end(); ++p)
+                if (listed_regular(p) && node_map_[idx(g.arc_nodes[p])] != static_cast<i32>(p))
+                    invalid = true;
+        });
+    if (invalid) {  // the serial pass, for its message
+        for (std::size_t p = 0; p < nl; ++p)
+            if (listed_regular(p)) node_map_[idx(g.arc_nodes[p])] = kNone;
+        for (std::size_t p = 0; p < nl; ++p) {
+            const i32 r = g.arc_nodes[p];
+            if (node_map_[idx(r)] != kNone)
+                throw Error("simplify", "the graph is not valid: node " + std::to_string(r) +
+                                            " is an arc end or in two arcs' lists");
+            if (g.node_kinds[idx(r)] != NodeKind::regular) continue;
+            node_map_[idx(r)] = static_cast<i32>(p);
+        }
     }
     // The critical nodes (arc ends, and critical nodes in lists) as a bit each: a critical
     // node's new number is its rank among them, which the arcs' pass reads instead of
