@@ -130,6 +130,7 @@ bool ParkedArrays::write(const void* owner, const void* data, std::size_t count,
                          [](const Entry& a, const Entry& b) { return a.offset < b.offset; }),
         e);
     file_peak_ = std::max(file_peak_, at + round_up(total));
+    most_parked_ = std::max(most_parked_, parked_bytes());
     return true;
 }
 

@@ -73,6 +73,8 @@ class ParkedArrays {
     }
     // Bytes parked now.
     std::size_t parked_bytes() const;
+    // The most bytes parked at once so far.
+    std::size_t most_parked() const { return most_parked_; }
     // The file's largest length so far: the most disk the parked arrays took at once (gaps
     // between them included).
     std::size_t file_peak() const { return file_peak_; }
@@ -110,6 +112,7 @@ class ParkedArrays {
     bool direct_ = false;     // O_DIRECT: moved in whole blocks (buffer_ when unaligned)
     char* buffer_ = nullptr;  // (aligned, 4 MiB, made on first use)
     std::uint64_t file_peak_ = 0;
+    std::size_t most_parked_ = 0;
     std::vector<Entry> entries_;  // by offset
 };
 

@@ -414,11 +414,22 @@ SegmentResult segment(Input input, const SegmentOptions& options, const Progress
     result.add_time("reeb", since(tp));  // (which it precedes: the times stay in run order)
     // The field waits on disk too once the Reeb graph's events are ordered (the contour tree
     // does not read it): the Reeb graph's peak of memory is in the contour tree.
-    // The graph's vertex lists and vertices' nodes wait too through the contour tree's join
-    // and split sweeps (its peak), which do not read them.
+    // The graph's vertex lists, vertices' nodes and node values wait too through the contour
+    // tree's join and split sweeps (its peak, the two side by side), which do not read them,
+    // and so do the mesh's pixel maps.
     reeb::ArrayParking sweeps;
     sweeps.park = [&](std::vector<std::int32_t>& v) { parked.park(v, {}, 0, 0); };
     sweeps.restore = [&](std::vector<std::int32_t>& v) { parked.restore(v, {}, 0, 0); };
+    sweeps.park_floats = [&](std::vector<float>& v) { parked.park(v, {}, 0, 0); };
+    sweeps.restore_floats = [&](std::vector<float>& v) { parked.restore(v, {}, 0, 0); };
+    sweeps.park_own = [&] {
+        parked.park(mesh.pixel_vertex, {}, 0, 0);
+        parked.park(mesh.vertex_pixel, {}, 0, 0);
+    };
+    sweeps.restore_own = [&] {
+        parked.restore(mesh.vertex_pixel, {}, 0, 0);
+        parked.restore(mesh.pixel_vertex, {}, 0, 0);
+    };
     auto graph = compute_reeb(
         result, scaled_progress(progress, 0.21, 0.4), tree,
         [&] { parked.park(result.field, {}, 0, 0); }, sweeps);
@@ -492,6 +503,7 @@ SegmentResult segment(Input input, const SegmentOptions& options, const Progress
     result.segmentation.region_count = static_cast<std::uint32_t>(result.regions.regions.size());
     result.add_time("grow", placing + scale.grow_seconds + since(t1));
     result.parked_file = parked.file_peak();
+    result.parked_most = parked.most_parked();
     return result;
 }
 
@@ -641,6 +653,7 @@ void write_run_json(const SegmentResult& result, const std::string& input_path,
         .field("parked_bytes", result.parked_bytes)
         .field("parked_bytes_field", result.parked_field)
         .field("parked_bytes_growing", result.parked_growing)
+        .field("parked_bytes_most", result.parked_most)
         .field("parked_file_bytes", result.parked_file)
         .end_object();
     j.key("timings_seconds").begin_object();

@@ -114,6 +114,11 @@ enum class ReebAlgorithm {
 // they are read again. Used only when both are given.
 struct ArrayParking {
     std::function<void(std::vector<std::int32_t>&)> park, restore;
+    // The same for arrays of floats (the graph's node values), when both are given.
+    std::function<void(std::vector<float>&)> park_floats, restore_floats;
+    // The caller's own arrays that the stage does not read either (the mesh's pixel maps),
+    // when both are given: taken away with the stage's arrays and put back with them.
+    std::function<void()> park_own, restore_own;
     bool on() const { return park && restore; }
 };
 
@@ -126,9 +131,11 @@ struct ReebOptions {
     // said to be a tree that has handles or holes is then an error.
     bool known_tree = false;
     std::function<void()> field_read;
-    // The contour tree's join and split sweeps read neither the graph's vertex lists and
-    // offsets nor its vertices' nodes (12 bytes a vertex, at the Reeb graph's peak of memory):
-    // they are handed to `sweeps.park` before the sweeps and to `sweeps.restore` after.
+    // The contour tree's join and split sweeps (side by side, the Reeb graph's peak of
+    // memory) read neither the graph's vertex lists and offsets, its vertices' nodes nor its
+    // node values (16 bytes a vertex): they are handed to `sweeps.park` (the values to
+    // `sweeps.park_floats`, and `sweeps.park_own` is called) before the sweeps, and back to
+    // the restoring functions after.
     ArrayParking sweeps;
 };
 
