@@ -1,3 +1,6 @@
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <catch2/catch.hpp>
 
 #include <algorithm>
@@ -78,4 +81,36 @@ TEST_CASE("find_root follows kNone-rooted parent links and compresses them", "[c
     CHECK(parent == std::vector<i32>{kNone, 0, 0, 0, kNone});
     CHECK(find_root(parent, 4) == 4);
     CHECK(find_root(parent, 0) == 0);
+}
+
+TEST_CASE("find_root_shared finds every node's root from many threads at once", "[core]") {
+    // A forest of long chains (each node links to an earlier node of its tree, or is a root),
+    // searched from every node at once on several threads: the roots a serial walk finds,
+    // and afterwards every link still names a node of its own tree.
+    std::mt19937 random(7);
+    const std::size_t n = std::size_t{1} << 20;
+    std::vector<i32> parent(n, kNone), tree(n);
+    for (std::size_t x = 0; x < n; ++x) {
+        if (x % 1000 == 0) {  // a root
+            tree[x] = static_cast<i32>(x);
+            continue;
+        }
+        // mostly the node just before (long paths), sometimes any earlier node of the tree
+        const std::size_t up = random() % 4 == 0 ? x - 1 - random() % (x % 1000) : x - 1;
+        parent[x] = static_cast<i32>(up);
+        tree[x] = tree[up];
+    }
+    std::vector<i32> found(n, kNone);
+    tbb::parallel_for(
+        tbb::blocked_range<std::size_t>(0, n, 256), [&](const tbb::blocked_range<std::size_t>& r) {
+            for (std::size_t i = r.begin(); i < r.end(); ++i) {
+                const std::size_t x = (i * 7919) % n;  // out of order
+                found[x] = terrain::detail::find_root_shared(parent, static_cast<i32>(x));
+            }
+        });
+    CHECK(found == tree);
+    std::size_t outside = 0;
+    for (std::size_t x = 0; x < n; ++x)
+        outside += parent[x] != kNone && tree[static_cast<std::size_t>(parent[x])] != tree[x];
+    CHECK(outside == 0);
 }

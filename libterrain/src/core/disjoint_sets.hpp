@@ -9,6 +9,7 @@
 // Finds compress the path they walk; that never changes a root, only shortens later finds.
 
 #include <algorithm>
+#include <atomic>
 #include <cstddef>
 #include <numeric>
 #include <vector>
@@ -78,6 +79,22 @@ inline i32 find_root(std::vector<i32>& parent, i32 x) {
     while (x != root) {
         const i32 up = parent[idx(x)];
         parent[idx(x)] = root;
+        x = up;
+    }
+    return root;
+}
+
+// find_root for threads that search the same forest at once while no link is added: every
+// link is read and written whole (relaxed atomics: plain loads and stores), and a link is only
+// ever set to a root of its own tree, so each thread finds the same root whatever the others
+// have compressed.
+inline i32 find_root_shared(std::vector<i32>& parent, i32 x) {
+    const auto link = [&](i32 n) { return std::atomic_ref<i32>(parent[idx(n)]); };
+    i32 root = x;
+    for (i32 up; (up = link(root).load(std::memory_order_relaxed)) != kNone;) root = up;
+    while (x != root) {
+        const i32 up = link(x).load(std::memory_order_relaxed);
+        link(x).store(root, std::memory_order_relaxed);
         x = up;
     }
     return root;

@@ -5,10 +5,13 @@
 // value, and the arcs that remain are listed with their regular nodes from the lower end up.
 
 #include <tbb/blocked_range.h>
+#include <tbb/combinable.h>
+#include <tbb/parallel_for.h>
 #include <tbb/task_group.h>
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <numeric>
 
 #include "../core/disjoint_sets.hpp"
@@ -28,13 +31,15 @@ void WorkingGraph::write_result(SimplifyResult& result, bool rewrite_field,
     // Its passes: the fates (0 to 0.2), the arcs (to 0.3), the new numbers (to 0.4), the
     // input's vertex lists made again (to 0.5), the vertices and their values (to 1).
     using detail::PassProgress;
-    const PassProgress fates(progress, 0, 0.2, "simplify"), arcs(progress, 0.2, 0.3, "simplify"),
+    const PassProgress arcs(progress, 0.2, 0.3, "simplify"),
         numbers(progress, 0.3, 0.4, "simplify");
     // code[i]: for an absorbed node, the critical node that finally took it (nodes are
     // only absorbed into critical nodes); for a remaining node, -2 - its new id.
     // A listed node's forward: the fate of its set's root (kNone for a list still there).
+    // (The passes over the nodes below run in parallel: their finds share the forests,
+    // find_root_shared, and each writes its own entries.)
     const auto fate = [&](i32 f) {
-        return f > -2 ? f : set_fate_[idx(find_root(set_parent_, -2 - f))];
+        return f > -2 ? f : set_fate_[idx(detail::find_root_shared(set_parent_, -2 - f))];
     };
     // (Large blocks made a slice at a time, with heartbeats: their first touch is slow.)
     const auto made = [&](double at) { return PassProgress(progress, at, at, "simplify"); };
@@ -44,14 +49,30 @@ void WorkingGraph::write_result(SimplifyResult& result, bool rewrite_field,
     const std::size_t nc = idx(critical_count_);
     std::vector<i32> code;
     detail::assign_in_slices(code, nc, i32{0}, made(0), nc + nl);  // (room for all)
-    for (std::size_t k = 0; k < nc; ++k) code[k] = fate(forward_of(critical_[k]));
-    for (std::size_t k = 0; k < nc; ++k)
-        if (code[k] != kNone) code[k] = find_root(code, code[k]);
-    for (std::size_t p = 0; p < nl; ++p) {
-        fates.at(p, nl);
-        const i32 f = fate(regular_[p].forward);
-        regular_[p].forward = f == kNone || code[idx(f)] == kNone ? f : code[idx(f)];
-    }
+    constexpr std::size_t kGrain = std::size_t{1} << 14;
+    detail::parallel_slices(nc, kGrain, progress, 0, 0.05, "simplify",
+                            [&](const tbb::blocked_range<std::size_t>& r) {
+                                for (std::size_t k = r.begin(); k < r.end(); ++k)
+                                    code[k] = fate(forward_of(critical_[k]));
+                            });
+    // (code[k] is written whole, with its root: a find through k reads its old link or the
+    // root, both in k's tree.)
+    detail::parallel_slices(
+        nc, kGrain, progress, 0.05, 0.1, "simplify", [&](const tbb::blocked_range<std::size_t>& r) {
+            for (std::size_t k = r.begin(); k < r.end(); ++k) {
+                const i32 c = std::atomic_ref<i32>(code[k]).load(std::memory_order_relaxed);
+                if (c == kNone) continue;
+                const i32 root = detail::find_root_shared(code, c);
+                std::atomic_ref<i32>(code[k]).store(root, std::memory_order_relaxed);
+            }
+        });
+    detail::parallel_slices(
+        nl, kGrain, progress, 0.1, 0.2, "simplify", [&](const tbb::blocked_range<std::size_t>& r) {
+            for (std::size_t p = r.begin(); p < r.end(); ++p) {
+                const i32 f = fate(regular_[p].forward);
+                regular_[p].forward = f == kNone || code[idx(f)] == kNone ? f : code[idx(f)];
+            }
+        });
     const auto code_of = [&](std::size_t i) { return i < nc ? code[i] : regular_[i - nc].forward; };
     // What the output reads of the working graph, taken out: the nodes that remain (by their
     // index here, in order) and the arcs that live, with their lists (a few thousand nodes on
@@ -176,8 +197,23 @@ void WorkingGraph::write_result(SimplifyResult& result, bool rewrite_field,
             throw Error("simplify", "the vertices' nodes came back with the wrong size");
     }
     // Each new node's vertex count.
+    constexpr std::size_t kSmallCounts = std::size_t{1} << 16;
     std::vector<i32> size(count + 1, 0);
-    if (lists_from_vertex_nodes_) {
+    if (lists_from_vertex_nodes_ && count <= kSmallCounts) {
+        // (A simplified graph has few nodes: each thread counts into its own sizes, summed
+        // after; the same integers in any order.)
+        const auto& of = owned_->vertex_nodes;
+        tbb::combinable<std::vector<i32>> counted([&] { return std::vector<i32>(count + 1, 0); });
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nv, std::size_t{1} << 16),
+                          [&](const tbb::blocked_range<std::size_t>& r) {
+                              auto& own = counted.local();
+                              for (std::size_t v = r.begin(); v < r.end(); ++v)
+                                  ++own[idx(node_map_[idx(of[v])]) + 1];
+                          });
+        counted.combine_each([&](const std::vector<i32>& own) {
+            for (std::size_t i = 0; i < own.size(); ++i) size[i] += own[i];
+        });
+    } else if (lists_from_vertex_nodes_) {
         for (const i32 n : owned_->vertex_nodes) ++size[idx(node_map_[idx(n)]) + 1];
     } else {
         for (std::size_t n = 0; n < nn; ++n)
