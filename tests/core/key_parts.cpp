@@ -12,22 +12,19 @@
 
 namespace {
 
-// Items grouped by key (a counting sort's fill): each key's items listed in the order seen.
+// Items grouped by key (count_by_key_parts, place_by_key_parts): each key's items listed in
+// the order seen.
 std::vector<std::int32_t> grouped(const std::vector<std::int64_t>& keys, std::size_t buckets,
                                   std::vector<std::int32_t>& offsets) {
     const terrain::ProgressFn none;
     const terrain::detail::PassProgress pass(none, 0, 1, "test");
     const auto key = [&](std::size_t i) { return keys[i]; };
     offsets.assign(buckets + 1, 0);
-    terrain::detail::scatter_by_key_parts(keys.size(), buckets, pass, key,
-                                          [&](std::size_t, std::size_t k) { ++offsets[k + 1]; });
-    for (std::size_t k = 0; k < buckets; ++k) offsets[k + 1] += offsets[k];
-    std::vector<std::int32_t> fill(offsets.begin(), offsets.end() - 1),
-        items(static_cast<std::size_t>(offsets.back()), -1);
-    terrain::detail::scatter_by_key_parts(
-        keys.size(), buckets, pass, key, [&](std::size_t i, std::size_t k) {
-            items[static_cast<std::size_t>(fill[k]++)] = static_cast<std::int32_t>(i);
-        });
+    terrain::detail::count_by_key_parts(keys.size(), offsets, pass, key);
+    std::vector<std::int32_t> items(static_cast<std::size_t>(offsets.back()), -1);
+    terrain::detail::place_by_key_parts(
+        keys.size(), offsets, pass, key,
+        [&](std::size_t i, std::size_t slot) { items[slot] = static_cast<std::int32_t>(i); });
     return items;
 }
 

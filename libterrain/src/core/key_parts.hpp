@@ -17,6 +17,8 @@
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
+#include <numeric>
+#include <vector>
 
 #include "pass_progress.hpp"
 
@@ -48,6 +50,26 @@ void scatter_by_key_parts(std::size_t items, std::size_t keys, const PassProgres
                               }
                           });
     }
+}
+
+// A counting sort by parts of the keys, in two steps (the caller sizes its output between):
+// count_by_key_parts turns `offsets` (keys + 1 zeros) into each key's first slot;
+// place_by_key_parts then calls `place(i, slot)` for every item i with a key, its slot among
+// its key's in item order (the serial sort's).
+template <class Key>
+void count_by_key_parts(std::size_t items, std::vector<std::int32_t>& offsets,
+                        const PassProgress& pass, const Key& key) {
+    scatter_by_key_parts(items, offsets.size() - 1, pass, key,
+                         [&](std::size_t, std::size_t k) { ++offsets[k + 1]; });
+    std::partial_sum(offsets.begin(), offsets.end(), offsets.begin());
+}
+template <class Key, class Place>
+void place_by_key_parts(std::size_t items, const std::vector<std::int32_t>& offsets,
+                        const PassProgress& pass, const Key& key, const Place& place) {
+    std::vector<std::int32_t> fill(offsets.begin(), offsets.end() - 1);
+    scatter_by_key_parts(items, fill.size(), pass, key, [&](std::size_t i, std::size_t k) {
+        place(i, static_cast<std::size_t>(fill[k]++));
+    });
 }
 
 }  // namespace terrain::detail

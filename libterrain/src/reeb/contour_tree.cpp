@@ -372,19 +372,14 @@ bool contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& prog
     const auto lower_end = [&](std::size_t x) -> std::int64_t {
         return attach[x] == kNone ? -1 : edge(x).first;
     };
-    detail::scatter_by_key_parts(nn, nn, span(0.75, 0.76), lower_end,
-                                 [&](std::size_t, std::size_t lo) { ++up_off[lo + 1]; });
+    detail::count_by_key_parts(nn, up_off, span(0.75, 0.76), lower_end);
     detail::scatter_by_key_parts(
         nn, nn, span(0.76, 0.775),
         [&](std::size_t x) -> std::int64_t { return attach[x] == kNone ? -1 : edge(x).second; },
         [&](std::size_t, std::size_t hi) { ++down_deg[hi]; });
-    std::partial_sum(up_off.begin(), up_off.end(), up_off.begin());
-    {
-        std::vector<i32> fill(up_off.begin(), up_off.end() - 1);
-        detail::scatter_by_key_parts(
-            nn, nn, span(0.775, 0.8), lower_end,
-            [&](std::size_t x, std::size_t lo) { up_to[idx(fill[lo]++)] = edge(x).second; });
-    }
+    detail::place_by_key_parts(
+        nn, up_off, span(0.775, 0.8), lower_end,
+        [&](std::size_t x, std::size_t slot) { up_to[slot] = edge(x).second; });
     g.node_kinds.assign(nn, NodeKind::regular);
     // (Each node its own entries: in parallel.)
     detail::parallel_slices(
@@ -478,17 +473,11 @@ bool contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& prog
     detail::release(up_to);
     const auto arc_of = [&](std::size_t n) -> std::int64_t { return g.node_arcs[n]; };
     g.arc_offsets.assign(arc_count + 1, 0);
-    detail::scatter_by_key_parts(nn, arc_count, span(0.875, 0.885), arc_of,
-                                 [&](std::size_t, std::size_t arc) { ++g.arc_offsets[arc + 1]; });
-    std::partial_sum(g.arc_offsets.begin(), g.arc_offsets.end(), g.arc_offsets.begin());
+    detail::count_by_key_parts(nn, g.arc_offsets, span(0.875, 0.885), arc_of);
     g.arc_nodes.resize(idx(g.arc_offsets.back()));
-    {
-        std::vector<i32> fill(g.arc_offsets.begin(), g.arc_offsets.end() - 1);
-        detail::scatter_by_key_parts(nn, arc_count, span(0.885, 0.9), arc_of,
-                                     [&](std::size_t n, std::size_t arc) {
-                                         g.arc_nodes[idx(fill[arc]++)] = static_cast<i32>(n);
-                                     });
-    }
+    detail::place_by_key_parts(
+        nn, g.arc_offsets, span(0.885, 0.9), arc_of,
+        [&](std::size_t n, std::size_t slot) { g.arc_nodes[slot] = static_cast<i32>(n); });
     report_progress(progress, 0.9, "reeb: arcs");
     count_general_links(mesh, g, general, scaled_progress(progress, 0.9, 1));
     return true;

@@ -231,15 +231,11 @@ void WorkingGraph::write_result(SimplifyResult& result, bool rewrite_field,
         // (By parts of the nodes: in parallel, each list in vertex order, key_parts.hpp.)
         const auto node_of = [&](std::size_t v) -> std::int64_t { return of[v]; };
         detail::assign_in_slices(offsets, nn + 1, i32{0}, made(0.4));
-        detail::scatter_by_key_parts(nv, nn, counted, node_of,
-                                     [&](std::size_t, std::size_t n) { ++offsets[n + 1]; });
-        std::partial_sum(offsets.begin(), offsets.end(), offsets.begin());
+        detail::count_by_key_parts(nv, offsets, counted, node_of);
         detail::assign_in_slices(listed_vertices, nv, i32{0}, made(0.45));
-        std::vector<i32> fill(offsets.begin(), offsets.end() - 1);
-        detail::scatter_by_key_parts(nv, nn, listed, node_of, [&](std::size_t v, std::size_t n) {
-            listed_vertices[idx(fill[n]++)] = static_cast<i32>(v);
-        });
-        detail::release(fill);
+        detail::place_by_key_parts(
+            nv, offsets, listed, node_of,
+            [&](std::size_t v, std::size_t slot) { listed_vertices[slot] = static_cast<i32>(v); });
         detail::release(owned_->vertex_nodes);
     }
     report_progress(progress, 0.5, "simplify");
