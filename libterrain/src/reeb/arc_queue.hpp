@@ -11,6 +11,9 @@
 #include <utility>
 #include <vector>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include "../core/indices.hpp"
 #include "../core/release.hpp"
 
@@ -80,9 +83,14 @@ class ArcQueue {
                 else
                     std::swap(sorted_[next[b]], sorted_[next[home]++]);
             }
-        for (std::size_t b = 0; b < kBuckets; ++b)
-            std::sort(sorted_.begin() + static_cast<std::ptrdiff_t>(begin[b]),
-                      sorted_.begin() + static_cast<std::ptrdiff_t>(begin[b + 1]));
+        // (The buckets on every thread: the keys are unique, so each bucket's order is the same.)
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, kBuckets, 1),
+                          [&](const tbb::blocked_range<std::size_t>& r) {
+                              for (std::size_t b = r.begin(); b < r.end(); ++b)
+                                  std::sort(
+                                      sorted_.begin() + static_cast<std::ptrdiff_t>(begin[b]),
+                                      sorted_.begin() + static_cast<std::ptrdiff_t>(begin[b + 1]));
+                          });
         // Sorted, each entry keeps only its arc id (4 bytes), written over the front half of
         // the keys in order (entry k's id lands on bytes a key before it or k itself held,
         // already read); the back half's pages go back to the system. The caller knows each

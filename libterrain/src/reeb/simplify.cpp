@@ -31,6 +31,8 @@
 #include <cstdint>
 #include <string>
 
+#include <tbb/blocked_range.h>
+
 #include "../core/pass_progress.hpp"
 #include "../core/release.hpp"
 #include "simplifier.hpp"
@@ -43,18 +45,34 @@ namespace internal {
 void Simplifier::run(const ProgressFn& progress, SimplifyResult& result) {
     // Nodes with many arcs from the start (a pole's many-armed saddle) are big.
     promote_pending(true);
-    // The candidates of the input graph; an arc with a big end is queued through it.
-    const detail::PassProgress seeded(progress, kSeedStart, kCopyEnd, "simplify");
-    for (std::size_t a = 0; a < arcs_.size(); ++a) {
-        seeded.at(a, arcs_.size());
-        if (a + kAhead < arcs_.size()) prefetch_ends(a + kAhead);
-        const i32 arc = static_cast<i32>(a);
-        if (managed(arc)) {
-            if (!candidate(arc)) set_waiting(arc);
+    // The candidates of the input graph, found on every thread: nothing is written but each
+    // arc's own `queued` (its key's bits if it is a candidate, kWaits if it has a big end and
+    // is not one; nothing is forwarded yet, so ends() writes nothing). Then, in arc order,
+    // the candidates are queued and the others set waiting, as one pass in order did.
+    constexpr std::uint32_t kWaits = kNotQueued - 1;  // (no persistence has these bits: a NaN)
+    constexpr std::size_t kGrain = std::size_t{1} << 14;
+    const std::size_t na = arcs_.size();
+    detail::parallel_slices(na, kGrain, progress, kSeedStart, kCopyEnd, "simplify",
+                            [&](const tbb::blocked_range<std::size_t>& r) {
+                                for (std::size_t a = r.begin(); a < r.end(); ++a) {
+                                    if (a + kAhead < r.end()) prefetch_ends(a + kAhead);
+                                    const i32 arc = static_cast<i32>(a);
+                                    if (managed(arc)) {
+                                        if (!candidate(arc)) arcs_[a].queued = kWaits;
+                                        continue;
+                                    }
+                                    if (candidate(arc)) mark_queued(arc);
+                                }
+                            });
+    for (std::size_t a = 0; a < na; ++a) {
+        std::uint32_t& queued = arcs_[a].queued;
+        if (queued == kNotQueued) continue;
+        if (queued == kWaits) {
+            queued = kNotQueued;
+            set_waiting(static_cast<i32>(a));
             continue;
         }
-        if (!candidate(arc)) continue;
-        queue_.seed(mark_queued(arc));
+        queue_.seed(std::uint64_t{queued} << 32 | static_cast<std::uint32_t>(a));
         ++pushed_;
     }
     queue_.seal();
