@@ -133,36 +133,14 @@ void Simplifier::run(const ProgressFn& progress, SimplifyResult& result) {
     report_progress(progress, 1.0, "simplify");
 }
 
-// The sorted entries ahead, in four steps, each reading what the step before fetched: their
-// arcs (and heap slots), their ends, the arcs at their ends, and those arcs' ends and
-// nearest listed nodes. A cancellation reads all of these (cancel, fit_arc, regularize,
-// consider), and each read depends on the one before: fetched one at a time, they cost a
-// miss each in a row.
+// The sorted entries ahead: their arcs (and heap slots) first, then (nearer) their ends.
 void Simplifier::prefetch_candidates_ahead() const {
-    const i32 far = queue_.sorted_ahead(kAhead);
+    const i32 far = queue_.sorted_ahead(kAhead), near = queue_.sorted_ahead(4);
     if (far != kNone) {
         __builtin_prefetch(&arcs_[idx(far)]);
         queue_.prefetch_slot(far);
     }
-    if (const i32 a = queue_.sorted_ahead(kAhead / 2); a != kNone) prefetch_ends(idx(a));
-    // (An end's arcs are read from its record only when they are there: not big, no run,
-    // not forwarded.)
-    const auto for_each_inline_arc = [&](i32 a, auto&& f) {
-        for (const i32 e : arcs_[idx(a)].end) {
-            const CriticalNode& c = critical_[idx(e)];
-            if (c.shift != 0 || (c.flags & (kBig | kForwarded)) || c.size > kInline) continue;
-            for (std::uint32_t i = 0; i < c.size; ++i) f(c.slot[i]);
-        }
-    };
-    if (const i32 a = queue_.sorted_ahead(kAhead / 4); a != kNone)
-        for_each_inline_arc(a, [&](i32 b) { __builtin_prefetch(&arcs_[idx(b)]); });
-    if (const i32 a = queue_.sorted_ahead(kAhead / 8); a != kNone)
-        for_each_inline_arc(a, [&](i32 b) {
-            const Arc& arc = arcs_[idx(b)];
-            for (const i32 e : arc.end) __builtin_prefetch(&critical_[idx(e)]);
-            for (const i32 r : {arc.head, arc.tail})
-                if (r >= critical_count_) __builtin_prefetch(&regular_[idx(r - critical_count_)]);
-        });
+    if (near != kNone) prefetch_ends(idx(near));
 }
 
 }  // namespace internal
