@@ -9,6 +9,9 @@
 #include <limits>
 #include <string>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include "../core/pass_progress.hpp"
 #include "../core/ranked_bits.hpp"
 #include "../core/release.hpp"
@@ -265,39 +268,64 @@ WorkingGraph::WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big
             lists_behind = detail::PagesBehind(g.node_vertices.data());
         }
     }
+    // The nodes a wave at a time. On every thread: each node's area (its vertices' areas
+    // gathered), and the regular nodes' records (each written by its own node). Then, in
+    // order: the areas summed (the same additions in the same order as one pass in order),
+    // and the critical nodes' records appended, their pages touched first on every thread.
     total_area_ = 0;
-    std::vector<i32> scratch;
-    bool sorted = true;  // every node's vertex list ascending
+    std::atomic<bool> all_sorted{true};  // every node's vertex list ascending
+    constexpr std::size_t kWave = std::size_t{1} << 20;
+    std::vector<double> wave_area(std::min(nn, kWave));
     i32 k = 0;
-    for (std::size_t n = 0; n < nn; ++n) {
-        nodes.at(n, nn);
-        if ((n & 0x3fff) == 0) {  // (what nodes before n held is read for the last time)
-            values_behind.before(g.node_values.data() + n);
-            kinds_behind.before(g.node_kinds.data() + n);
-            offsets_behind.before(g.node_vertex_offsets.data() + n);
-            lists_behind.before(g.node_vertices.data() + g.node_vertex_offsets[n]);
-        }
-        if (n + kAhead < nn) {
-            const std::size_t m = n + kAhead;
-            const i32 i = g.node_vertex_offsets[m];
-            if (!mesh.vertex_areas.empty() && i < g.node_vertex_offsets[m + 1])
-                __builtin_prefetch(&mesh.vertex_areas[idx(g.node_vertices[idx(i)])]);
-            if (node_map_[m] >= 0) __builtin_prefetch(&regular_[idx(node_map_[m])], 1);
-        }
-        const double area = node_area(mesh, g, n, scratch, sorted);
-        total_area_ += area;
-        if (node_map_[n] < 0) {
+    for (std::size_t n0 = 0; n0 < nn; n0 += kWave) {
+        const std::size_t n1 = std::min(nn, n0 + kWave);
+        nodes.at(n0, nn);
+        // (what nodes before n0 held is read for the last time)
+        values_behind.before(g.node_values.data() + n0);
+        kinds_behind.before(g.node_kinds.data() + n0);
+        offsets_behind.before(g.node_vertex_offsets.data() + n0);
+        lists_behind.before(g.node_vertices.data() + g.node_vertex_offsets[n0]);
+        tbb::parallel_for(
+            tbb::blocked_range<std::size_t>(n0, n1, kGrain),
+            [&](const tbb::blocked_range<std::size_t>& r) {
+                std::vector<i32> scratch;
+                bool sorted = true;
+                for (std::size_t n = r.begin(); n < r.end(); ++n) {
+                    if (n + kAhead < r.end()) {
+                        const std::size_t m = n + kAhead;
+                        const i32 i = g.node_vertex_offsets[m];
+                        if (!mesh.vertex_areas.empty() && i < g.node_vertex_offsets[m + 1])
+                            __builtin_prefetch(&mesh.vertex_areas[idx(g.node_vertices[idx(i)])]);
+                        if (node_map_[m] >= 0) __builtin_prefetch(&regular_[idx(node_map_[m])], 1);
+                    }
+                    const double area = node_area(mesh, g, n, scratch, sorted);
+                    wave_area[n - n0] = area;
+                    if (node_map_[n] >= 0) {
+                        RegularNode& node = regular_[idx(node_map_[n])];
+                        node.area = area;
+                        node.value = g.node_values[n];
+                        node_map_[n] += critical_count_;
+                    }
+                }
+                if (!sorted) all_sorted = false;
+            });
+        const std::size_t critical_here =
+            critical_nodes.rank(n1 - 1) + critical_nodes.test(n1 - 1) - critical_.size();
+        detail::touch_pages(critical_.data() + critical_.size(),
+                            critical_here * sizeof(CriticalNode));
+        for (std::size_t n = n0; n < n1; ++n) {
+            const double area = wave_area[n - n0];
+            total_area_ += area;
+            if (node_map_[n] >= 0) continue;
             CriticalNode& c = critical_.emplace_back();
             c.area = area;
             c.value = g.node_values[n];
             c.flags = g.node_kinds[n] != NodeKind::regular ? kCritical : 0;
             node_map_[n] = k++;
-        } else {
-            regular_[idx(node_map_[n])].area = area;
-            regular_[idx(node_map_[n])].value = g.node_values[n];
-            node_map_[n] += critical_count_;
         }
     }
+    const bool sorted = all_sorted;
+    detail::release(wave_area);
     total_area_ = mesh_area_or_one(total_area_);
     if (areas_read) areas_read();  // (before the arcs: their copy's end is the peak)
     // The new numbers are read again only by write_result, once the working graph is freed:
@@ -342,36 +370,50 @@ WorkingGraph::WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big
         offsets_behind_a = detail::PagesBehind(g.arc_offsets.data());
         listed_behind = detail::PagesBehind(g.arc_nodes.data());
     }
-    for (std::size_t a = 0; a < na; ++a) {
-        arcs.at(a, na);
-        if ((a & 0x3fff) == 0) {  // (what arcs before a held is read for the last time)
-            ends_behind.before(g.arcs.data() + a);
-            offsets_behind_a.before(g.arc_offsets.data() + a);
-            listed_behind.before(g.arc_nodes.data() + g.arc_offsets[a]);
-        }
-        Arc& arc = arcs_.emplace_back();
-        if (a + kAhead < na)
-            for (const i32 e : g.arcs[a + kAhead]) critical_nodes.prefetch(idx(e));
-        if (a + kAhead / 2 < na)
-            for (const i32 e : g.arcs[a + kAhead / 2])
-                __builtin_prefetch(&critical_[idx(critical_number(e))], 1);
-        arc.end = {critical_number(g.arcs[a][0]), critical_number(g.arcs[a][1])};
-        for (const i32 e : arc.end) link(static_cast<i32>(a), e);
-        ++critical_[idx(arc.end[1])].down;
-        arc.set = static_cast<i32>(a);
-        for (i32 p = g.arc_offsets[a]; p < g.arc_offsets[a + 1]; ++p) {
-            const i32 listed = g.arc_nodes[idx(p)];
-            const i32 r =
-                critical_nodes.test(idx(listed)) ? critical_number(listed) : critical_count_ + p;
-            set_forward(r, -2 - arc.set);
-            if (arc.tail == kNone) {
-                arc.head = r;
-            } else {
-                next(arc.tail) = r;
-                prev(r) = arc.tail;
-            }
-            arc.tail = r;
-            arc.area += area(r);
+    // A wave of arcs at a time: their records' pages touched on every thread; each arc's ends
+    // and list on every thread (each listed node is in one list, and lists hold no arc end);
+    // then the arcs join their ends in arc order (a node's arcs in the order one pass made).
+    constexpr std::size_t kArcWave = std::size_t{1} << 20;
+    for (std::size_t a0 = 0; a0 < na; a0 += kArcWave) {
+        const std::size_t a1 = std::min(na, a0 + kArcWave);
+        arcs.at(a0, na);
+        // (what arcs before a0 held is read for the last time)
+        ends_behind.before(g.arcs.data() + a0);
+        offsets_behind_a.before(g.arc_offsets.data() + a0);
+        listed_behind.before(g.arc_nodes.data() + g.arc_offsets[a0]);
+        detail::touch_pages(arcs_.data() + a0, (a1 - a0) * sizeof(Arc));
+        arcs_.resize(a1);
+        tbb::parallel_for(
+            tbb::blocked_range<std::size_t>(a0, a1, kGrain),
+            [&](const tbb::blocked_range<std::size_t>& range) {
+                for (std::size_t a = range.begin(); a < range.end(); ++a) {
+                    if (a + kAhead < range.end())
+                        for (const i32 e : g.arcs[a + kAhead]) critical_nodes.prefetch(idx(e));
+                    Arc& arc = arcs_[a];
+                    arc.end = {critical_number(g.arcs[a][0]), critical_number(g.arcs[a][1])};
+                    arc.set = static_cast<i32>(a);
+                    for (i32 p = g.arc_offsets[a]; p < g.arc_offsets[a + 1]; ++p) {
+                        const i32 listed = g.arc_nodes[idx(p)];
+                        const i32 r = critical_nodes.test(idx(listed)) ? critical_number(listed)
+                                                                       : critical_count_ + p;
+                        set_forward(r, -2 - arc.set);
+                        if (arc.tail == kNone) {
+                            arc.head = r;
+                        } else {
+                            next(arc.tail) = r;
+                            prev(r) = arc.tail;
+                        }
+                        arc.tail = r;
+                        arc.area += area(r);
+                    }
+                }
+            });
+        for (std::size_t a = a0; a < a1; ++a) {
+            if (a + kAhead < a1)
+                for (const i32 e : arcs_[a + kAhead].end) __builtin_prefetch(&critical_[idx(e)], 1);
+            const Arc& arc = arcs_[a];
+            for (const i32 e : arc.end) link(static_cast<i32>(a), e);
+            ++critical_[idx(arc.end[1])].down;
         }
     }
     if (owned) {  // the arcs are copied
