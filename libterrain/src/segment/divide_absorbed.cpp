@@ -125,8 +125,9 @@ double edge_length(const TriangleMesh& mesh, std::size_t a, std::size_t b) {
 }
 
 // The edges' mean length, and the least length of the edges at each block of 2^kBlockShift
-// consecutive vertices (+infinity for a block without edges). The sum is taken in vertex order, on
-// one thread: the costs, hence the labels, depend on its last bits.
+// consecutive vertices (+infinity for a block without edges). The costs, hence the labels,
+// depend on the sum's last bits: it is taken in vertex order, on one thread, over the lengths
+// that a wave of blocks has made on every thread (each block its own lengths and least).
 constexpr std::size_t kBlockShift = 12;
 struct EdgeLengths {
     double mean = 1;
@@ -136,17 +137,33 @@ struct EdgeLengths {
 EdgeLengths edge_lengths(const TriangleMesh& mesh, const detail::PassProgress& pass) {
     EdgeLengths out;
     const std::size_t n = mesh.vertex_count();
-    out.least.assign((n >> kBlockShift) + 1, std::numeric_limits<double>::infinity());
+    const std::size_t blocks = (n >> kBlockShift) + 1;
+    out.least.assign(blocks, std::numeric_limits<double>::infinity());
+    constexpr std::size_t kWaveBlocks = 64;  // (a wave's lengths: 2^18 vertices, about 12 MB)
+    std::array<std::vector<double>, kWaveBlocks> lengths;
     double sum = 0;
     std::size_t count = 0;
-    for (std::size_t v = 0; v < n; ++v) {
-        pass.at(v, n);
-        double& least = out.least[v >> kBlockShift];
-        for (const i32 w : mesh.neighbors_of(v)) {
-            const double len = edge_length(mesh, v, idx(w));
-            sum += len;
-            least = std::min(least, len);
-            ++count;
+    for (std::size_t b0 = 0; b0 < blocks; b0 += kWaveBlocks) {
+        pass.at(b0 << kBlockShift, n);
+        const std::size_t b1 = std::min(blocks, b0 + kWaveBlocks);
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(b0, b1, 1),
+                          [&](const tbb::blocked_range<std::size_t>& r) {
+                              for (std::size_t b = r.begin(); b < r.end(); ++b) {
+                                  std::vector<double>& mine = lengths[b - b0];
+                                  mine.clear();
+                                  double least = std::numeric_limits<double>::infinity();
+                                  const std::size_t last = std::min(n, (b + 1) << kBlockShift);
+                                  for (std::size_t v = b << kBlockShift; v < last; ++v)
+                                      for (const i32 w : mesh.neighbors_of(v)) {
+                                          mine.push_back(edge_length(mesh, v, idx(w)));
+                                          least = std::min(least, mine.back());
+                                      }
+                                  out.least[b] = least;
+                              }
+                          });
+        for (std::size_t b = b0; b < b1; ++b) {
+            for (const double len : lengths[b - b0]) sum += len;
+            count += lengths[b - b0].size();
         }
     }
     out.mean = count == 0 || sum <= 0 ? 1.0 : sum / double(count);
