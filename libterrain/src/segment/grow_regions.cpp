@@ -5,9 +5,14 @@
 
 #include "terrain/segment/grow_regions.hpp"
 
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
 #include <queue>
+#include <vector>
 
 #include "../core/indices.hpp"
 #include "../core/pass_progress.hpp"
@@ -114,8 +119,12 @@ class Grower {
                                        " nodes without a region (no extremum in their component)");
         out.region_count = static_cast<std::uint32_t>(seeds.size());
         out.labels.resize(g_.vertex_nodes.size());
-        for (std::size_t v = 0; v < out.labels.size(); ++v)
-            out.labels[v] = static_cast<std::uint32_t>(node_region_[idx(g_.vertex_nodes[v])] + 1);
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, out.labels.size(), 1 << 16),
+                          [&](const tbb::blocked_range<std::size_t>& r) {
+                              for (std::size_t v = r.begin(); v < r.end(); ++v)
+                                  out.labels[v] = static_cast<std::uint32_t>(
+                                      node_region_[idx(g_.vertex_nodes[v])] + 1);
+                          });
         report_progress(progress, 1.0, "grow");
         return out;
     }
@@ -168,56 +177,80 @@ class Grower {
 
     void push(i32 n, i32 r, bool relaxed) { heap_.push({cost(n, r, relaxed), n, r}); }
 
-    // Calls f(v) for each vertex v of node n. A node's list is in the order the simplification
-    // gathered it (by value, scattered over the surface); a node with a large share of the
-    // vertices is walked in vertex order instead, by a pass over vertex_nodes: the vertices
-    // around each one are then next to those of the last (on a global grid, one such node
-    // held 99 % of the vertices and its walk in list order waited on memory at every step).
-    // The callers push candidates, a set: the order does not change what the growing does.
+    // Whether node n's vertices are walked in vertex order, by a pass over vertex_nodes: a
+    // node's list is in the order the simplification gathered it (by value, scattered over the
+    // surface), and a node with a large share of the vertices waits on memory at every step
+    // of its list (on a global grid, one such node held 99 % of the vertices); walked in
+    // vertex order, the vertices around each one are next to those of the last.
+    bool walked(i32 n) const {
+        const std::size_t count =
+            idx(g_.node_vertex_offsets[idx(n) + 1] - g_.node_vertex_offsets[idx(n)]);
+        return options_.walk_share > 0 && count * options_.walk_share >= g_.vertex_nodes.size();
+    }
+
+    // The distinct keys key(w) >= 0 (a node or a region) of the mesh neighbours w of node n's
+    // vertices, in any order: the callers push a candidate for each, and the candidates are a
+    // set (an entry pushed twice is popped twice in a row, the second time with nothing left
+    // to do), so neither the order nor the repeats change what the growing does. A walked node
+    // is walked on every thread, a slice of the vertices at a time; the others by their list.
     // `assigning`: n is being assigned (its vertices count towards the progress).
-    template <class F>
-    void for_each_vertex(i32 n, bool assigning, F&& f) {
+    template <class Key>
+    const std::vector<i32>& keys_around(i32 n, bool assigning, const Key& key) {
+        keys_.clear();
         const i32 first = g_.node_vertex_offsets[idx(n)], last = g_.node_vertex_offsets[idx(n) + 1];
-        const std::size_t count = idx(last - first), nv = g_.vertex_nodes.size();
-        if (options_.walk_share > 0 && count * options_.walk_share >= nv) {
-            std::size_t seen = 0;
-            for (std::size_t v = 0; v < nv && seen < count; ++v)
-                if (g_.vertex_nodes[v] == n) {
-                    tick(assigning ? seen : 0);
-                    ++seen;
-                    f(v);
-                }
-            return;
+        const auto add = [&](std::vector<i32>& to, std::size_t v) {
+            for (const i32 w : mesh_.neighbors_of(v)) {
+                const i32 k = key(w);
+                if (k >= 0 && (to.empty() || to.back() != k)) to.push_back(k);
+            }
+        };
+        if (!walked(n)) {
+            for (i32 i = first; i < last; ++i) {
+                tick(assigning ? idx(i - first) : 0);
+                add(keys_, idx(g_.node_vertices[idx(i)]));
+            }
+            return keys_;
         }
-        for (i32 i = first; i < last; ++i) {
-            tick(assigning ? idx(i - first) : 0);
-            f(idx(g_.node_vertices[idx(i)]));
+        const std::size_t nv = g_.vertex_nodes.size(), count = idx(last - first);
+        // (slices of 4 M vertices or more, at most 16: a report after each)
+        const std::size_t slices = std::min<std::size_t>(16, 1 + (nv >> 22));
+        constexpr std::size_t kGrain = std::size_t{1} << 16;
+        tbb::enumerable_thread_specific<std::vector<i32>> found;
+        for (std::size_t s = 0; s < slices; ++s) {
+            tbb::parallel_for(
+                tbb::blocked_range<std::size_t>(nv * s / slices, nv * (s + 1) / slices, kGrain),
+                [&](const tbb::blocked_range<std::size_t>& r) {
+                    std::vector<i32>& mine = found.local();
+                    for (std::size_t v = r.begin(); v < r.end(); ++v)
+                        if (g_.vertex_nodes[v] == n) add(mine, v);
+                    std::sort(mine.begin(), mine.end());
+                    mine.erase(std::unique(mine.begin(), mine.end()), mine.end());
+                });
+            visited_ += count / slices;
+            report(done_ + (assigning ? count * (s + 1) / slices : 0));
         }
+        for (const auto& mine : found) keys_.insert(keys_.end(), mine.begin(), mine.end());
+        std::sort(keys_.begin(), keys_.end());
+        keys_.erase(std::unique(keys_.begin(), keys_.end()), keys_.end());
+        return keys_;
     }
 
     // Candidates (u, r) for the unassigned nodes u touching node n (in region r) on the mesh.
     void push_mesh_candidates(i32 n, bool relaxed) {
         const i32 r = node_region_[idx(n)];
-        i32 last = kNone;
-        for_each_vertex(n, true, [&](std::size_t v) {
-            for (const i32 w : mesh_.neighbors_of(v)) {
-                const i32 u = g_.vertex_nodes[idx(w)];
-                if (u == last || node_region_[idx(u)] != kNone) continue;
-                last = u;
-                if (!relaxed && options_.cost == GrowCost::graph && !reeb_eligible(u)) continue;
-                push(u, r, relaxed);
-            }
-        });
+        const bool graph = !relaxed && options_.cost == GrowCost::graph;
+        for (const i32 u : keys_around(n, true, [&](i32 w) {
+                 const i32 u = g_.vertex_nodes[idx(w)];
+                 return node_region_[idx(u)] != kNone || (graph && !reeb_eligible(u)) ? kNone : u;
+             }))
+            push(u, r, relaxed);
     }
 
     // Candidates for node u against every region it touches on the mesh.
     void push_all_regions(i32 u) {
-        for_each_vertex(u, false, [&](std::size_t v) {
-            for (const i32 w : mesh_.neighbors_of(v)) {
-                const i32 r = node_region_[idx(g_.vertex_nodes[idx(w)])];
-                if (r != kNone) push(u, r, false);
-            }
-        });
+        for (const i32 r : keys_around(
+                 u, false, [&](i32 w) { return node_region_[idx(g_.vertex_nodes[idx(w)])]; }))
+            push(u, r, false);
     }
 
     void assign(i32 n, i32 r) {
@@ -244,6 +277,7 @@ class Grower {
     std::vector<i32> node_region_, nb_off_, nb_, unassigned_branches_;
     std::vector<double> node_area_, region_sum_, region_area_;
     std::priority_queue<Candidate, std::vector<Candidate>, std::greater<Candidate>> heap_;
+    std::vector<i32> keys_;  // keys_around()'s
     // While run() runs: its progress, the vertices of the nodes assigned so far, the vertices
     // looked at (every 2^18 a report: a node the simplification gave a large part of the
     // surface takes seconds), and the fraction reported last.
