@@ -172,7 +172,7 @@ bool lists_ascending(const ReebGraph& g) {
 WorkingGraph::WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big_degree,
                            const ProgressFn& progress, ReebGraph* owned,
                            const std::function<void()>& areas_read,
-                           const VertexNodesParking& parking)
+                           const VertexNodesParking& parking, std::size_t wave)
     : g_(g),
       input_nodes_(g.node_count()),
       input_vertices_(g.vertex_nodes.size()),
@@ -274,11 +274,11 @@ WorkingGraph::WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big
     // and the critical nodes' records appended, their pages touched first on every thread.
     total_area_ = 0;
     std::atomic<bool> all_sorted{true};  // every node's vertex list ascending
-    constexpr std::size_t kWave = std::size_t{1} << 20;
-    std::vector<double> wave_area(std::min(nn, kWave));
+    wave = std::max<std::size_t>(1, wave);
+    std::vector<double> wave_area(std::min(nn, wave));
     i32 k = 0;
-    for (std::size_t n0 = 0; n0 < nn; n0 += kWave) {
-        const std::size_t n1 = std::min(nn, n0 + kWave);
+    for (std::size_t n0 = 0; n0 < nn; n0 += wave) {
+        const std::size_t n1 = std::min(nn, n0 + wave);
         nodes.at(n0, nn);
         // (what nodes before n0 held is read for the last time)
         values_behind.before(g.node_values.data() + n0);
@@ -373,9 +373,8 @@ WorkingGraph::WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big
     // A wave of arcs at a time: their records' pages touched on every thread; each arc's ends
     // and list on every thread (each listed node is in one list, and lists hold no arc end);
     // then the arcs join their ends in arc order (a node's arcs in the order one pass made).
-    constexpr std::size_t kArcWave = std::size_t{1} << 20;
-    for (std::size_t a0 = 0; a0 < na; a0 += kArcWave) {
-        const std::size_t a1 = std::min(na, a0 + kArcWave);
+    for (std::size_t a0 = 0; a0 < na; a0 += wave) {
+        const std::size_t a1 = std::min(na, a0 + wave);
         arcs.at(a0, na);
         // (what arcs before a0 held is read for the last time)
         ends_behind.before(g.arcs.data() + a0);

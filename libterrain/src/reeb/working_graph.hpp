@@ -46,6 +46,10 @@ inline constexpr std::size_t kAhead = 16;
 // scanned, above it they are looked up.
 inline constexpr i32 kBigDegree = 48;
 
+// The working graph's copy takes this many nodes, then arcs, at a time: each wave on every
+// thread, then its areas summed and its arcs joined to their ends in order.
+inline constexpr std::size_t kCopyWave = std::size_t{1} << 20;
+
 class WorkingGraph {
   public:
     // Throws terrain::Error when an arc's list holds an arc end or a node of another list.
@@ -59,10 +63,11 @@ class WorkingGraph {
     // areas are summed, before the arcs are copied: the mesh's areas are read no more.
     // `parking` (simplify(ReebGraph&&)): owned's vertex nodes, when write_result makes the
     // vertex lists again from them, are parked then too and restored in write_result.
+    // The copy goes `wave` nodes, then `wave` arcs, at a time (tests make it small).
     WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big_degree = kBigDegree,
                  const ProgressFn& progress = {}, ReebGraph* owned = nullptr,
                  const std::function<void()>& areas_read = {},
-                 const VertexNodesParking& parking = {});
+                 const VertexNodesParking& parking = {}, std::size_t wave = kCopyWave);
 
     // The simplified graph and the rewritten field (simplify_output.cpp). The working graph is
     // freed as it goes: nothing else may be asked of it after.
