@@ -211,14 +211,18 @@ class Grower {
             }
             return keys_;
         }
-        const std::size_t nv = g_.vertex_nodes.size(), count = idx(last - first);
+        // The vertices from the node's lowest to its highest (read in its list, in order).
+        const auto [lo, hi] =
+            std::minmax_element(g_.node_vertices.begin() + first, g_.node_vertices.begin() + last);
+        const std::size_t begin = idx(*lo), span = idx(*hi) + 1 - begin, count = idx(last - first);
         // (slices of 4 M vertices or more, at most 16: a report after each)
-        const std::size_t slices = std::min<std::size_t>(16, 1 + (nv >> 22));
+        const std::size_t slices = std::min<std::size_t>(16, 1 + (span >> 22));
         constexpr std::size_t kGrain = std::size_t{1} << 16;
         tbb::enumerable_thread_specific<std::vector<i32>> found;
         for (std::size_t s = 0; s < slices; ++s) {
             tbb::parallel_for(
-                tbb::blocked_range<std::size_t>(nv * s / slices, nv * (s + 1) / slices, kGrain),
+                tbb::blocked_range<std::size_t>(begin + span * s / slices,
+                                                begin + span * (s + 1) / slices, kGrain),
                 [&](const tbb::blocked_range<std::size_t>& r) {
                     std::vector<i32>& mine = found.local();
                     for (std::size_t v = r.begin(); v < r.end(); ++v)
