@@ -74,13 +74,15 @@ case "$mode" in
   run)
     install_packages "${packages[@]}"
     build
-    # The main job: the synthetic Vesta HAMO tile segmented with the paper's terrain
-    # parameters (shape index x100, persistence 10, area ratio 0.5 %, graph cost, lambda 20).
+    # The main job: the synthetic Vesta HAMO tile segmented with the defaults: landforms at
+    # their own scale (the shape index at the radius chosen per pixel, regions down to 20
+    # pixels; docs/segment.md). The paper's terrain parameters are --persistence 10
+    # --area-ratio 0.5 --cost graph --saddle-penalty 20.
     sample=examples/data/vesta_hamo_tile.lbl
     mkdir -p "$out_dir"
     "$build_dir/tools/terrain" info "$sample"
     "$build_dir/tools/terrain" segment "$sample" -o "$out_dir/vesta_hamo_tile" --overwrite \
-      --persistence 10 --area-ratio 0.5 --cost graph --saddle-penalty 20 --timings
+      --timings
     echo "setup: outputs in $out_dir/vesta_hamo_tile/ (labels.tif, regions.geojson, adjacency.*, preview.png, run.json)"
     ;;
   test)

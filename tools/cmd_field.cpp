@@ -74,6 +74,15 @@ int run_field(int argc, char** argv) {
         const auto field_progress = scaled_progress(progress, 0.4, 1);
         std::vector<float> values;
         std::optional<field::SdfResult> sdf;
+        // With --radius auto on a DEM, the radius each pixel took goes to <stem>_radius.tif.
+        const bool scales = field_options.kind == field::FieldKind::shape_index &&
+                            field_options.shape_index.auto_scale && !to_ply;
+        const std::string radius_path =
+            (std::filesystem::path(output).parent_path() /
+             (std::filesystem::path(output).stem().string() + "_radius.tif"))
+                .string();
+        if (scales) io::check_output_path(radius_path, overwrite);
+        std::vector<float> radius;
         if (field_options.kind == field::FieldKind::sdf) {
             const std::size_t open = input.dem && !field_options.sdf.allow_open
                                          ? mesh_topology(input.mesh).boundary_edges
@@ -87,8 +96,16 @@ int run_field(int argc, char** argv) {
             values = std::move(sdf->values);
         } else {
             check_field_limits(field_options, input.mesh);
-            values = field::vertex_field(input.mesh, input.dem ? &*input.dem : nullptr,
-                                         field_options, field_progress);
+            if (scales) {
+                auto selected = field::scale_selected_shape_index(
+                    input.mesh, field_options.shape_index, field_progress);
+                values = std::move(selected.field);
+                radius.reserve(selected.scale.size());
+                for (const auto k : selected.scale) radius.push_back(float(selected.radii[k]));
+            } else {
+                values = field::vertex_field(input.mesh, input.dem ? &*input.dem : nullptr,
+                                             field_options, field_progress);
+            }
         }
         std::string name = field::to_string(field_options.kind);  // shape-index -> shape_index
         std::replace(name.begin(), name.end(), '-', '_');
@@ -98,11 +115,16 @@ int run_field(int argc, char** argv) {
             io::write_float_raster(*input.dem,
                                    field::field_to_pixels(input.mesh, *input.dem, values), output,
                                    overwrite, name);
+            if (scales)
+                io::write_float_raster(*input.dem,
+                                       field::field_to_pixels(input.mesh, *input.dem, radius),
+                                       radius_path, overwrite, "radius_m");
         }
         const auto [lo, hi] = std::minmax_element(values.begin(), values.end());
         std::printf("%s: %s on %zu vertices, range %.6g .. %.6g\n", output.c_str(), name.c_str(),
                     values.size(), double(*lo), double(*hi));
         if (sdf) print_sdf_notes(*sdf);
+        if (scales) std::printf("%s: the radius each pixel took, metres\n", radius_path.c_str());
         return 0;
     });
 }

@@ -25,13 +25,16 @@ int run_segment(int argc, char** argv) {
         add_input_options(options, input_values);
         po::variables_map vm;
         if (!parse_command(argc, argv,
-                           "terrain segment INPUT -o OUTDIR [--persistence 10] [--area-ratio 0.5 | "
-                           "--min-area AREA] [--cost graph|standard] [--saddle-penalty 20] "
-                           "[--absorbed divide|whole] [--format GeoJSON|GPKG|...] [--timings]",
+                           "terrain segment INPUT -o OUTDIR [--radius auto|M] [--persistence 10] "
+                           "[--area-ratio 0.5 | --min-area auto|AREA] [--cost graph|standard] "
+                           "[--saddle-penalty 20] [--absorbed auto|divide|whole] "
+                           "[--format GeoJSON|GPKG|...] [--timings]",
                            options, vm))
             return 0;
-        to_field_options(field_values, vm);  // refuses contradictions (exit status 2)
+        // (refuses contradictions: exit status 2)
+        field_values.options = to_field_options(field_values, vm);
         check_one_area_threshold(vm, "min-area");
+        segment_values.landform_defaults = no_scale_option(vm);
         const auto segment_options = to_pipeline_options(field_values, segment_values);
         pipeline::OutputDirectory dir(common.output, common.overwrite);
 

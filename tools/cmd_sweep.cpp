@@ -47,7 +47,8 @@ int run_sweep(int argc, char** argv) {
         if (vm.count("min-areas") && !vm["area-ratios"].defaulted())
             throw UsageError("give --area-ratios or --min-areas, not both");
         const bool by_area = vm.count("min-areas") > 0;
-        to_field_options(field_values, vm);  // refuses contradictions (exit status 2)
+        // (refuses contradictions: exit status 2)
+        field_values.options = to_field_options(field_values, vm);
         const auto segment_options = to_pipeline_options(field_values, segment_values);
         std::vector<double> ratios;
         std::vector<pipeline::AreaThreshold> areas;

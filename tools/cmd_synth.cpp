@@ -1,19 +1,42 @@
 // terrain synth -o OUT.lbl: a synthetic cratered Vesta tile written as a PDS3 DEM in the layout
 // of the Dawn HAMO DTM (the sample examples/data/vesta_hamo_tile.lbl is made this way).
+#include <cmath>
 #include <cstdint>
+#include <fstream>
 #include <iostream>
 #include <string>
 
 #include "cli.hpp"
+#include "terrain/core/error.hpp"
 #include "terrain/io/write_pds3_dem.hpp"
 #include "terrain/synth/crater_field.hpp"
 
 namespace terrain::cli {
+namespace {
+
+// The tile's crater population as CSV, centres in pixels of the tile ((0,0) the top-left
+// corner), diameters on the ground and in pixels along a row.
+void write_crater_list(const synth::VestaTileOptions& tile, const Dem& dem,
+                       const std::string& path, bool overwrite) {
+    if (!overwrite && std::ifstream(path)) throw Error("synth", path + " exists (--overwrite replaces it)");
+    std::ofstream out(path);
+    if (!out) throw Error("synth", "cannot write " + path);
+    const double pixel = std::abs(dem.transform[1]);
+    out << "id,col,row,diameter_m,diameter_px,degradation,age\n";
+    out.precision(10);
+    std::size_t id = 0;
+    for (const auto& c : synth::vesta_crater_population(tile))
+        out << ++id << ',' << c.col << ',' << c.row << ',' << c.diameter << ','
+            << c.diameter / pixel << ',' << c.degradation << ',' << c.age << '\n';
+    if (!out.flush()) throw Error("synth", "cannot write " + path);
+}
+
+}  // namespace
 
 int run_synth(int argc, char** argv) {
     return guarded("synth", [&] {
         synth::VestaTileOptions tile;
-        std::string output;
+        std::string output, craters_csv;
         std::uint64_t seed = tile.seed;
         bool overwrite = false, quiet = false;
         po::options_description options("terrain synth options");
@@ -27,13 +50,17 @@ int run_synth(int argc, char** argv) {
             "longitude of the tile centre, degrees east")(
             "lat", po::value(&tile.center_lat)->default_value(tile.center_lat),
             "latitude of the tile centre, degrees (within +-80)")(
+            "craters", po::value(&craters_csv),
+            "also write the generated craters as CSV (id, col, row in pixels of the tile, "
+            "diameter_m, diameter_px, degradation, age), oldest first: the truth the crater "
+            "benchmarks score against")(
             "overwrite", po::bool_switch(&overwrite), "replace existing files")(
             "quiet,q", po::bool_switch(&quiet), "no progress output");
         po::positional_options_description positional;
         po::variables_map vm;
         if (!parse(argc, argv,
                    "terrain synth -o OUT.lbl [--width 512] [--height 512] [--seed N] [--lon DEG] "
-                   "[--lat DEG] [--overwrite] [-q]",
+                   "[--lat DEG] [--craters CSV] [--overwrite] [-q]",
                    options, positional, vm))
             return 0;
         tile.seed = seed;
@@ -50,6 +77,7 @@ int run_synth(int argc, char** argv) {
             ") in the layout of the Dawn FC2 HAMO DTM: planetary radius = DN * 2 + 255000 m, "
             "64 pixels per degree. Not real data.";
         io::write_pds3_dem(dem, output, pds);
+        if (!craters_csv.empty()) write_crater_list(tile, dem, craters_csv, overwrite);
         report_progress(progress, 1.0, "write");
         std::cout << "Wrote " << output << " (PDS3 label) and " << io::pds3_image_path(output)
                   << " (" << dem.width << " x " << dem.height

@@ -13,8 +13,15 @@ struct FieldOptionValues {
     std::string window = "disk";      // --window
     double cone_angle_degrees = 120;  // --cone-angle (the library takes radians)
     bool no_postprocess = false;
+    std::string radius;  // --radius as given: metres, or "auto"
+    std::string radii;   // --radii as given: metres, comma-separated
     field::FieldOptions options;
 };
+
+// True when none of the options that set a scale was given (--rings, --radius, --radii,
+// --persistence, --area-ratio, --min-area, --area-ratios, --min-areas): a DEM then takes the
+// landform defaults (pipeline::SegmentOptions::landform_defaults).
+bool no_scale_option(const po::variables_map& vm);
 
 // Adds --field, --rings, --radius, --window and the SDF's --rays, --cone-angle, --no-postprocess,
 // --allow-open bound to `values`.
@@ -31,7 +38,9 @@ field::ShapeIndexWindow parse_window(const std::string& name);
 // The library's options from the parsed values; throws UsageError for contradictions.
 field::FieldOptions to_field_options(const FieldOptionValues& values, const po::variables_map& vm);
 
-// Throws terrain::Error when --radius exceeds kMaxRadiusEdges mean edge lengths of `mesh`.
+// Throws terrain::Error when --radius exceeds kMaxRadiusEdges mean edge lengths of `mesh`
+// with a window whose cost grows with the radius (the ball, or a mesh read from a file); the
+// disk window on a DEM costs the same at any radius and takes any.
 void check_field_limits(const field::FieldOptions& options, const TriangleMesh& mesh);
 
 }  // namespace terrain::cli

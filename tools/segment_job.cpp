@@ -14,14 +14,16 @@ void add_segment_options(po::options_description& options, SegmentOptionValues& 
         "cancel arcs whose area ratio is below A percent of the surface")(
         "min-area", po::value(&values.min_area),
         "instead of --area-ratio: cancel arcs whose area on the body is below AREA (m^2, or "
-        "5km2, 2000m2, 3ha)")(
+        "5km2, 2000m2, 3ha), or auto: 20 pixels of the DEM (the default when no scale option "
+        "is given)")(
         "cost", po::value(&values.cost)->default_value("auto"),
         "graph (Reeb-graph constrained), standard, or auto: graph for DEMs, standard for meshes")(
         "saddle-penalty", po::value(&values.grow.saddle_penalty)->default_value(20.0),
         "graph cost: penalty for joining a saddle with several unassigned branches")(
-        "absorbed", po::value(&values.absorbed)->default_value("divide"),
+        "absorbed", po::value(&values.absorbed)->default_value("auto"),
         "divide: the vertices cancellations absorbed go back to the regions around them by "
-        "their own values; whole: each surviving node grows as one unit (the paper)")(
+        "their own values; whole: each surviving node grows as one unit (the paper); auto: "
+        "divide for DEMs, whole for mesh files")(
         "format", po::value(&values.format)->default_value("GeoJSON"),
         "OGR driver of the region polygons (GeoJSON, GPKG, ...)")(
         "timings", po::bool_switch(&values.timings), "print the time of each stage");
@@ -37,7 +39,7 @@ pipeline::SegmentOptions to_pipeline_options(const FieldOptionValues& field,
     pipeline::SegmentOptions out;
     out.field = field.name;
     out.shape_index = field.options.shape_index;
-    out.shape_index.window = parse_window(field.window);
+    out.shape_index.window = parse_window(field.window);  // (to_field_options parsed it too)
     out.rays = field.options.sdf.rays;
     out.cone_angle_degrees = field.cone_angle_degrees;
     out.postprocess = !field.no_postprocess;
@@ -48,6 +50,7 @@ pipeline::SegmentOptions to_pipeline_options(const FieldOptionValues& field,
     out.saddle_penalty = values.grow.saddle_penalty;
     out.absorbed = values.absorbed;
     out.format = values.format;
+    out.landform_defaults = values.landform_defaults;
     pipeline::check_options(out);
     return out;
 }

@@ -17,7 +17,8 @@ struct SegmentOptionValues {
     std::string min_area;  // --min-area as given, or empty
     segment::GrowOptions grow;
     std::string cost = "auto";
-    std::string absorbed = "divide";
+    std::string absorbed = "auto";
+    bool landform_defaults = false;  // no scale option given (no_scale_option)
     std::string format = "GeoJSON";
     bool timings = false;
 };

@@ -391,8 +391,29 @@ PYBIND11_MODULE(_terrain, m) {
             "rings", [](const pipeline::SegmentOptions& o) { return o.shape_index.rings; },
             [](pipeline::SegmentOptions& o, int v) { o.shape_index.rings = v; })
         .def_property(
-            "radius", [](const pipeline::SegmentOptions& o) { return o.shape_index.radius; },
-            [](pipeline::SegmentOptions& o, double v) { o.shape_index.radius = v; })
+            "radius",
+            [](const pipeline::SegmentOptions& o) -> py::object {
+                if (o.shape_index.auto_scale) return py::str("auto");
+                return py::float_(o.shape_index.radius);
+            },
+            [](pipeline::SegmentOptions& o, const py::object& v) {
+                // Metres, or "auto": the radius chosen per vertex (docs/field.md).
+                if (py::isinstance<py::str>(v)) {
+                    if (v.cast<std::string>() != "auto")
+                        throw Error("options", "radius takes metres or \"auto\", not '" +
+                                                   v.cast<std::string>() + "'");
+                    o.shape_index.auto_scale = true;
+                    return;
+                }
+                o.shape_index.auto_scale = false;
+                o.shape_index.radius = v.cast<double>();
+            })
+        .def_property(
+            "radii", [](const pipeline::SegmentOptions& o) { return o.shape_index.radii; },
+            [](pipeline::SegmentOptions& o, const std::vector<double>& v) {
+                o.shape_index.radii = v;
+            })
+        .def_readwrite("landform_defaults", &pipeline::SegmentOptions::landform_defaults)
         .def_property(
             "window",
             [](const pipeline::SegmentOptions& o) {

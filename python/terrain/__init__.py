@@ -40,10 +40,13 @@ __all__ = [
 
 # The options of `terrain segment` (docs/cli.md), as keyword arguments.
 _SEGMENT_OPTIONS = (
-    "field", "rings", "radius", "window", "rays", "cone_angle", "postprocess", "allow_open",
+    "field", "rings", "radius", "radii", "window", "rays", "cone_angle", "postprocess", "allow_open",
     "persistence", "area_ratio", "min_area", "cost", "saddle_penalty", "absorbed",
     "format",
 )
+# The options that set a scale: given none, a DEM takes the landform defaults (radius "auto",
+# min_area "auto"; docs/segment.md), as `terrain segment` does.
+_SCALE_OPTIONS = ("rings", "radius", "radii", "persistence", "area_ratio", "min_area")
 # How the input is read and meshed.
 _INPUT_OPTIONS = ("band", "elevation", "nan_nodata", "pixel_size", "frame", "repair",
                   "max_memory")
@@ -99,6 +102,11 @@ def _split_options(options, allowed):
     read = {}
     if "rings" in options and options.get("radius", 0):
         raise Error("field: give rings or radius, not both")
+    if "radii" in options and options.get("radius") != "auto":
+        raise Error("field: radii goes with radius=\"auto\"")
+    # No scale option: a DEM takes the landform defaults, as on the command line.
+    native.landform_defaults = not any(
+        options.get(name) is not None for name in _SCALE_OPTIONS)
     if options.get("area_ratio") is not None and options.get("min_area") is not None:
         raise Error("segment: give area_ratio or min_area, not both")
     for name, value in options.items():
@@ -210,16 +218,23 @@ class SegmentResult:
 def segment(dem, geotransform=None, crs=None, *, progress=None, **options):
     """Segment a DEM (or a mesh file) into landform regions, as `terrain segment` does.
 
+    Given no scale option (rings, radius, radii, persistence, area_ratio, min_area), a DEM
+    takes the landform defaults: radius="auto", min_area="auto" (docs/segment.md); any of
+    them gives the paper's single scale for the rest (rings=2, persistence=10,
+    area_ratio=0.5).
+
     dem: a path (DEM or .off/.ply/.obj mesh), a terrain.Dem, or a 2-D numpy array of
         elevations in metres (NaN = NoData) with its GDAL `geotransform` (6 numbers or an
         affine.Affine) and `crs` (WKT, "EPSG:32611", "IAU_2015:30100", or a CRS object).
     options (keywords, the command line's defaults): field="shape-index" (or "sdf",
-        "height"), rings=2, radius=0, window="disk" (or "ball"; docs/field.md), rays=25, cone_angle=120, postprocess=True,
+        "height"), rings=2, radius=0 (metres, or "auto": chosen per vertex among radii, a
+        list of metres; docs/field.md), window="disk" (or "ball"), rays=25, cone_angle=120,
+        postprocess=True,
         allow_open=False, persistence=10, area_ratio=0.5 (percent) or min_area (an area on
         the body: m^2 as a number, or "5km2", "2000m2", "3ha"; an arc is cancelled when its
         area is below it, whatever the tile's extent), cost="auto" ("graph",
-        "standard"), saddle_penalty=20, absorbed="divide" (or "whole", the paper's
-        growing), format="GeoJSON"; reading: band=1,
+        "standard"), saddle_penalty=20, absorbed="auto" ("divide" for DEMs, "whole", the
+        paper's growing, for meshes), format="GeoJSON"; reading: band=1,
         elevation="auto", nan_nodata=False, pixel_size=None, frame="auto", repair=False,
         max_memory=None (bytes, or "512M", "4G" as --max-memory: a file whose estimated
         peak memory exceeds it, or the memory available, is refused before it is read).

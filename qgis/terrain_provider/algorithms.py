@@ -16,6 +16,7 @@ from qgis.core import (
     QgsProcessingOutputRasterLayer,
     QgsProcessingOutputVectorLayer,
     QgsProcessingParameterBand,
+    QgsProcessingParameterBoolean,
     QgsProcessingParameterEnum,
     QgsProcessingParameterFolderDestination,
     QgsProcessingParameterNumber,
@@ -36,6 +37,10 @@ from . import backend
 FIELDS = ["shape-index", "sdf", "height"]
 COSTS = ["auto", "graph", "standard"]
 WINDOWS = ["disk", "ball"]
+# Landforms at their own scale (terrain segment with no scale option: docs/segment.md), or
+# the paper's single scale set by the options that follow.
+SCALES = ["landforms at their own scale (automatic)",
+          "single scale (rings or radius, persistence, area ratio)"]
 
 
 def region_colours(regions_path, layer=None):
@@ -132,7 +137,12 @@ class _Base(QgsProcessingAlgorithm):
         self.addParameter(QgsProcessingParameterBand("BAND", "Band", 1, "INPUT", optional=True))
 
     def add_segment_options(self, area_ratio=True):
+        if area_ratio:
+            self.addParameter(QgsProcessingParameterEnum(
+                "SCALE", "Scale", SCALES, defaultValue=0))
         self.addParameter(QgsProcessingParameterEnum("FIELD", "Field", FIELDS, defaultValue=0))
+        self.addParameter(QgsProcessingParameterBoolean(
+            "AUTO_RADIUS", "Shape index: radius chosen per pixel (auto, DEMs)", False))
         self.addParameter(QgsProcessingParameterNumber(
             "RINGS", "Shape index: rings (mesh edges)", QgsProcessingParameterNumber.Integer, 2,
             minValue=1))
@@ -162,8 +172,16 @@ class _Base(QgsProcessingAlgorithm):
             "cost": COSTS[self.parameterAsEnum(parameters, "COST", context)],
             "saddle_penalty": self.parameterAsDouble(parameters, "SADDLE_PENALTY", context),
         }
+        if area_ratio and self.parameterAsEnum(parameters, "SCALE", context) == 0:
+            # Landforms at their own scale: no scale option, as `terrain segment` with none.
+            for name in ("rings", "persistence"):
+                del options[name]
+            return options
         radius = self.parameterAsDouble(parameters, "RADIUS", context)
-        if radius > 0:  # instead of rings (giving both is refused)
+        if self.parameterAsBool(parameters, "AUTO_RADIUS", context):
+            del options["rings"]
+            options["radius"] = "auto"
+        elif radius > 0:  # instead of rings (giving both is refused)
             del options["rings"]
             options["radius"] = radius
             options["window"] = WINDOWS[self.parameterAsEnum(parameters, "WINDOW", context)]

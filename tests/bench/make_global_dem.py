@@ -2,7 +2,11 @@
 """Writes a global equirectangular DEM on Vesta's sphere (radius 255 km) as a tiled GeoTIFF:
 craters (power-law radii, uniform on the sphere), long waves and pixel noise; radii stored as
 Float32 in 2 m steps like the HAMO DNs.
-  make_global_dem.py OUT.tif WIDTH [SEED]     (height = WIDTH / 2)"""
+  make_global_dem.py OUT.tif WIDTH [SEED] [--craters CSV]     (height = WIDTH / 2)
+--craters writes the craters (the truth bench_craters.py scores against): id, lon, lat
+(degrees), col, row (pixels, (0,0) the grid's top-left corner), diameter_m, diameter_px
+(along a meridian), col_scale (cos lat: ground per column over ground per row), degradation
+(0: every crater is fresh here)."""
 import sys
 import numpy as np
 from osgeo import gdal, osr
@@ -10,9 +14,27 @@ from osgeo import gdal, osr
 R = 255000.0
 
 
+def write_craters(path, lon_c, lat_c, radii, width, height):
+    px = 2 * np.pi * R / width
+    with open(path, "w") as f:
+        f.write("id,lon,lat,col,row,diameter_m,diameter_px,col_scale,degradation\n")
+        for i in range(len(radii)):
+            col = lon_c[i] / (2 * np.pi) * width
+            row = (np.pi / 2 - lat_c[i]) / np.pi * height
+            f.write(f"{i + 1},{np.degrees(lon_c[i]):.6f},{np.degrees(lat_c[i]):.6f},{col:.4f},"
+                    f"{row:.4f},{2 * radii[i]:.3f},{2 * radii[i] / px:.4f},"
+                    f"{np.cos(lat_c[i]):.6f},0\n")
+
+
 def main():
-    out, width = sys.argv[1], int(sys.argv[2])
-    seed = int(sys.argv[3]) if len(sys.argv) > 3 else 7
+    args = sys.argv[1:]
+    craters = None
+    if "--craters" in args:
+        k = args.index("--craters")
+        craters = args[k + 1]
+        del args[k:k + 2]
+    out, width = args[0], int(args[1])
+    seed = int(args[2]) if len(args) > 2 else 7
     height = width // 2
     rng = np.random.default_rng(seed)
     # Craters: power-law radii (metres), uniform on the sphere.
@@ -24,6 +46,8 @@ def main():
     lon_c = rng.random(n) * 2 * np.pi
     lat_c = np.arcsin(rng.random(n) * 2 - 1)
     depth = 0.2 * radii
+    if craters:
+        write_craters(craters, lon_c, lat_c, radii, width, height)
     # Low-frequency relief: a few spherical harmonics-like waves.
     waves = [(rng.integers(1, 12), rng.integers(1, 8), rng.random() * 2 * np.pi, 3000.0 / (k + 1))
              for k in range(12)]

@@ -62,14 +62,17 @@ def test_sweep(moon, cli, tmp_path):
 
 
 def test_shape_index(result, moon):
-    si = terrain.shape_index(moon)
+    # The default segmentation's field is the shape index at the scale chosen per vertex.
+    si = terrain.shape_index(moon, radius="auto")
     assert si.shape == result.labels.shape
     valid = np.isfinite(si)
     assert valid.mean() > 0.9
     assert si[valid].min() >= 0 and si[valid].max() <= 100
     assert np.allclose(si[valid], result.field[valid])
+    rings = terrain.shape_index(moon)
+    assert not np.allclose(rings[valid], si[valid])
     wider = terrain.shape_index(moon, rings=4)
-    assert not np.allclose(wider[valid], si[valid])
+    assert not np.allclose(wider[valid], rings[valid])
 
 
 def test_reeb_graph(moon, cli, tmp_path):

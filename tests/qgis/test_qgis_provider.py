@@ -88,8 +88,9 @@ def test_segment_on_vesta(qgis, cli_vesta, tmp_path, backend):
 
 def test_segment_parameters_reach_terrain(qgis, tmp_path):
     out = tmp_path / "out"
-    done, results = qgis("terrain:segment", INPUT=MOON, OUTPUT=out, PERSISTENCE=5, AREA_RATIO=1,
-                         COST=2, RINGS=3)
+    # SCALE 1: the single scale of the options given (0, the default, is the landforms').
+    done, results = qgis("terrain:segment", INPUT=MOON, OUTPUT=out, SCALE=1, PERSISTENCE=5,
+                         AREA_RATIO=1, COST=2, RINGS=3)
     assert done.returncode == 0, done.stdout + done.stderr
     parameters = json.loads((out / "run.json").read_text())["parameters"]
     assert parameters["persistence"] == 5 and parameters["area_ratio_percent"] == 1
@@ -103,14 +104,25 @@ def test_segment_at_a_radius(qgis, tmp_path):
     labels = {}
     for backend in ("module", "cli"):
         out = tmp_path / backend
-        done, _ = qgis("terrain:segment", backend=backend, INPUT=MOON, OUTPUT=out, RADIUS=30000,
-                       WINDOW=1)
+        done, _ = qgis("terrain:segment", backend=backend, INPUT=MOON, OUTPUT=out, SCALE=1,
+                       RADIUS=30000, WINDOW=1)
         assert done.returncode == 0, done.stdout + done.stderr
         parameters = json.loads((out / "run.json").read_text())["parameters"]
         assert parameters["radius"] == 30000 and parameters["shape_index_window"] == "ball"
         ds = gdal.Open(str(out / "labels.tif"))
         labels[backend] = ds.ReadAsArray()
     assert np.array_equal(labels["module"], labels["cli"])
+
+
+def test_segment_with_the_radius_chosen_per_pixel(qgis, tmp_path):
+    # AUTO_RADIUS with a single area ratio: the command line's --radius auto --area-ratio 1.
+    out = tmp_path / "auto"
+    done, _ = qgis("terrain:segment", INPUT=MOON, OUTPUT=out, SCALE=1, AUTO_RADIUS=True,
+                   AREA_RATIO=1)
+    assert done.returncode == 0, done.stdout + done.stderr
+    parameters = json.loads((out / "run.json").read_text())["parameters"]
+    assert parameters["radius"] == "auto" and parameters["area_ratio_percent"] == 1
+    assert len(parameters["radii_m"]) >= 2
 
 
 def test_library_errors_reach_qgis(qgis, tmp_path):

@@ -84,7 +84,7 @@ void gather(const TriangleMesh& mesh, std::int32_t v, const ShapeIndexOptions& o
 
 }  // namespace
 
-GridLayout grid_layout(const TriangleMesh& mesh) {
+GridLayout grid_layout(const TriangleMesh& mesh, double tile_angle) {
     GridLayout g;
     g.width = mesh.grid_width, g.height = mesh.grid_height;
     g.seam = mesh.seam_closed;
@@ -119,7 +119,7 @@ GridLayout grid_layout(const TriangleMesh& mesh) {
                     }
             }
         if (spacing > 0)
-            g.disk_tile = int(std::clamp(kMaxDiskTileAngle * radius / spacing, 8.0, 64.0));
+            g.disk_tile = int(std::clamp(tile_angle * radius / spacing, 8.0, 64.0));
     }
     return g;
 }
@@ -131,9 +131,13 @@ bool dem_mesh(const TriangleMesh& mesh) {
            mesh.vertex_pixel.size() == mesh.vertex_count();
 }
 
+}  // namespace
+
 bool disk_applies(const TriangleMesh& mesh, const ShapeIndexOptions& options) {
     return options.radius > 0 && options.window == ShapeIndexWindow::disk && dem_mesh(mesh);
 }
+
+namespace {
 
 // Solves the symmetric positive system A x = b (n <= 5) by Cholesky; false if singular.
 template <int N>
@@ -857,7 +861,7 @@ void for_each_vertex(const TriangleMesh& mesh, const ShapeIndexOptions& options,
     const auto normals = vertex_normals(mesh, scaled_progress(progress, 0, 0.05));
     const bool grid = grid_applies(mesh, options), disk = disk_applies(mesh, options);
     GridLayout layout;
-    if (grid || disk) layout = grid_layout(mesh);
+    if (grid || disk) layout = grid_layout(mesh, options.disk_tile_angle);
     report_progress(progress, 0.06, "shape index");
     if (grid) {
         grid_for_each_vertex(mesh, layout, options, normals, scaled_progress(progress, 0.06, 1),
@@ -892,6 +896,12 @@ void for_each_vertex(const TriangleMesh& mesh, const ShapeIndexOptions& options,
 }
 
 }  // namespace
+
+void for_each_curvature(const TriangleMesh& mesh, const ShapeIndexOptions& options,
+                        const ProgressFn& progress, const CurvatureBody& body) {
+    for_each_vertex(mesh, options, progress, body);
+}
+
 }  // namespace detail
 
 using namespace detail;
@@ -924,6 +934,7 @@ std::vector<PrincipalCurvatures> principal_curvatures(const TriangleMesh& mesh,
 
 std::vector<float> shape_index_field(const TriangleMesh& mesh, const ShapeIndexOptions& options,
                                      const ProgressFn& progress) {
+    if (options.auto_scale) return scale_selected_shape_index(mesh, options, progress).field;
     constexpr float kUnknown = -1.0f;
     std::vector<float> field(mesh.vertex_count(), kUnknown);
     for_each_vertex(mesh, options, progress,

@@ -130,7 +130,7 @@ constexpr int kMaxReach = 128;  // a window reaching further (pixels) takes the 
 
 // The vertex a pixel owns (-1 where none, and on collapsed pole rows), the grid's seam and
 // the disk window's tile size.
-GridLayout grid_layout(const TriangleMesh& mesh);
+GridLayout grid_layout(const TriangleMesh& mesh, double tile_angle = kMaxDiskTileAngle);
 
 // The disk window: the pixels whose ground offset from the vertex, lifted onto the vertex's
 // tangent plane, is within the radius (the ball's footprint where the terrain is its tangent
@@ -269,6 +269,8 @@ using VertexFn = std::function<void(std::int32_t, bool, const PrincipalCurvature
 inline void tile_fallback(const TriangleMesh& mesh, std::int32_t v, const Vec3& normal,
                           const ShapeIndexOptions& options, const GridLayout* disk_grid,
                           GridScratch& s, std::size_t& fallbacks, const VertexFn& body) {
+    const bool pole = v == mesh.pole_vertices[0] || v == mesh.pole_vertices[1];
+    if (options.skip_wide && !pole) return body(v, false, PrincipalCurvatures{}, 0.0);
     PrincipalCurvatures k;
     double scale = 0;
     const bool ok = mesh_fit(mesh, v, normal, options, disk_grid, s.mesh, k, scale);
@@ -364,5 +366,13 @@ bool disk_mesh_fit(const TriangleMesh& mesh, const GridLayout& g, std::int32_t v
 void disk_tile(const TriangleMesh& mesh, const GridLayout& g, const std::vector<Vec3>& normals,
                const ShapeIndexOptions& options, int r0, int c0, GridScratch& s,
                std::size_t& mesh_fallbacks, const VertexFn& body);
+
+// Every vertex's fit with `options` (rings or one radius): body(v, ok, curvatures, scale),
+// the curvatures times `scale` (shape_index.cpp's for_each_vertex), on several threads.
+using CurvatureBody =
+    std::function<void(std::int32_t, bool, const PrincipalCurvatures&, double)>;
+void for_each_curvature(const TriangleMesh& mesh, const ShapeIndexOptions& options,
+                        const ProgressFn& progress, const CurvatureBody& body);
+bool disk_applies(const TriangleMesh& mesh, const ShapeIndexOptions& options);
 
 }  // namespace terrain::field::detail

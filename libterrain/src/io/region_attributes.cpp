@@ -82,6 +82,7 @@ std::vector<Attribute> region_attributes(const segment::RegionGraph& graph,
     a.push_back({"field_max", r.field_max});
     a.push_back({"landform", std::string(segment::to_string(r.landform))});
     a.push_back({"neighbor_count", as_int(r.neighbor_count)});
+    if (graph.has_field_scale) a.push_back({"field_scale_m", r.field_scale_m});
     a.push_back({"representative_vertex", std::int64_t{r.representative_vertex}});
     const bool lonlat = graph.point_frame == segment::PointFrame::lonlat;
     const bool mesh = graph.point_frame == segment::PointFrame::mesh;

@@ -98,14 +98,37 @@ void check_options(const SegmentOptions& o) {
     if (!std::isfinite(o.saddle_penalty) || o.saddle_penalty < 0)
         throw Error("segment", "--saddle-penalty must be a number >= 0");
     if (o.cost != "auto") segment::parse_grow_cost(o.cost);
-    if (!o.min_area.empty()) parse_area(o.min_area);
+    if (!o.min_area.empty() && o.min_area != "auto") parse_area(o.min_area);
     parse_absorbed(o.absorbed);
 }
 
-Absorbed parse_absorbed(const std::string& name) {
+Absorbed parse_absorbed(const std::string& name, bool dem) {
     if (name == "divide") return Absorbed::divide;
     if (name == "whole") return Absorbed::whole;
-    throw Error("segment", "--absorbed is divide or whole; '" + name + "' is neither");
+    if (name == "auto") return dem ? Absorbed::divide : Absorbed::whole;
+    throw Error("segment", "--absorbed is divide, whole or auto; '" + name + "' is none of them");
+}
+
+SegmentOptions resolve_options(const SegmentOptions& options, bool dem) {
+    SegmentOptions out = options;
+    if (out.absorbed == "auto") out.absorbed = dem ? "divide" : "whole";
+    if (out.landform_defaults && dem && out.field == "shape-index") {
+        out.shape_index.auto_scale = true;
+        out.min_area = "auto";
+    }
+    out.landform_defaults = false;
+    return out;
+}
+
+double min_area_m2(const SegmentOptions& options, const TriangleMesh& mesh) {
+    if (options.min_area.empty()) return 0;
+    if (options.min_area != "auto") return parse_area(options.min_area);
+    double area = 0;
+    for (const float a : mesh.vertex_areas) area += a;
+    const double n = double(std::max<std::size_t>(1, mesh.vertex_areas.size()));
+    if (!(area > 0) || !std::isfinite(area))
+        throw Error("segment", "--min-area auto needs a mesh with a positive area");
+    return kAutoMinAreaPixels * area / n;
 }
 
 double parse_area(const std::string& text, const std::string& option) {
@@ -140,7 +163,7 @@ reeb::SimplifyOptions simplify_options(const SegmentOptions& options, const Tria
     reeb::SimplifyOptions out = options.simplify;
     out.rewrite_field = false;  // (the regions grow on the graph and the field as computed)
     if (!options.min_area.empty())
-        out.area_ratio = reeb::area_ratio_for_area(mesh, parse_area(options.min_area));
+        out.area_ratio = reeb::area_ratio_for_area(mesh, min_area_m2(options, mesh));
     return out;
 }
 
@@ -204,8 +227,16 @@ std::vector<std::uint32_t> SegmentResult::label_pixels() const {
 void compute_field(SegmentResult& result, const SegmentOptions& options,
                    const ProgressFn& progress) {
     const auto t0 = clock::now();
-    result.field =
-        field::vertex_field(result.input.mesh, result.dem(), field_options(options), progress);
+    const auto fo = field_options(options);
+    if (fo.kind == field::FieldKind::shape_index && fo.shape_index.auto_scale) {
+        auto selected = field::scale_selected_shape_index(result.input.mesh, fo.shape_index,
+                                                          progress);
+        result.field = std::move(selected.field);
+        result.field_scale = std::move(selected.scale);
+        result.field_radii = std::move(selected.radii);
+    } else {
+        result.field = field::vertex_field(result.input.mesh, result.dem(), fo, progress);
+    }
     if (options.field == "shape-index") {
         result.shape_index_method =
             field::shape_index_method(result.input.mesh, options.shape_index);
@@ -260,7 +291,8 @@ ScaleResult grow_scale(const Input& input, const std::vector<float>& field,
     segment::GrowOptions grow;
     grow.saddle_penalty = options.saddle_penalty;
     grow.cost = grow_cost(options, input.dem.has_value());
-    const bool divide = parse_absorbed(options.absorbed) == Absorbed::divide;
+    const bool divide =
+        parse_absorbed(options.absorbed, input.dem.has_value()) == Absorbed::divide;
     out.segmentation = segment::grow_regions(input.mesh, simplified.graph, grow,
                                              scaled_progress(progress, 0, divide ? 0.5 : 1));
     if (divide)
@@ -346,11 +378,35 @@ ScaleResult segment_scale(const Input& input, const std::vector<float>& field,
                       scaled_progress(progress, 0.3, 1));
 }
 
-SegmentResult segment(Input input, const SegmentOptions& options, const ProgressFn& progress) {
-    check_options(options);
+// Each region's field scale: the ladder's radius most of its vertices took (ties to the
+// smaller), then the per-vertex scales are freed.
+void set_region_scales(SegmentResult& result) {
+    auto& scale = result.field_scale;
+    const auto& labels = result.segmentation.labels;
+    auto& regions = result.regions.regions;
+    if (scale.empty() || scale.size() != labels.size()) return;
+    const std::size_t rungs = result.field_radii.size();
+    std::vector<std::uint32_t> counts(regions.size() * rungs, 0);
+    for (std::size_t v = 0; v < labels.size(); ++v)
+        if (labels[v] >= 1 && labels[v] <= regions.size() && scale[v] < rungs)
+            ++counts[(labels[v] - 1) * rungs + scale[v]];
+    for (std::size_t r = 0; r < regions.size(); ++r) {
+        std::size_t best = 0;
+        for (std::size_t k = 1; k < rungs; ++k)
+            if (counts[r * rungs + k] > counts[r * rungs + best]) best = k;
+        regions[r].field_scale_m = counts[r * rungs + best] > 0 ? result.field_radii[best] : 0;
+    }
+    result.regions.has_field_scale = true;
+    std::vector<std::uint8_t>().swap(scale);
+}
+
+SegmentResult segment(Input input, const SegmentOptions& requested, const ProgressFn& progress) {
+    check_options(requested);
+    const SegmentOptions options = resolve_options(requested, input.dem.has_value());
     // A polygon format that cannot hold the DEM's coordinates is refused before any work.
     if (input.dem) io::check_polygon_format(*input.dem, options.format);
     SegmentResult result;
+    result.options = options;
     result.input = std::move(input);
     result.timings.push_back({"read", result.input.read_seconds});
     if (result.input.dem) result.timings.push_back({"mesh", result.input.mesh_seconds});
@@ -448,6 +504,7 @@ SegmentResult segment(Input input, const SegmentOptions& options, const Progress
     result.parked_bytes = parked.parked_bytes();
     const auto thresholds = simplify_options(options, result.input.mesh);
     result.area_ratio_percent = thresholds.area_ratio;
+    result.min_area_m2 = min_area_m2(options, result.input.mesh);
     // The areas wait on disk again once the simplification has read them, and the graph's
     // vertices' nodes until its output reads them (both before its peak of memory, the end
     // of its copy of the arcs). (Parked without progress: the simplification reports around
@@ -501,6 +558,7 @@ SegmentResult segment(Input input, const SegmentOptions& options, const Progress
         result.segmentation.region_count, result.dem(), scaled_progress(progress, 0.905, 1));
     // On a DEM, with the regions of valid pixels in no triangle (segment::label_pixels).
     result.segmentation.region_count = static_cast<std::uint32_t>(result.regions.regions.size());
+    set_region_scales(result);
     result.add_time("grow", placing + scale.grow_seconds + since(t1));
     result.parked_file = parked.file_peak();
     result.parked_most = parked.most_parked();
@@ -535,11 +593,20 @@ void release_large_data(SegmentResult& result) {
     release_free_memory();
 }
 
+// The preview's words for a scale chosen per vertex: the ladder's ends.
+std::string scale_caption(const std::vector<double>& radii) {
+    if (radii.empty()) return "radius auto";
+    return "radius auto (" + std::to_string(radii.size()) + " radii, " +
+           JsonWriter::number(std::round(radii.front())) + "-" +
+           JsonWriter::number(std::round(radii.back())) + " m)";
+}
+
 std::vector<std::string> write_segment_directory(SegmentResult& result,
-                                                 const SegmentOptions& options,
+                                                 const SegmentOptions& given,
                                                  const std::string& input_path,
                                                  const std::string& dir, const WriteOptions& write,
                                                  const ProgressFn& progress) {
+    const SegmentOptions options = resolve_options(given, result.input.dem.has_value());
     const auto t0 = clock::now();
     release_free_memory();  // (freed blocks a program keeps: GDAL's block cache comes next)
     io::SegmentOutputOptions out;
@@ -547,7 +614,9 @@ std::vector<std::string> write_segment_directory(SegmentResult& result,
     out.preview_caption.input = fs::path(input_path).filename().string();
     out.preview_caption.field = options.field;
     auto& caption = out.preview_caption.parameters;
-    if (options.field == "shape-index")
+    if (options.field == "shape-index" && options.shape_index.auto_scale)
+        caption.push_back(scale_caption(result.field_radii));
+    else if (options.field == "shape-index")
         caption.push_back(
             options.shape_index.radius > 0
                 ? "radius " + JsonWriter::number(options.shape_index.radius) + " m (" +
@@ -594,9 +663,10 @@ std::vector<std::string> write_segment_directory(SegmentResult& result,
 }
 
 void write_run_json(const SegmentResult& result, const std::string& input_path,
-                    const SegmentOptions& options, const std::vector<std::string>& files,
+                    const SegmentOptions& given, const std::vector<std::string>& files,
                     const std::string& path,
                     const std::vector<std::pair<std::string, std::string>>& extra) {
+    const SegmentOptions options = resolve_options(given, result.input.dem.has_value());
     std::ofstream os(path, std::ios::binary);
     if (!os) throw Error("write", "cannot write " + path);
     JsonWriter j(os);
@@ -608,13 +678,19 @@ void write_run_json(const SegmentResult& result, const std::string& input_path,
     j.key("parameters")
         .begin_object()
         .field("field", options.field)
-        .field("rings", options.shape_index.rings)
-        .field("radius", options.shape_index.radius)
-        .field("persistence", options.simplify.persistence)
+        .field("rings", options.shape_index.rings);
+    if (options.shape_index.auto_scale) {
+        j.field("radius", "auto").key("radii_m").begin_array();
+        for (const double r : result.field_radii) j.value(r);
+        j.end_array().field("contrast_curvedness", options.shape_index.contrast_curvedness);
+    } else {
+        j.field("radius", options.shape_index.radius);
+    }
+    j.field("persistence", options.simplify.persistence)
         .field("area_ratio_percent",
                options.min_area.empty() ? options.simplify.area_ratio : result.area_ratio_percent);
     if (!options.min_area.empty())
-        j.field("min_area", options.min_area).field("min_area_m2", parse_area(options.min_area));
+        j.field("min_area", options.min_area).field("min_area_m2", result.min_area_m2);
     j.field("cost", options.cost == "auto" ? (dem ? "graph" : "standard") : options.cost.c_str())
         .field("saddle_penalty", options.saddle_penalty)
         .field("absorbed", options.absorbed)

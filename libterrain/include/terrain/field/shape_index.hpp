@@ -5,6 +5,7 @@
 // Sign convention fixed by behaviour: cap +1 (100), cup -1 (0), ridge +0.5 (75),
 // valley -0.5 (25), saddle and plane 0 (50).
 
+#include <cstdint>
 #include <vector>
 
 #include "terrain/core/progress.hpp"
@@ -34,6 +35,29 @@ struct ShapeIndexOptions {
     double planar_curvedness = 1e-4;
     ShapeIndexMethod method = ShapeIndexMethod::automatic;
     ShapeIndexWindow window = ShapeIndexWindow::disk;
+    // The analysis scale chosen per vertex (`--radius auto`, DEM meshes only; docs/field.md,
+    // "Scale chosen per vertex"): the disk window's fit is made over every radius of `radii`
+    // (metres, increasing; empty: field::default_radii of the mesh), each vertex's
+    // curvatures taken relative to the body's sphere, and its scale-normalised curvedness c
+    // (curvedness x radius) followed up the ladder. Each local maximum of c over the ladder
+    // is a peak; a vertex takes its first significant peak (c >= contrast_curvedness) unless
+    // a later one is peak_dominance times as strong, or its strongest peak when none is
+    // significant; a rise to the ladder's top is no peak (the landform is wider than the
+    // ladder: planar). The field is 50 + 50 SI w, the shape index of the chosen radius with
+    // its contrast w = c^2 / (c^2 + contrast_curvedness^2): shapes too weak to be seen at
+    // any scale read as planar. rings and radius are ignored.
+    bool auto_scale = false;
+    std::vector<double> radii;
+    double contrast_curvedness = 0.2;
+    double peak_dominance = 2.0;
+    // A vertex whose window reaches beyond the grid method's tables (the disk near a pole)
+    // gets no fit instead of the mesh path's (scale_selected_shape_index sets it above its
+    // first radius, where the window's cost would grow with the radius).
+    bool skip_wide = false;
+    // The largest angle on the body (radians) a tile of the disk window's sums spans; each
+    // tile's fits are made in the frame of its first vertex. scale_selected_shape_index widens
+    // it, so that its large radii do not pay for margins many times a small tile's area.
+    double disk_tile_angle = 0.05;
 };
 
 // The method shape_index_field takes for this mesh and these options: "grid" or "mesh".
@@ -57,8 +81,27 @@ std::vector<PrincipalCurvatures> principal_curvatures(const TriangleMesh& mesh,
                                                       const ProgressFn& progress = {});
 
 // Per-vertex shape index mapped to [0, 100]: 50 * (SI + 1). Multi-threaded, deterministic.
+// With options.auto_scale, the scale-selected field (scale_selected_shape_index's).
 std::vector<float> shape_index_field(const TriangleMesh& mesh,
                                      const ShapeIndexOptions& options = {},
                                      const ProgressFn& progress = {});
+
+// The ladder of radii `--radius auto` takes on a DEM mesh: 2, 4, 8, ..., 128 times the
+// mesh's pixel spacing (the square root of its mean vertex area), the largest kept below a
+// quarter of the grid's smaller side. Throws terrain::Error for a mesh not made from a DEM.
+std::vector<double> default_radii(const TriangleMesh& mesh);
+
+struct ScaleSelectedField {
+    std::vector<float> field;        // per vertex, in [0, 100] as shape_index_field's
+    std::vector<std::uint8_t> scale;  // per vertex, the index in `radii` of its radius
+    std::vector<double> radii;       // the ladder, metres
+};
+
+// The scale-selected shape index of options.auto_scale (options.radii, or default_radii).
+// Throws terrain::Error (stage "field") for a mesh not made from a DEM, a ladder that is
+// not increasing and positive, or more than 32 radii.
+ScaleSelectedField scale_selected_shape_index(const TriangleMesh& mesh,
+                                              const ShapeIndexOptions& options,
+                                              const ProgressFn& progress = {});
 
 }  // namespace terrain::field

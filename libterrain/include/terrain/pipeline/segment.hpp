@@ -74,7 +74,9 @@ struct SegmentOptions {
     bool postprocess = true;                    // sdf: bilateral smoothing of the face values
     bool allow_open = false;                    // sdf: a mesh with holes is accepted
     reeb::SimplifyOptions simplify{10.0, 0.5};  // persistence, area ratio (percent)
-    // The area threshold in the user's units ("5km2", "2000m2", "3ha", "1e6": m^2), or empty.
+    // The area threshold in the user's units ("5km2", "2000m2", "3ha", "1e6": m^2), "auto"
+    // (kAutoMinAreaPixels of the mesh's mean vertex area: the DEM's pixel, whatever the
+    // extent), or empty.
     // When set it replaces simplify.area_ratio: an arc is cancelled when its area on the body
     // is below it, applied as the equivalent ratio 100 * min_area / (the mesh's area) percent
     // (reeb::area_ratio_for_area), so the same landform is kept whatever the tile's extent.
@@ -83,9 +85,16 @@ struct SegmentOptions {
     double saddle_penalty = 20;
     std::string format = "GeoJSON";  // OGR driver of the region polygons
     // What the growing does with the vertices the simplification absorbed into surviving
-    // nodes: "divide" (default) gives them back to the regions around by their own values
-    // (segment::divide_absorbed); "whole" keeps each node one unit, as the paper does.
-    std::string absorbed = "divide";
+    // nodes: "divide" gives them back to the regions around by their own values
+    // (segment::divide_absorbed); "whole" keeps each node one unit, as the paper does;
+    // "auto" (default): divide on a DEM, whole on a mesh read from a file (where the paper's
+    // benchmark scores better so).
+    std::string absorbed = "auto";
+    // Landforms at their own scale (docs/segment.md, "Landforms at their own scale"): on a DEM
+    // with the shape index, the field's radius chosen per vertex (shape_index.auto_scale) and
+    // min_area "auto", whatever shape_index and min_area say; a mesh file is left as it is.
+    // The command line and the Python module set it when no scale option is given.
+    bool landform_defaults = false;
     // Large arrays that wait unread through the Reeb graph and the simplification (the DEM's
     // values, the field, the mesh's pixel maps) are parked in an unlinked temporary file in
     // this directory (empty: $TMPDIR, else /tmp) when they hold park_min_bytes or more; a
@@ -96,8 +105,16 @@ struct SegmentOptions {
 };
 
 enum class Absorbed { divide, whole };
-// "divide" or "whole"; throws terrain::Error otherwise.
-Absorbed parse_absorbed(const std::string& name);
+// "divide", "whole", or "auto" (divide when `dem`); throws terrain::Error otherwise.
+Absorbed parse_absorbed(const std::string& name, bool dem = true);
+
+// The smallest landform of min_area "auto", in mean vertex areas (pixels of a DEM): a floor
+// of about 5 pixels across, that of a crater of about 10.
+inline constexpr double kAutoMinAreaPixels = 20;
+// The options a run takes on this input: landform_defaults applied when `dem`.
+SegmentOptions resolve_options(const SegmentOptions& options, bool dem);
+// The area threshold in m^2 that options.min_area gives on `mesh` (0 when it is empty).
+double min_area_m2(const SegmentOptions& options, const TriangleMesh& mesh);
 
 // Thresholds and names, checked before any long work; throws terrain::Error.
 void check_options(const SegmentOptions& options);
@@ -158,6 +175,12 @@ struct SegmentResult {
     std::vector<StageTime> timings;         // read, mesh, field, reeb, simplify, grow, write
     std::optional<MeshCounts> mesh_counts;  // kept by release_large_data for run.json
     double area_ratio_percent = 0;          // the area-ratio threshold applied (percent)
+    double min_area_m2 = 0;                 // the area threshold applied (m^2), 0 if none
+    // With the scale chosen per vertex (shape_index.auto_scale): the ladder of radii
+    // (metres) and each vertex's index in it, freed once the region table holds the scale.
+    std::vector<double> field_radii;
+    std::vector<std::uint8_t> field_scale;
+    SegmentOptions options;  // as resolved for this input (resolve_options)
 
     const Dem* dem() const { return input.dem ? &*input.dem : nullptr; }
     void add_time(const std::string& name, double seconds);

@@ -60,6 +60,9 @@ struct Region {
     std::int32_t representative_vertex = -1;
     std::array<double, 3> point{0, 0, 0};
     std::size_t neighbor_count = 0;  // edges of the graph at this region
+    // The field's radius (metres) most of the region's vertices took when it was chosen per
+    // vertex (--radius auto; ties to the smaller), 0 otherwise.
+    double field_scale_m = 0;
 };
 
 // Two regions that share at least one mesh edge.
@@ -80,6 +83,7 @@ struct RegionGraph {
     // The CRS of the points when point_frame is lonlat (the body's geographic CRS; EPSG:4326
     // on Earth), as WKT; empty otherwise.
     std::string point_crs_wkt;
+    bool has_field_scale = false;  // the regions' field_scale_m are set (--radius auto)
 };
 
 // The regions of `labels` (one per vertex, 1..region_count, every id used) with their

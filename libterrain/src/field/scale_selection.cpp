@@ -1,0 +1,156 @@
+// The shape index at the scale chosen per vertex (`--radius auto`; docs/field.md, "Scale
+// chosen per vertex"): the disk window's fit over a ladder of radii, each vertex taking the
+// radius where its scale-normalised curvedness peaks (Lindeberg's automatic scale selection,
+// with curvedness x radius as the normalised measure: the same for a bowl of any size with
+// the same depth-to-diameter ratio).
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "shape_index_fit.hpp"
+#include "terrain/core/error.hpp"
+#include "terrain/field/shape_index.hpp"
+
+namespace terrain::field {
+namespace {
+
+constexpr std::size_t kMaxRadii = 32;
+// The ladder's tiles of sums may span this angle on the body (shape_index.hpp): the tilt of a
+// tile's frame is a slope, which the fit takes up, not a curvature.
+constexpr double kLadderTileAngle = 0.4;
+
+void check_dem_mesh(const TriangleMesh& mesh) {
+    if (mesh.grid_width <= 0 || mesh.grid_height <= 0 ||
+        mesh.vertex_pixel.size() != mesh.vertex_count())
+        throw Error("field",
+                    "--radius auto chooses the scale on a DEM's grid; a mesh read from a file "
+                    "takes --rings or --radius");
+}
+
+}  // namespace
+
+std::vector<double> default_radii(const TriangleMesh& mesh) {
+    check_dem_mesh(mesh);
+    double area = 0;
+    for (const float a : mesh.vertex_areas) area += a;
+    const double n = double(std::max<std::size_t>(1, mesh.vertex_areas.size()));
+    const double spacing = std::sqrt(area / n);
+    if (!(spacing > 0) || !std::isfinite(spacing))
+        throw Error("field", "--radius auto needs a mesh with a positive area");
+    // At least the first two rungs, so that even a small tile has a choice.
+    const double limit = std::max(4.0, 0.25 * std::min(mesh.grid_width, mesh.grid_height));
+    std::vector<double> radii;
+    for (double pixels = 2; pixels <= 128 && (pixels <= limit || radii.size() < 2); pixels *= 2)
+        radii.push_back(pixels * spacing);
+    return radii;
+}
+
+ScaleSelectedField scale_selected_shape_index(const TriangleMesh& mesh,
+                                              const ShapeIndexOptions& options,
+                                              const ProgressFn& progress) {
+    ScaleSelectedField out;
+    out.radii = options.radii.empty() ? default_radii(mesh) : options.radii;
+    check_dem_mesh(mesh);
+    if (out.radii.empty() || out.radii.size() > kMaxRadii)
+        throw Error("field", "--radii takes 1 to " + std::to_string(kMaxRadii) + " radii");
+    for (std::size_t i = 0; i < out.radii.size(); ++i)
+        if (!(out.radii[i] > 0) || !std::isfinite(out.radii[i]) ||
+            (i > 0 && !(out.radii[i] > out.radii[i - 1])))
+            throw Error("field", "--radii must be positive metres in increasing order");
+    if (!(options.contrast_curvedness >= 0) || !std::isfinite(options.contrast_curvedness))
+        throw Error("field", "the contrast curvedness must be a number >= 0");
+    if (!(options.peak_dominance >= 1) || !std::isfinite(options.peak_dominance))
+        throw Error("field", "the peak dominance must be a number >= 1");
+
+    const std::size_t n = mesh.vertex_count();
+    const double tau2 = options.contrast_curvedness * options.contrast_curvedness;
+    const double beta = options.peak_dominance;
+    const double sig = options.contrast_curvedness;
+    // 1 / the distance from the body's centre on a body-fixed mesh; 0 on a map.
+    const auto body_curvature = [&](std::int32_t v) {
+        if (mesh.frame != MeshFrame::body) return 0.0;
+        const auto& p = mesh.positions[std::size_t(v)];
+        const double x = mesh.origin[0] + p[0], y = mesh.origin[1] + p[1],
+                     z = mesh.origin[2] + p[2];
+        const double r = std::sqrt(x * x + y * y + z * z);
+        return r > 0 ? 1.0 / r : 0.0;
+    };
+    // Per vertex, as the rungs go up: the previous rung's curvedness and field value, whether
+    // the curvedness rose into it, and the peak chosen so far (its curvedness; whether it is
+    // a significant one).
+    constexpr std::uint8_t kRising = 1, kSignificant = 2, kChosen = 4, kSeen = 8;
+    std::vector<float> previous_c(n, -1.0f), previous_f(n, 50.0f), chosen_c(n, -1.0f);
+    std::vector<std::uint8_t> state(n, kRising), previous_rung(n, 0);
+    out.field.assign(n, 50.0f);
+    out.scale.assign(n, 0);
+    const std::size_t rungs = out.radii.size();
+    // A peak over scale at rung `rung` (curvedness c, field value f): taken when it is the
+    // first significant one (c >= sig), or at least beta times as strong as the one taken, or
+    // when no significant one is taken yet and it is stronger than the one taken. A rise
+    // that ends at the ladder's top is no peak: the landform is larger than the ladder.
+    const auto peak = [&](std::size_t v, std::uint8_t rung, float c, float f, bool top) {
+        const bool significant = c >= sig && !top;
+        const bool chosen = state[v] & kChosen, chosen_significant = state[v] & kSignificant;
+        bool take = !chosen;
+        if (significant)
+            take = take || !chosen_significant || c >= beta * chosen_c[v];
+        else
+            take = take || (!chosen_significant && c > chosen_c[v]);
+        if (!take) return;
+        chosen_c[v] = c;
+        out.scale[v] = rung;
+        out.field[v] = top && rungs >= 3 ? 50.0f : f;
+        state[v] = std::uint8_t((state[v] & ~kSignificant) | kChosen | (significant ? kSignificant : 0));
+    };
+    const auto steps = double(rungs);
+    for (std::size_t i = 0; i < rungs; ++i) {
+        ShapeIndexOptions one = options;
+        one.auto_scale = false;
+        one.radius = out.radii[i];
+        one.window = ShapeIndexWindow::disk;
+        one.skip_wide = i > 0;
+        one.disk_tile_angle = kLadderTileAngle;
+        const double radius = out.radii[i];
+        const auto rung = static_cast<std::uint8_t>(i);
+        detail::for_each_curvature(
+            mesh, one, scaled_progress(progress, double(i) / steps, double(i + 1) / steps),
+            [&](std::int32_t vi, bool ok, const PrincipalCurvatures& k, double scale) {
+                if (!ok || !(scale > 0)) return;
+                const auto v = std::size_t(vi);
+                // Curvatures in 1/m relative to the body's sphere through the vertex (its own
+                // convex curvature would otherwise grow into every large window), times the
+                // radius: dimensionless, scale-normalised.
+                const double body = body_curvature(vi);
+                const double k1 = (k.k1 / scale - body) * radius,
+                             k2 = (k.k2 / scale - body) * radius;
+                const double cd = std::sqrt(0.5 * (k1 * k1 + k2 * k2));
+                if (!std::isfinite(cd)) return;
+                const auto c = float(cd);
+                const double weight = tau2 > 0 ? cd * cd / (cd * cd + tau2) : 1.0;
+                const double si = cd > 0 ? shape_index(k1, k2) : 0.0;
+                const auto f = static_cast<float>(50.0 * (si * weight + 1.0));
+                if (state[v] & kSeen) {
+                    const bool rose = state[v] & kRising;
+                    if (rose && c < previous_c[v])  // the previous rung was a peak
+                        peak(v, previous_rung[v], previous_c[v], previous_f[v], false);
+                    state[v] = std::uint8_t(c >= previous_c[v] ? state[v] | kRising
+                                                                : state[v] & ~kRising);
+                }
+                state[v] |= kSeen;
+                previous_c[v] = c;
+                previous_f[v] = f;
+                previous_rung[v] = rung;
+            });
+    }
+    // The last rung each vertex reached: a peak if the curvedness rose into it (at the
+    // ladder's top only when the ladder is that vertex's whole ladder).
+    for (std::size_t v = 0; v < n; ++v) {
+        if (!(state[v] & kSeen) || !(state[v] & kRising)) continue;
+        const bool top = std::size_t(previous_rung[v]) + 1 == rungs && rungs >= 3;
+        peak(v, previous_rung[v], previous_c[v], previous_f[v], top);
+    }
+    report_progress(progress, 1.0, "shape index");
+    return out;
+}
+
+}  // namespace terrain::field
