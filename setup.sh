@@ -149,13 +149,14 @@ case "$mode" in
       cp -n tests/fuzz/seeds/"$target"/* "$corpus/"
       binary="$fuzz_dir/tests/fuzz/fuzz_$target"
       max_len=16384
+      dict=()
       case "$target" in
         ply | off | obj) binary="$fuzz_dir/tests/fuzz/fuzz_mesh_$target" max_len=4096 ;;
-        pds) max_len=8192 ;;
+        pds) max_len=8192 dict=(-dict=tests/fuzz/pds.dict) ;;
       esac
       echo "setup: fuzzing $target for ${seconds}s"
       ASAN_OPTIONS=detect_leaks=1 nice -n 19 "$binary" "$corpus" -max_total_time="$seconds" \
-        -rss_limit_mb=2048 -timeout=10 -max_len="$max_len" -print_final_stats=1 \
+        -rss_limit_mb=2048 -timeout=10 -max_len="$max_len" -print_final_stats=1 "${dict[@]}" \
         -artifact_prefix="$fuzz_dir/findings/$target/" 2>&1 | tail -n 14 ||
         echo "setup: fuzz_$target stopped on a finding (above)"
     done

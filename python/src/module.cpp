@@ -173,6 +173,7 @@ Dem dem_from_array(py::array_t<double, py::array::c_style | py::array::forcecast
     } else {
         dem.elevation = io::detect_elevation_kind(dem.body, lo, hi);
     }
+    io::check_dem_on_body(dem);  // issue 53: on its body, as io::read_dem checks
     return dem;
 }
 

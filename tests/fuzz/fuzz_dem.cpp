@@ -8,8 +8,10 @@
 #include <cpl_vsi.h>
 #include <gdal_priv.h>
 
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstdlib>
 #include <set>
 #include <string>
 #include <vector>
@@ -76,7 +78,25 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         // much memory. (Without it, a sparse but valid header of 9 GB is no finding.)
         options.memory.limit = std::uint64_t{512} << 20;
         const terrain::Dem dem = terrain::io::read_dem(path, options);
-        (void)terrain::io::describe_dem(dem);
+        const auto d = terrain::io::describe_dem(dem);
+        // A grid read is a surface (issue 53): finite sizes, and on a body, latitudes inside
+        // +-90 but for the half pixel of a pixel centre and the half pixel to its edge.
+        if (!std::isfinite(d.pixel_width_m) || !std::isfinite(d.pixel_height_m)) std::abort();
+        if (d.has_geographic_extent) {
+            const double b = dem.body.semi_minor_axis();
+            // (Both steps: a rotated pixel's corner is off its centre in both.)
+            const auto& t = dem.transform;
+            const double pixel_degrees =
+                dem.georef.kind == terrain::CrsKind::geographic
+                    ? std::hypot(t[1], t[4]) + std::hypot(t[2], t[5])
+                    : (b > 0 ? (dem.georef.pixel_width_m + dem.georef.pixel_height_m) / b * 180 /
+                                   3.141592653589793
+                             : 0);
+            const double limit = 90 + pixel_degrees + 1e-9;
+            if (!std::isfinite(d.lat_min) || !std::isfinite(d.lat_max) || d.lat_min < -limit ||
+                d.lat_max > limit)
+                std::abort();
+        }
     } catch (const terrain::Error&) {
     }
     VSIUnlink(path.c_str());

@@ -132,6 +132,12 @@ TEST_CASE("a PDS label declaring more than its image holds is one line, fast",
     const auto at = text.find(samples);
     REQUIRE(at != std::string::npos);
     text.replace(at, samples.size(), "LINE_SAMPLES = 20000");
+    // Pixels of 1 m, so that the 20000 rows stay on Vesta (at 64 pixels a degree they span
+    // 312 degrees of latitude, refused before the size is checked).
+    const std::string scale = "0.06954046238414907 <KM/PIXEL>";
+    const auto scale_at = text.find(scale);
+    REQUIRE(scale_at != std::string::npos);
+    text.replace(scale_at, scale.size(), "0.001 <KM/PIXEL>");
     write_bytes(label, text);
     // It cost 3.18 GB before "cannot read row 6".
     const auto r = run_limited({"info", label}, 30, 700);

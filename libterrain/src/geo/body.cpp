@@ -62,6 +62,12 @@ std::string identify_body_name(const std::string& names, double semi_major_axis)
     return "unknown";
 }
 
+double known_body_radius(const std::string& name) {
+    for (const auto& body : kBodies)
+        if (body.name == name) return body.mean_radius;
+    return 0;
+}
+
 Body body_from_crs(const std::string& crs_definition) {
     Body body;
     if (crs_definition.empty()) {

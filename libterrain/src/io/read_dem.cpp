@@ -76,7 +76,8 @@ Dem read_dem(const std::string& path, const ReadDemOptions& options, const Progr
     // would make the georeference loop or the arrays absurd).
     dem.body = geo::body_from_crs(dem.crs_wkt);
     validate_dem_grid(path, dem, dataset->GetSpatialRef());
-    geo::georeference(dem);  // the body, and where the pixels lie on it
+    geo::georeference(dem);                          // the body, and where the pixels lie on it
+    validate_dem_on_body(path, dem, dataset.get());  // ... which must be on it
 
     GDALRasterBand* band = dataset->GetRasterBand(options.band);
     int has_scale = 0, has_offset = 0;
@@ -184,6 +185,7 @@ Dem read_dem(const std::string& path, const ReadDemOptions& options, const Progr
     } else {
         dem.elevation = detect_elevation_kind(dem.body, lo, hi);
     }
+    validate_dem_heights(path, dem, dataset.get(), lo);
     report_progress(progress, 1.0, "read");
     return dem;
 }
@@ -192,6 +194,15 @@ Dem read_dem(const std::string& path, const ReadDemOptions& options, const Progr
 
 Dem read_dem(const std::string& path, const ReadDemOptions& options, const ProgressFn& progress) {
     return read_dem(path, options, progress, nullptr);
+}
+
+void check_dem_on_body(const Dem& dem) {
+    double lo = std::numeric_limits<double>::infinity();
+    for (double v : dem.values)
+        if (std::isfinite(v)) lo = std::min(lo, v);
+    const std::string name = dem.source.empty() ? "<grid>" : dem.source;
+    validate_dem_on_body(name, dem, nullptr);
+    if (std::isfinite(lo)) validate_dem_heights(name, dem, nullptr, lo);
 }
 
 Dem read_dem_summary(const std::string& path, DemValueSummary& summary,

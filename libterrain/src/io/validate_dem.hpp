@@ -9,6 +9,7 @@
 #include "terrain/core/dem.hpp"
 #include "terrain/core/memory_budget.hpp"
 
+class GDALDataset;
 class GDALRasterBand;
 class OGRSpatialReference;
 
@@ -25,6 +26,20 @@ constexpr double kMinPixelDegrees = 1e-9;
 
 // The grid of `dem` (width, height, transform, body) under `srs` (null: no CRS).
 void validate_dem_grid(const std::string& path, const Dem& dem, const OGRSpatialReference* srs);
+
+// After geo::georeference(dem), before the values are read: the body's radius is positive and
+// every pixel centre maps to a finite longitude and a latitude inside +-90 (half a pixel of
+// slack at the poles), for every kind of CRS. The pixel centres checked are all those of the
+// grid's four edges and a lattice of 65 x 65 inside it (on a cylindrical projection, whose
+// latitude follows the row, the edges decide); the mesh checks every vertex again. The error
+// names where the fault comes from: the PDS3 label's key (`dataset` is the one read; null for
+// a grid made in memory) or the geotransform.
+void validate_dem_on_body(const std::string& path, const Dem& dem, GDALDataset* dataset);
+
+// After the values are read and the elevation kind is set: the body's radius plus the lowest
+// height (or the lowest radius) stays positive.
+void validate_dem_heights(const std::string& path, const Dem& dem, GDALDataset* dataset,
+                          double min_value);
 
 // The band's declared size against the memory budget (`plan`; null: not checked), and its
 // last row read back (a raster whose data end early, such as a PDS label declaring more rows

@@ -1,4 +1,5 @@
 #include <bit>
+#include <cmath>
 #include <cstring>
 #include <fstream>
 
@@ -28,6 +29,17 @@ void write_ply(const TriangleMesh& mesh, const std::string& path, bool overwrite
         if (property.labels ? property.labels->size() != n
                             : (!property.values || property.values->size() != n))
             throw Error("write", "property '" + property.name + "' has the wrong number of values");
+    // No NaN written as if it were a coordinate or an area (what a grid off its body gave
+    // before io::read_dem refused it): the stage that made them missed a fault of the input.
+    for (std::size_t v = 0; v < n; ++v) {
+        const auto p = mesh.position(v);
+        if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]) ||
+            (v < mesh.vertex_areas.size() && !std::isfinite(mesh.vertex_areas[v])))
+            throw Error("write", "vertex " + std::to_string(v) + " of the mesh for '" + path +
+                                     "' has a NaN or infinite position or area; nothing is "
+                                     "written (check the input's CRS radius, geotransform "
+                                     "and values)");
+    }
     AtomicOutput output(path, overwrite);
     {
         std::ofstream out(output.temp_path(), std::ios::binary);

@@ -118,6 +118,14 @@ class VertexPlacer {
         if (need_lonlat)
             earth_ = std::make_unique<GeographicLib::Geocentric>(dem.body.semi_major_axis,
                                                                  dem.body.flattening);
+        // Latitudes beyond the poles (a projected grid off its body) place nothing: half a
+        // pixel of slack, as io::read_dem checks.
+        if (need_lonlat && dem.body.semi_minor_axis() > 0) {
+            const double step_y = std::hypot(dem.transform[2], dem.transform[5]);
+            const double pixel_degrees =
+                geographic_crs ? step_y : geo.pixel_height_m / dem.body.semi_minor_axis() / kDegree;
+            max_latitude_ = 90 + 0.5 * pixel_degrees;
+        }
         if (frame == MeshFrame::map && geographic_crs) {
             const auto centre = dem.map_xy(dem.width / 2.0, dem.height / 2.0);
             tangent_ =
@@ -170,17 +178,27 @@ class VertexPlacer {
                         const auto p = dem_.index(col, row);
                         const auto v = vertex_of[p];
                         if (v < 0) continue;
-                        if (!ok[col] || !std::isfinite(lon[col]) || !std::isfinite(lat[col])) {
+                        if (!ok[col] || !on_body(lon[col], lat[col])) {
                             failed[row] = 1;
                             continue;
                         }
-                        put(v, point(col, row, lon[col], lat[col]));
+                        const auto xyz = point(col, row, lon[col], lat[col]);
+                        if (!finite(xyz)) {
+                            failed[row] = 1;
+                            continue;
+                        }
+                        put(v, xyz);
                     }
                 }
             });
-        if (std::find(failed.begin(), failed.end(), 1) != failed.end())
-            throw Error("mesh", "some pixels of '" + dem_.source +
-                                    "' fall outside the CRS's valid area and cannot be placed");
+        const auto bad = std::find(failed.begin(), failed.end(), 1);
+        if (bad != failed.end())
+            throw Error("mesh", "row " + std::to_string(bad - failed.begin()) + " of '" +
+                                    dem_.source + "' has valid pixels that cannot be placed on " +
+                                    dem_.body.name +
+                                    " (outside the CRS's valid area, past the poles or with no "
+                                    "finite position); check the CRS's radius, the "
+                                    "geotransform (or the label's map projection) and the values");
     }
 
     // A collapsed pole row's vertex (0: north, 1: south): at the pole, at the mean radius
@@ -200,6 +218,13 @@ class VertexPlacer {
     }
 
   private:
+    bool on_body(double lon, double lat) const {
+        return std::isfinite(lon) && std::isfinite(lat) && std::abs(lat) <= max_latitude_;
+    }
+    static bool finite(const std::array<double, 3>& p) {
+        return std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]);
+    }
+
     // Radii are distances from the centre along the geocentric direction.
     static std::array<double, 3> along_radius(double value, double cos_lat, double sin_lat,
                                               double cos_lon, double sin_lon) {
@@ -217,12 +242,17 @@ class VertexPlacer {
         for (int col = 0; col < W; ++col) {
             const auto v = vertex_of[dem_.index(col, row)];
             if (v < 0) continue;
-            if (!std::isfinite(lon[std::size_t(col)]) || !std::isfinite(lat[std::size_t(col)])) {
+            if (!on_body(lon[std::size_t(col)], lat[std::size_t(col)])) {
                 failed[std::size_t(row)] = 1;
                 continue;
             }
-            put(v, along_radius(dem_.values[dem_.index(col, row)], cl, sl,
-                                cos_lon[std::size_t(col)], sin_lon[std::size_t(col)]));
+            const auto p = along_radius(dem_.values[dem_.index(col, row)], cl, sl,
+                                        cos_lon[std::size_t(col)], sin_lon[std::size_t(col)]);
+            if (!finite(p)) {
+                failed[std::size_t(row)] = 1;
+                continue;
+            }
+            put(v, p);
         }
     }
 
@@ -248,6 +278,7 @@ class VertexPlacer {
     MeshFrame frame_;
     double unit_;
     const LonLatMapping* lonlat_ = nullptr;  // null: map coordinates are lon/lat already
+    double max_latitude_ = std::numeric_limits<double>::infinity();  // map frame: no limit
     std::unique_ptr<GeographicLib::Geocentric> earth_;
     std::unique_ptr<GeographicLib::LocalCartesian> tangent_;
 };

@@ -18,4 +18,8 @@ Body body_from_crs(const std::string& crs_definition);
 // known names first ("D_MOON", "Mars_2000_IAU_IAG", "VESTA"), then the radius.
 std::string identify_body_name(const std::string& names, double semi_major_axis);
 
+// The mean radius in metres of a body identify_body_name knows ("Moon": 1737400); 0 for
+// another name ("unknown", "none"). For checks that a CRS's radius is plausible.
+double known_body_radius(const std::string& name);
+
 }  // namespace terrain::geo

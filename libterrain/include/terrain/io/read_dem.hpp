@@ -38,6 +38,13 @@ struct DemValueSummary {
 Dem read_dem_summary(const std::string& path, DemValueSummary& summary,
                      const ReadDemOptions& options = {}, const ProgressFn& progress = {});
 
+// For a grid made in memory (values set, geo::georeference(dem) called, the elevation kind
+// set): the checks read_dem makes on the grids it reads that the grid lies on its body: a
+// positive radius, every pixel centre's latitude inside +-90 (half a pixel of slack), and the
+// body's radius plus the lowest height positive. Throws terrain::Error (stage "read") naming
+// the geotransform or the CRS. No-op for a grid without CRS.
+void check_dem_on_body(const Dem& dem);
+
 // The radius/height decision of docs/bodies-and-elevation.md for valid values in
 // [min_value, max_value] on `body`.
 ElevationKind detect_elevation_kind(const Body& body, double min_value, double max_value);
