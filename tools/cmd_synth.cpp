@@ -16,9 +16,10 @@ namespace {
 
 // The tile's crater population as CSV, centres in pixels of the tile ((0,0) the top-left
 // corner), diameters on the ground and in pixels along a row.
-void write_crater_list(const synth::VestaTileOptions& tile, const Dem& dem,
-                       const std::string& path, bool overwrite) {
-    if (!overwrite && std::ifstream(path)) throw Error("synth", path + " exists (--overwrite replaces it)");
+void write_crater_list(const synth::VestaTileOptions& tile, const Dem& dem, const std::string& path,
+                       bool overwrite) {
+    if (!overwrite && std::ifstream(path))
+        throw Error("synth", path + " exists (--overwrite replaces it)");
     std::ofstream out(path);
     if (!out) throw Error("synth", "cannot write " + path);
     const double pixel = std::abs(dem.transform[1]);
@@ -53,8 +54,8 @@ int run_synth(int argc, char** argv) {
             "craters", po::value(&craters_csv),
             "also write the generated craters as CSV (id, col, row in pixels of the tile, "
             "diameter_m, diameter_px, degradation, age), oldest first: the truth the crater "
-            "benchmarks score against")(
-            "overwrite", po::bool_switch(&overwrite), "replace existing files")(
+            "benchmarks score against")("overwrite", po::bool_switch(&overwrite),
+                                        "replace existing files")(
             "quiet,q", po::bool_switch(&quiet), "no progress output");
         po::positional_options_description positional;
         po::variables_map vm;

@@ -89,8 +89,8 @@ field::FieldOptions to_field_options(const FieldOptionValues& values, const po::
             used = 0;
         }
         if (used == 0 || used != values.radius.size())
-            throw Error("options", "--radius takes metres or auto; '" + values.radius +
-                                       "' is neither");
+            throw Error("options",
+                        "--radius takes metres or auto; '" + values.radius + "' is neither");
     }
     if (!values.radii.empty()) {
         if (!out.shape_index.auto_scale) throw UsageError("--radii goes with --radius auto");
@@ -120,7 +120,8 @@ void check_field_limits(const field::FieldOptions& options, const TriangleMesh& 
         // Any radius costs the same; one wider than the grid sees nothing more.
         double area = 0;
         for (const float a : mesh.vertex_areas) area += a;
-        const double spacing = std::sqrt(area / double(std::max<std::size_t>(1, mesh.vertex_areas.size())));
+        const double spacing =
+            std::sqrt(area / double(std::max<std::size_t>(1, mesh.vertex_areas.size())));
         const double across = double(std::max(mesh.grid_width, mesh.grid_height)) * spacing;
         if (options.shape_index.radius > across)
             throw Error("options", "--radius " + std::to_string(options.shape_index.radius) +

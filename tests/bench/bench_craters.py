@@ -6,6 +6,7 @@ crater-sized regions that are generated craters).
 
   bench_craters.py BUILD_DIR [--tiles 3] [--tile-size 1024] [--global-width 2048]
                    [--work DIR] [--args "SEGMENT OPTIONS"] [--compare "SEGMENT OPTIONS"]
+                   [--concave-below 43.75]
 
 --args: the options of the run scored (default: none, the landform defaults); --compare: a
 second run on the same inputs, scored beside it (for instance the paper's single scale,
@@ -30,6 +31,7 @@ import crater_score  # noqa: E402
 
 gdal.UseExceptions()
 HERE = os.path.dirname(os.path.abspath(__file__))
+CONCAVE_BELOW = crater_score.CONCAVE_BELOW
 
 
 def read_craters(path):
@@ -82,7 +84,7 @@ def run(terrain, cases, work, args, title):
     for name, dem, craters, wrap in cases:
         out = os.path.join(work, f"{title}_{os.path.splitext(os.path.basename(dem))[0]}")
         labels, mean, seconds = segment(terrain, dem, out, args)
-        rows = crater_score.score(labels, mean, read_craters(craters), wrap)
+        rows = crater_score.score(labels, mean, read_craters(craters), wrap, CONCAVE_BELOW)
         for i, r in enumerate(rows):
             t = total.setdefault(r["bin"], [0, 0, 0, 0])
             t[0] += r["found"]; t[1] += r["craters"]; t[2] += r["true"]; t[3] += r["regions"]
@@ -109,7 +111,12 @@ def main():
     parser.add_argument("--work")
     parser.add_argument("--args", default="")
     parser.add_argument("--compare")
+    parser.add_argument("--concave-below", type=float, default=crater_score.CONCAVE_BELOW,
+                        help="the mean shape index x100 under which a region is concave "
+                             "(default 43.75, the concave landform classes; 50: mean SI < 0)")
     a = parser.parse_args()
+    global CONCAVE_BELOW
+    CONCAVE_BELOW = a.concave_below
     terrain = os.path.join(a.build, "tools", "terrain")
     if not os.access(terrain, os.X_OK):
         parser.error(f"no terrain program in {a.build}/tools")

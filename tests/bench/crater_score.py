@@ -128,10 +128,11 @@ def precision(labels, concave, craters, matched, wrap=False):
     return out
 
 
-def score(labels, field_mean, craters, wrap=False):
+def score(labels, field_mean, craters, wrap=False, concave_below=CONCAVE_BELOW):
     """Recall and precision per bin of a label map (0 = no region) whose region k has mean
-    field field_mean[k] (x100 shape index), against a crater table (a dict of columns)."""
-    concave = np.asarray(field_mean, float) < CONCAVE_BELOW
+    field field_mean[k] (x100 shape index), against a crater table (a dict of columns).
+    concave_below: the mean field under which a region is concave (50: mean SI < 0)."""
+    concave = np.asarray(field_mean, float) < concave_below
     h, w = labels.shape
     indices = scored(craters, w, h, wrap)
     found, match = find(labels, concave, craters, indices, wrap)

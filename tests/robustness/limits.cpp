@@ -48,3 +48,27 @@ TEST_CASE("bad values exit 1 and bad usage exits 2 in every command", "[robustne
         CHECK(run_limited({command, dem, "-o"}).status == 2);  // missing argument
     }
 }
+
+TEST_CASE("segment and sweep check --radius alike", "[robustness][cli]") {
+    // The disk window costs the same at any radius: 3 km (43 pixels of the Vesta sample, over
+    // 20 mean edge lengths) runs in both; one wider than the grid is refused by both.
+    const auto dir = scratch_dir("limits_radius");
+    const auto dem = sample("vesta_hamo_tile.lbl");
+    for (const char* command : {"segment", "sweep"}) {
+        INFO(command);
+        std::vector<std::string> args = {
+            command, dem,           "-o",           (dir / command).string(),
+            "-q",    "--overwrite", "--area-ratio", "0.5"};
+        if (std::string(command) == "sweep")
+            args.back() = "0.5", args[args.size() - 2] = "--area-ratios";
+        auto wide = args;
+        wide.insert(wide.end(), {"--radius", "3000"});
+        CHECK(run_limited(wide, 120).status == 0);
+        auto huge = args;
+        huge.insert(huge.end(), {"--radius", "1e7"});
+        const auto r = run_limited(huge, 30);
+        CHECK(r.status == 1);
+        CHECK(line_count(r.err) == 1);
+        CHECK_THAT(r.err, Contains("wider than the grid"));
+    }
+}

@@ -14,7 +14,7 @@
 namespace terrain::field {
 namespace {
 
-constexpr std::size_t kMaxRadii = 32;
+constexpr std::size_t kMaxRadii = 16;  // (a rung in 4 bits)
 // The ladder's tiles of sums may span this angle on the body (shape_index.hpp): the tilt of a
 // tile's frame is a slope, which the fit takes up, not a curvature.
 constexpr double kLadderTileAngle = 0.4;
@@ -38,7 +38,7 @@ std::vector<double> default_radii(const TriangleMesh& mesh) {
     if (!(spacing > 0) || !std::isfinite(spacing))
         throw Error("field", "--radius auto needs a mesh with a positive area");
     // At least the first two rungs, so that even a small tile has a choice.
-    const double limit = std::max(4.0, 0.25 * std::min(mesh.grid_width, mesh.grid_height));
+    const double limit = std::max(4.0, 0.5 * std::min(mesh.grid_width, mesh.grid_height));
     std::vector<double> radii;
     for (double pixels = 2; pixels <= 128 && (pixels <= limit || radii.size() < 2); pixels *= 2)
         radii.push_back(pixels * spacing);
@@ -76,20 +76,29 @@ ScaleSelectedField scale_selected_shape_index(const TriangleMesh& mesh,
         return r > 0 ? 1.0 / r : 0.0;
     };
     // Per vertex, as the rungs go up: the previous rung's curvedness and field value, whether
-    // the curvedness rose into it, and the peak chosen so far (its curvedness; whether it is
-    // a significant one).
+    // the curvedness rose into it, the previous rung itself, and the peak chosen so far (its
+    // curvedness; whether it is a significant one). Curvedness and field values are held in
+    // 16 bits (1/4096 and 1/600: far finer than the thresholds and the persistence), so that
+    // the ladder adds 8 bytes a vertex to the field's own 5.
     constexpr std::uint8_t kRising = 1, kSignificant = 2, kChosen = 4, kSeen = 8;
-    std::vector<float> previous_c(n, -1.0f), previous_f(n, 50.0f), chosen_c(n, -1.0f);
-    std::vector<std::uint8_t> state(n, kRising), previous_rung(n, 0);
+    const auto quantize = [](double x, double unit) {
+        return static_cast<std::uint16_t>(std::clamp(std::lround(x * unit), 0L, 65535L));
+    };
+    constexpr double kCurvednessUnit = 4096, kFieldUnit = 600;
+    std::vector<std::uint16_t> previous_c(n, 0), previous_f(n, 0), chosen_c(n, 0);
+    std::vector<std::uint8_t> state(n, kRising);  // flags below, the previous rung above 4 bits
+    const auto previous_rung = [&](std::size_t v) { return std::uint8_t(state[v] >> 4); };
     out.field.assign(n, 50.0f);
     out.scale.assign(n, 0);
     const std::size_t rungs = out.radii.size();
+    const std::uint16_t significant_c = quantize(sig, kCurvednessUnit);
     // A peak over scale at rung `rung` (curvedness c, field value f): taken when it is the
     // first significant one (c >= sig), or at least beta times as strong as the one taken, or
     // when no significant one is taken yet and it is stronger than the one taken. A rise
     // that ends at the ladder's top is no peak: the landform is larger than the ladder.
-    const auto peak = [&](std::size_t v, std::uint8_t rung, float c, float f, bool top) {
-        const bool significant = c >= sig && !top;
+    const auto peak = [&](std::size_t v, std::uint8_t rung, std::uint16_t c, std::uint16_t f,
+                          bool top) {
+        const bool significant = c >= significant_c && !top;
         const bool chosen = state[v] & kChosen, chosen_significant = state[v] & kSignificant;
         bool take = !chosen;
         if (significant)
@@ -99,8 +108,9 @@ ScaleSelectedField scale_selected_shape_index(const TriangleMesh& mesh,
         if (!take) return;
         chosen_c[v] = c;
         out.scale[v] = rung;
-        out.field[v] = top && rungs >= 3 ? 50.0f : f;
-        state[v] = std::uint8_t((state[v] & ~kSignificant) | kChosen | (significant ? kSignificant : 0));
+        out.field[v] = top && rungs >= 3 ? 50.0f : float(f / kFieldUnit);
+        state[v] = std::uint8_t((state[v] & ~kSignificant) | kChosen |
+                                (significant ? kSignificant : 0));
     };
     const auto steps = double(rungs);
     for (std::size_t i = 0; i < rungs; ++i) {
@@ -125,29 +135,28 @@ ScaleSelectedField scale_selected_shape_index(const TriangleMesh& mesh,
                              k2 = (k.k2 / scale - body) * radius;
                 const double cd = std::sqrt(0.5 * (k1 * k1 + k2 * k2));
                 if (!std::isfinite(cd)) return;
-                const auto c = float(cd);
+                const auto c = quantize(cd, kCurvednessUnit);
                 const double weight = tau2 > 0 ? cd * cd / (cd * cd + tau2) : 1.0;
                 const double si = cd > 0 ? shape_index(k1, k2) : 0.0;
-                const auto f = static_cast<float>(50.0 * (si * weight + 1.0));
+                const auto f = quantize(50.0 * (si * weight + 1.0), kFieldUnit);
                 if (state[v] & kSeen) {
                     const bool rose = state[v] & kRising;
                     if (rose && c < previous_c[v])  // the previous rung was a peak
-                        peak(v, previous_rung[v], previous_c[v], previous_f[v], false);
+                        peak(v, previous_rung(v), previous_c[v], previous_f[v], false);
                     state[v] = std::uint8_t(c >= previous_c[v] ? state[v] | kRising
                                                                 : state[v] & ~kRising);
                 }
-                state[v] |= kSeen;
+                state[v] = std::uint8_t((state[v] & 0x0f) | kSeen | (rung << 4));
                 previous_c[v] = c;
                 previous_f[v] = f;
-                previous_rung[v] = rung;
             });
     }
     // The last rung each vertex reached: a peak if the curvedness rose into it (at the
     // ladder's top only when the ladder is that vertex's whole ladder).
     for (std::size_t v = 0; v < n; ++v) {
         if (!(state[v] & kSeen) || !(state[v] & kRising)) continue;
-        const bool top = std::size_t(previous_rung[v]) + 1 == rungs && rungs >= 3;
-        peak(v, previous_rung[v], previous_c[v], previous_f[v], top);
+        const bool top = std::size_t(previous_rung(v)) + 1 == rungs && rungs >= 3;
+        peak(v, previous_rung(v), previous_c[v], previous_f[v], top);
     }
     report_progress(progress, 1.0, "shape index");
     return out;

@@ -118,8 +118,7 @@ GridLayout grid_layout(const TriangleMesh& mesh, double tile_angle) {
                         spacing = std::max(spacing, std::sqrt(dot(d, d)));
                     }
             }
-        if (spacing > 0)
-            g.disk_tile = int(std::clamp(tile_angle * radius / spacing, 8.0, 64.0));
+        if (spacing > 0) g.disk_tile = int(std::clamp(tile_angle * radius / spacing, 8.0, 64.0));
     }
     return g;
 }

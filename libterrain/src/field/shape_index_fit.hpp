@@ -369,8 +369,7 @@ void disk_tile(const TriangleMesh& mesh, const GridLayout& g, const std::vector<
 
 // Every vertex's fit with `options` (rings or one radius): body(v, ok, curvatures, scale),
 // the curvatures times `scale` (shape_index.cpp's for_each_vertex), on several threads.
-using CurvatureBody =
-    std::function<void(std::int32_t, bool, const PrincipalCurvatures&, double)>;
+using CurvatureBody = std::function<void(std::int32_t, bool, const PrincipalCurvatures&, double)>;
 void for_each_curvature(const TriangleMesh& mesh, const ShapeIndexOptions& options,
                         const ProgressFn& progress, const CurvatureBody& body);
 bool disk_applies(const TriangleMesh& mesh, const ShapeIndexOptions& options);

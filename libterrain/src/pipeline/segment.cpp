@@ -11,6 +11,7 @@
 
 #include "../core/pass_progress.hpp"
 #include "../core/release.hpp"
+#include "../core/significant.hpp"
 #include "parked_arrays.hpp"
 #include "terrain/core/error.hpp"
 #include "terrain/core/huge_pages.hpp"
@@ -229,8 +230,8 @@ void compute_field(SegmentResult& result, const SegmentOptions& options,
     const auto t0 = clock::now();
     const auto fo = field_options(options);
     if (fo.kind == field::FieldKind::shape_index && fo.shape_index.auto_scale) {
-        auto selected = field::scale_selected_shape_index(result.input.mesh, fo.shape_index,
-                                                          progress);
+        auto selected =
+            field::scale_selected_shape_index(result.input.mesh, fo.shape_index, progress);
         result.field = std::move(selected.field);
         result.field_scale = std::move(selected.scale);
         result.field_radii = std::move(selected.radii);
@@ -291,8 +292,7 @@ ScaleResult grow_scale(const Input& input, const std::vector<float>& field,
     segment::GrowOptions grow;
     grow.saddle_penalty = options.saddle_penalty;
     grow.cost = grow_cost(options, input.dem.has_value());
-    const bool divide =
-        parse_absorbed(options.absorbed, input.dem.has_value()) == Absorbed::divide;
+    const bool divide = parse_absorbed(options.absorbed, input.dem.has_value()) == Absorbed::divide;
     out.segmentation = segment::grow_regions(input.mesh, simplified.graph, grow,
                                              scaled_progress(progress, 0, divide ? 0.5 : 1));
     if (divide)
@@ -597,12 +597,11 @@ void release_large_data(SegmentResult& result) {
 std::string scale_caption(const std::vector<double>& radii) {
     if (radii.empty()) return "radius auto";
     return "radius auto (" + std::to_string(radii.size()) + " radii, " +
-           JsonWriter::number(std::round(radii.front())) + "-" +
-           JsonWriter::number(std::round(radii.back())) + " m)";
+           terrain::detail::significant(radii.front(), 3) + "-" +
+           terrain::detail::significant(radii.back(), 3) + " m)";
 }
 
-std::vector<std::string> write_segment_directory(SegmentResult& result,
-                                                 const SegmentOptions& given,
+std::vector<std::string> write_segment_directory(SegmentResult& result, const SegmentOptions& given,
                                                  const std::string& input_path,
                                                  const std::string& dir, const WriteOptions& write,
                                                  const ProgressFn& progress) {
@@ -623,9 +622,13 @@ std::vector<std::string> write_segment_directory(SegmentResult& result,
                       field::shape_index_window(result.input.mesh, options.shape_index) + ")"
                 : std::to_string(options.shape_index.rings) + " rings");
     caption.push_back("persistence " + JsonWriter::number(options.simplify.persistence));
-    caption.push_back(
-        "area ratio " + JsonWriter::number(result.area_ratio_percent) + " %" +
-        (options.min_area.empty() ? std::string() : " (min area " + options.min_area + ")"));
+    if (options.min_area == "auto")
+        caption.push_back("min area auto (" + terrain::detail::significant(result.min_area_m2, 3) +
+                          " m^2)");
+    else
+        caption.push_back(
+            "area ratio " + JsonWriter::number(result.area_ratio_percent) + " %" +
+            (options.min_area.empty() ? std::string() : " (min area " + options.min_area + ")"));
     caption.push_back("cost " +
                       std::string(options.cost == "auto" ? (result.input.dem ? "graph" : "standard")
                                                          : options.cost) +

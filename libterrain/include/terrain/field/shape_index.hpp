@@ -87,19 +87,20 @@ std::vector<float> shape_index_field(const TriangleMesh& mesh,
                                      const ProgressFn& progress = {});
 
 // The ladder of radii `--radius auto` takes on a DEM mesh: 2, 4, 8, ..., 128 times the
-// mesh's pixel spacing (the square root of its mean vertex area), the largest kept below a
-// quarter of the grid's smaller side. Throws terrain::Error for a mesh not made from a DEM.
+// mesh's pixel spacing (the square root of its mean vertex area), the largest kept below
+// half the grid's smaller side (a landform wider than the ladder's top reads planar). Throws
+// terrain::Error for a mesh not made from a DEM.
 std::vector<double> default_radii(const TriangleMesh& mesh);
 
 struct ScaleSelectedField {
-    std::vector<float> field;        // per vertex, in [0, 100] as shape_index_field's
+    std::vector<float> field;         // per vertex, in [0, 100] as shape_index_field's
     std::vector<std::uint8_t> scale;  // per vertex, the index in `radii` of its radius
-    std::vector<double> radii;       // the ladder, metres
+    std::vector<double> radii;        // the ladder, metres
 };
 
 // The scale-selected shape index of options.auto_scale (options.radii, or default_radii).
 // Throws terrain::Error (stage "field") for a mesh not made from a DEM, a ladder that is
-// not increasing and positive, or more than 32 radii.
+// not increasing and positive, or more than 16 radii.
 ScaleSelectedField scale_selected_shape_index(const TriangleMesh& mesh,
                                               const ShapeIndexOptions& options,
                                               const ProgressFn& progress = {});
