@@ -15,6 +15,9 @@ namespace terrain::field {
 namespace {
 
 constexpr std::size_t kMaxRadii = 16;  // (a rung in 4 bits)
+// The contrast kept by a vertex whose curvedness rises to the ladder's top: a landform wider
+// than the ladder reads nearly planar, without making plateaus of exactly equal values.
+constexpr float kTopContrast = 0.25f;
 // The ladder's tiles of sums may span this angle on the body (shape_index.hpp): the tilt of a
 // tile's frame is a slope, which the fit takes up, not a curvature.
 constexpr double kLadderTileAngle = 0.4;
@@ -108,7 +111,8 @@ ScaleSelectedField scale_selected_shape_index(const TriangleMesh& mesh,
         if (!take) return;
         chosen_c[v] = c;
         out.scale[v] = rung;
-        out.field[v] = top && rungs >= 3 ? 50.0f : float(f / kFieldUnit);
+        const float value = float(f / kFieldUnit);
+        out.field[v] = top && rungs >= 3 ? 50.0f + kTopContrast * (value - 50.0f) : value;
         state[v] = std::uint8_t((state[v] & ~kSignificant) | kChosen |
                                 (significant ? kSignificant : 0));
     };

@@ -593,12 +593,21 @@ void release_large_data(SegmentResult& result) {
     release_free_memory();
 }
 
+// A length and an area for the preview's caption, in m or km, three significant digits.
+std::string caption_length(double m) {
+    return m >= 1000 ? terrain::detail::significant(m / 1000, 3) + " km"
+                     : terrain::detail::significant(m, 3) + " m";
+}
+std::string caption_area(double m2) {
+    return m2 >= 1e5 ? terrain::detail::significant(m2 / 1e6, 3) + " km^2"
+                     : terrain::detail::significant(m2, 3) + " m^2";
+}
+
 // The preview's words for a scale chosen per vertex: the ladder's ends.
 std::string scale_caption(const std::vector<double>& radii) {
     if (radii.empty()) return "radius auto";
     return "radius auto (" + std::to_string(radii.size()) + " radii, " +
-           terrain::detail::significant(radii.front(), 3) + "-" +
-           terrain::detail::significant(radii.back(), 3) + " m)";
+           caption_length(radii.front()) + " to " + caption_length(radii.back()) + ")";
 }
 
 std::vector<std::string> write_segment_directory(SegmentResult& result, const SegmentOptions& given,
@@ -623,8 +632,7 @@ std::vector<std::string> write_segment_directory(SegmentResult& result, const Se
                 : std::to_string(options.shape_index.rings) + " rings");
     caption.push_back("persistence " + JsonWriter::number(options.simplify.persistence));
     if (options.min_area == "auto")
-        caption.push_back("min area auto (" + terrain::detail::significant(result.min_area_m2, 3) +
-                          " m^2)");
+        caption.push_back("min area auto (" + caption_area(result.min_area_m2) + ")");
     else
         caption.push_back(
             "area ratio " + JsonWriter::number(result.area_ratio_percent) + " %" +

@@ -43,7 +43,7 @@ struct ShapeIndexOptions {
     // is a peak; a vertex takes its first significant peak (c >= contrast_curvedness) unless
     // a later one is peak_dominance times as strong, or its strongest peak when none is
     // significant; a rise to the ladder's top is no peak (the landform is wider than the
-    // ladder: planar). The field is 50 + 50 SI w, the shape index of the chosen radius with
+    // ladder: a quarter of that rung's contrast, nearly planar). The field is 50 + 50 SI w, the shape index of the chosen radius with
     // its contrast w = c^2 / (c^2 + contrast_curvedness^2): shapes too weak to be seen at
     // any scale read as planar. rings and radius are ignored.
     bool auto_scale = false;
@@ -88,7 +88,7 @@ std::vector<float> shape_index_field(const TriangleMesh& mesh,
 
 // The ladder of radii `--radius auto` takes on a DEM mesh: 2, 4, 8, ..., 128 times the
 // mesh's pixel spacing (the square root of its mean vertex area), the largest kept below
-// half the grid's smaller side (a landform wider than the ladder's top reads planar). Throws
+// half the grid's smaller side (a landform wider than the ladder's top reads nearly planar). Throws
 // terrain::Error for a mesh not made from a DEM.
 std::vector<double> default_radii(const TriangleMesh& mesh);
 
