@@ -221,6 +221,11 @@ py::dict region_columns(const segment::RegionGraph& graph) {
     d["point_y"] = py_;
     d["point_z"] = pz;
     d["neighbor_count"] = neighbors;
+    if (graph.has_field_scale) {  // the radius chosen per pixel (--radius auto)
+        py::array_t<double> scale(n);
+        for (std::size_t i = 0; i < n; ++i) scale.mutable_at(i) = r[i].field_scale_m;
+        d["field_scale_m"] = scale;
+    }
     return d;
 }
 

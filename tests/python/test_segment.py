@@ -219,3 +219,21 @@ def test_window_is_the_cli_and_disk_by_default(cli, moon, tmp_path):
     assert np.array_equal(ball, ds.ReadAsArray(), equal_nan=True)
     with pytest.raises(terrain.Error, match="window must be disk or ball"):
         terrain.shape_index(moon, radius=30000, window="cube")
+
+
+def test_the_default_regions_carry_their_field_scale(moon, cli, tmp_path):
+    # With no scale option each region records the radius most of its pixels took, as the
+    # command line's regions.geojson does; a single scale has no such column.
+    import json
+    result = terrain.segment(moon)
+    scale = result.regions["field_scale_m"]
+    assert len(scale) == result.region_count
+    out = tmp_path / "seg"
+    assert cli("segment", moon, "-o", out, "-q").returncode == 0
+    features = json.loads((out / "regions.geojson").read_text())["features"]
+    by_id = {f["properties"]["id"]: f["properties"]["field_scale_m"] for f in features}
+    assert [by_id[int(i)] for i in result.regions["id"]] == list(scale)
+    radii = json.loads((out / "run.json").read_text())["parameters"]["radii_m"]
+    assert set(scale[result.regions["vertex_count"] > 0]) <= set(radii)
+    assert len(set(scale)) >= 2
+    assert "field_scale_m" not in terrain.segment(moon, area_ratio=0.5).regions
