@@ -428,7 +428,7 @@ TEST_CASE("shape index by the grid method is the same whatever the thread count"
 }
 
 TEST_CASE("shape index by the grid method agrees with the mesh method on real DEMs",
-          "[shape_index][shared]") {
+          "[shape_index][real_data]") {
     // Every vertex of each crop (its border and NoData neighbours included) is compared.
     struct Case {
         std::string name;
@@ -436,7 +436,7 @@ TEST_CASE("shape index by the grid method agrees with the mesh method on real DE
         std::vector<double> radii;
     };
     std::vector<Case> cases;
-    const auto srtm = test::shared_data("earth/bigtujunga_srtm30m_utm11.tif");
+    const auto srtm = test::real_data("earth/bigtujunga_srtm30m_utm11.tif");
     REQUIRE(srtm.has_value());
     cases.push_back({"SRTM crop", crop(io::read_dem(*srtm), 400, 200, 240, 200), {60, 150, 300}});
     // The Vesta sample (a HAMO tile far from its projection's centre, meshed in the body
@@ -446,7 +446,7 @@ TEST_CASE("shape index by the grid method agrees with the mesh method on real DE
                      {350, 700}});
     // A geographic (lon/lat) Moon crop at 55-80 N from LOLA LDEM_4: pixels 2-6 times narrower
     // than tall.
-    const auto ldem = test::shared_data("moon_lola_ldem4/LDEM_4.LBL");
+    const auto ldem = test::real_data("moon_lola_ldem4/LDEM_4.LBL");
     REQUIRE(ldem.has_value());
     {
         const Dem full = io::read_dem(*ldem);
@@ -547,7 +547,7 @@ TEST_CASE("shape index with the disk window is the same whatever the thread coun
     CHECK(one == two);
 }
 
-TEST_CASE("shape index with the disk window on real DEMs", "[shape_index][shared]") {
+TEST_CASE("shape index with the disk window on real DEMs", "[shape_index][real_data]") {
     // Each radius with the largest median distance from the ball's values allowed (the
     // medians measured when the disk window came, plus about 30 %: on real terrain the two
     // windows and fits differ by about one unit of 100 at the median, docs/field.md).
@@ -557,14 +557,14 @@ TEST_CASE("shape index with the disk window on real DEMs", "[shape_index][shared
         std::vector<std::pair<double, double>> radii;
     };
     std::vector<Case> cases;
-    const auto srtm = test::shared_data("earth/bigtujunga_srtm30m_utm11.tif");
+    const auto srtm = test::real_data("earth/bigtujunga_srtm30m_utm11.tif");
     REQUIRE(srtm.has_value());
     cases.push_back(
         {"SRTM crop", crop(io::read_dem(*srtm), 400, 200, 240, 200), {{150, 1.0}, {300, 0.9}}});
     cases.push_back({"Vesta sample",
                      crop(io::read_dem(test::sample("vesta_hamo_tile.lbl")), 256, 256, 256, 256),
                      {{350, 1.25}, {700, 1.0}}});
-    const auto ldem = test::shared_data("moon_lola_ldem4/LDEM_4.LBL");
+    const auto ldem = test::real_data("moon_lola_ldem4/LDEM_4.LBL");
     REQUIRE(ldem.has_value());
     {
         const Dem full = io::read_dem(*ldem);

@@ -7,8 +7,8 @@
 using namespace terrain;
 
 TEST_CASE("describe_dem on LDEM_4: the Moon, radii, 7581 m pixels, global",
-          "[describe_dem][shared]") {
-    const auto path = test::shared_data("moon_lola_ldem4/LDEM_4.LBL");
+          "[describe_dem][real_data]") {
+    const auto path = test::real_data("moon_lola_ldem4/LDEM_4.LBL");
     REQUIRE(path.has_value());  // CI always has ../shared beside the project
     const auto d = io::describe_dem(io::read_dem(*path));
     CHECK(d.body.name == "Moon");
@@ -38,8 +38,8 @@ TEST_CASE("describe_dem on the bundled global Moon and a crop", "[describe_dem]"
            (crop.lon_min < lon + 360 && crop.lon_max > lon + 360)));
 }
 
-TEST_CASE("describe_dem on the SRTM tile: Earth, 30 m, heights", "[describe_dem][shared]") {
-    const auto path = test::shared_data("earth/bigtujunga_srtm30m_utm11.tif");
+TEST_CASE("describe_dem on the SRTM tile: Earth, 30 m, heights", "[describe_dem][real_data]") {
+    const auto path = test::real_data("earth/bigtujunga_srtm30m_utm11.tif");
     REQUIRE(path.has_value());  // CI always has ../shared beside the project
     const auto d = io::describe_dem(io::read_dem(*path));
     CHECK(d.body.name == "Earth");

@@ -59,8 +59,8 @@ TEST_CASE("read_dem applies scale and offset and turns NoData into holes", "[rea
     CHECK(dem.height_at(1, 0) == Approx(5));
 }
 
-TEST_CASE("read_dem on the real LOLA PDS3 product", "[read_dem][shared]") {
-    const auto path = test::shared_data("moon_lola_ldem4/LDEM_4.LBL");
+TEST_CASE("read_dem on the real LOLA PDS3 product", "[read_dem][real_data]") {
+    const auto path = test::real_data("moon_lola_ldem4/LDEM_4.LBL");
     REQUIRE(path.has_value());  // CI always has ../shared beside the project
     const Dem dem = io::read_dem(*path);
     CHECK(dem.width == 1440);

@@ -182,8 +182,8 @@ TEST_CASE("regions.geojson on the Moon: lon/lat on the Moon, CRS recorded, areas
     CHECK(first.find("\"crs\"") != std::string::npos);
 }
 
-TEST_CASE("regions.geojson on Earth is RFC 7946 lon/lat", "[write_region_polygons][shared]") {
-    const auto source = test::shared_data("earth/bigtujunga_srtm30m_utm11.tif");
+TEST_CASE("regions.geojson on Earth is RFC 7946 lon/lat", "[write_region_polygons][real_data]") {
+    const auto source = test::real_data("earth/bigtujunga_srtm30m_utm11.tif");
     REQUIRE(source.has_value());  // CI always has ../shared beside the project
     const Dem srtm = test::crop(io::read_dem(*source), 500, 300, 36, 30);
     const auto t = test::segment_tile(srtm, designed_labels(srtm));
@@ -602,8 +602,8 @@ TEST_CASE("regions.geojson of a global grid: split at the seam, poles closed, ar
 }
 
 TEST_CASE("regions.geojson of LDEM_4 (0..360): valid, within range, areas add up",
-          "[write_region_polygons][global][shared]") {
-    const auto source = test::shared_data("moon_lola_ldem4/LDEM_4.LBL");
+          "[write_region_polygons][global][real_data]") {
+    const auto source = test::real_data("moon_lola_ldem4/LDEM_4.LBL");
     REQUIRE(source.has_value());
     const Dem ldem = io::read_dem(*source);
     REQUIRE(ldem.georef.global_longitude);

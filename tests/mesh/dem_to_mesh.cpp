@@ -174,8 +174,8 @@ TEST_CASE("dem_to_mesh: the global LOLA Moon is a closed sphere", "[mesh]") {
     CHECK(p2v[5] == mesh.pole_vertices[0]);
 }
 
-TEST_CASE("dem_to_mesh: LDEM_4 closes, area within 1% of 4 pi R^2", "[mesh][shared]") {
-    const auto path = test::shared_data("moon_lola_ldem4/LDEM_4.LBL");
+TEST_CASE("dem_to_mesh: LDEM_4 closes, area within 1% of 4 pi R^2", "[mesh][real_data]") {
+    const auto path = test::real_data("moon_lola_ldem4/LDEM_4.LBL");
     REQUIRE(path.has_value());
     const auto mesh = mesh::dem_to_mesh(io::read_dem(*path));
     const auto topo = mesh_topology(mesh);
@@ -187,8 +187,8 @@ TEST_CASE("dem_to_mesh: LDEM_4 closes, area within 1% of 4 pi R^2", "[mesh][shar
 }
 
 TEST_CASE("dem_to_mesh: a projected tile's area is planimetric area x mean slope factor",
-          "[mesh][shared]") {
-    const auto path = test::shared_data("earth/bigtujunga_srtm30m_utm11.tif");
+          "[mesh][real_data]") {
+    const auto path = test::real_data("earth/bigtujunga_srtm30m_utm11.tif");
     REQUIRE(path.has_value());
     const Dem dem = io::read_dem(*path);
     const auto mesh = mesh::dem_to_mesh(dem);

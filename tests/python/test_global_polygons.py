@@ -148,8 +148,8 @@ def ldem4_out(cli, tmp_path_factory):
     scale spans 360.00006 x 180.00003 degrees), segmented."""
     from conftest import SOURCE_DIR
 
-    ldem = SOURCE_DIR.parent / "shared" / "data" / "moon_lola_ldem4" / "LDEM_4.LBL"
-    assert ldem.exists(), "../shared/data is beside the project in CI"
+    ldem = SOURCE_DIR / "tests" / "data" / "moon_lola_ldem4" / "LDEM_4.LBL"
+    assert ldem.exists(), "tests/data holds LDEM_4 (tests/data/README.md)"
     out = tmp_path_factory.mktemp("ldem4") / "out"
     done = cli("segment", ldem, "-o", out, "-q")
     assert done.returncode == 0, done.stderr
@@ -209,7 +209,7 @@ def test_ldem4_gpkg_to_lonlat_as_documented(cli, ldem4_out, monkeypatch):
 
     work = ldem4_out.parent / "gpkg"
     work.mkdir()
-    ldem = SOURCE_DIR.parent / "shared" / "data" / "moon_lola_ldem4" / "LDEM_4.LBL"
+    ldem = SOURCE_DIR / "tests" / "data" / "moon_lola_ldem4" / "LDEM_4.LBL"
     done = cli("segment", ldem, "-o", work / "out", "-q", "--format", "GPKG")
     assert done.returncode == 0, done.stderr
     text = (SOURCE_DIR / "docs" / "outputs.md").read_text()

@@ -207,7 +207,7 @@ TEST_CASE("The closed Moon is a tree with index sum 2", "[reeb]") {
         CHECK(s.loops == 0);
         CHECK(degree_sum(g) == 2);
     }
-    if (const auto ldem = test::shared_data("moon_lola_ldem4/LDEM_4.LBL")) {
+    if (const auto ldem = test::real_data("moon_lola_ldem4/LDEM_4.LBL")) {
         const auto big = io::read_dem(*ldem);
         const auto m = mesh::dem_to_mesh(big);
         const auto f = field::height_field(m, &big);

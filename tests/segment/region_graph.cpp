@@ -196,8 +196,8 @@ TEST_CASE("region_graph areas on the Moon are the pixels' footprints on the sphe
     CHECK(sum == Approx(test::labelled_area(t.dem, t.pixels)).epsilon(5e-6));
 }
 
-TEST_CASE("region_graph areas on a UTM tile match geodesic pixel areas", "[regions][shared]") {
-    const auto path = test::shared_data("earth/bigtujunga_srtm30m_utm11.tif");
+TEST_CASE("region_graph areas on a UTM tile match geodesic pixel areas", "[regions][real_data]") {
+    const auto path = test::real_data("earth/bigtujunga_srtm30m_utm11.tif");
     REQUIRE(path.has_value());  // CI always has ../shared beside the project
     const Dem srtm = test::crop(io::read_dem(*path), 300, 200, 40, 20);
     // One region per pixel: each area is one pixel's, interpolated between exact nodes.

@@ -19,8 +19,8 @@ std::string sample(const std::string& name) {
     return std::string(TERRAIN_SOURCE_DIR) + "/examples/data/" + name;
 }
 
-std::optional<std::string> shared_data(const std::string& relative) {
-    const std::string path = std::string(TERRAIN_SHARED_DATA_DIR) + "/" + relative;
+std::optional<std::string> real_data(const std::string& relative) {
+    const std::string path = std::string(TERRAIN_REAL_DATA_DIR) + "/" + relative;
     if (!std::filesystem::exists(path)) return std::nullopt;
     return path;
 }

@@ -13,8 +13,9 @@ namespace terrain::test {
 
 // examples/data/<name>
 std::string sample(const std::string& name);
-// ../shared/data/<relative>, or nullopt when the shared data is not beside the project.
-std::optional<std::string> shared_data(const std::string& relative);
+// tests/data/<relative>: the real DEMs the tests read (tests/data/README.md), or nullopt when
+// the file is missing.
+std::optional<std::string> real_data(const std::string& relative);
 
 // A fresh, empty directory under the build tree for one test (removed at the start of the
 // next run, kept for inspection after a failure).

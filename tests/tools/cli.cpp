@@ -33,8 +33,8 @@ TEST_CASE("terrain usage errors exit 2", "[cli]") {
     CHECK(run_cli({"info", "--help"}).status == 0);
 }
 
-TEST_CASE("terrain info --json on LDEM_4", "[cli][shared]") {
-    const auto path = terrain::test::shared_data("moon_lola_ldem4/LDEM_4.LBL");
+TEST_CASE("terrain info --json on LDEM_4", "[cli][real_data]") {
+    const auto path = terrain::test::real_data("moon_lola_ldem4/LDEM_4.LBL");
     REQUIRE(path.has_value());
     const auto r = run_cli({"info", *path, "--json"});
     REQUIRE(r.status == 0);

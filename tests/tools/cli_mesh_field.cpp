@@ -64,10 +64,10 @@ TEST_CASE("terrain mesh on the shared DEMs and the samples", "[cli][mesh]") {
         std::string input, expect;
     };
     const std::vector<Case> cases = {
-        {terrain::test::shared_data("moon_lola_ldem4/LDEM_4.LBL").value(),
+        {terrain::test::real_data("moon_lola_ldem4/LDEM_4.LBL").value(),
          "0 boundary edges in 0 loop(s), Euler characteristic 2, frame body"},
-        {terrain::test::shared_data("earth/bigtujunga_srtm30m_utm11.tif").value(), "frame map"},
-        {terrain::test::shared_data("mars_hirise_crop/mars_dtm.tif").value(), "8400 vertices"},
+        {terrain::test::real_data("earth/bigtujunga_srtm30m_utm11.tif").value(), "frame map"},
+        {terrain::test::sample("mars_hirise_crop.tif"), "8400 vertices"},
         {terrain::test::sample("vesta_hamo_tile.lbl"), "262144 vertices"},
         {terrain::test::sample("moon_ldem1_global.tif"), "Euler characteristic 2"},
     };
