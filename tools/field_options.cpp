@@ -118,10 +118,7 @@ void check_field_limits(const field::FieldOptions& options, const TriangleMesh& 
         return;
     if (std::string(field::shape_index_window(mesh, options.shape_index)) == "disk") {
         // Any radius costs the same; one wider than the grid sees nothing more.
-        double area = 0;
-        for (const float a : mesh.vertex_areas) area += a;
-        const double spacing =
-            std::sqrt(area / double(std::max<std::size_t>(1, mesh.vertex_areas.size())));
+        const double spacing = std::sqrt(mean_vertex_area(mesh));
         const double across = double(std::max(mesh.grid_width, mesh.grid_height)) * spacing;
         if (options.shape_index.radius > across)
             throw Error("options", "--radius " + std::to_string(options.shape_index.radius) +

@@ -34,10 +34,7 @@ void check_dem_mesh(const TriangleMesh& mesh) {
 
 std::vector<double> default_radii(const TriangleMesh& mesh) {
     check_dem_mesh(mesh);
-    double area = 0;
-    for (const float a : mesh.vertex_areas) area += a;
-    const double n = double(std::max<std::size_t>(1, mesh.vertex_areas.size()));
-    const double spacing = std::sqrt(area / n);
+    const double spacing = std::sqrt(mean_vertex_area(mesh));
     if (!(spacing > 0) || !std::isfinite(spacing))
         throw Error("field", "--radius auto needs a mesh with a positive area");
     // At least the first two rungs, so that even a small tile has a choice.
@@ -113,8 +110,8 @@ ScaleSelectedField scale_selected_shape_index(const TriangleMesh& mesh,
         out.scale[v] = rung;
         const float value = float(f / kFieldUnit);
         out.field[v] = top && rungs >= 3 ? 50.0f + kTopContrast * (value - 50.0f) : value;
-        state[v] = std::uint8_t((state[v] & ~kSignificant) | kChosen |
-                                (significant ? kSignificant : 0));
+        state[v] =
+            std::uint8_t((state[v] & ~kSignificant) | kChosen | (significant ? kSignificant : 0));
     };
     const auto steps = double(rungs);
     for (std::size_t i = 0; i < rungs; ++i) {
@@ -147,8 +144,8 @@ ScaleSelectedField scale_selected_shape_index(const TriangleMesh& mesh,
                     const bool rose = state[v] & kRising;
                     if (rose && c < previous_c[v])  // the previous rung was a peak
                         peak(v, previous_rung(v), previous_c[v], previous_f[v], false);
-                    state[v] = std::uint8_t(c >= previous_c[v] ? state[v] | kRising
-                                                                : state[v] & ~kRising);
+                    state[v] =
+                        std::uint8_t(c >= previous_c[v] ? state[v] | kRising : state[v] & ~kRising);
                 }
                 state[v] = std::uint8_t((state[v] & 0x0f) | kSeen | (rung << 4));
                 previous_c[v] = c;

@@ -611,6 +611,13 @@ std::vector<std::uint32_t> first_edge_slots(const TriangleMesh& mesh) {
     return first;
 }
 
+double mean_vertex_area(const TriangleMesh& mesh) {
+    if (mesh.vertex_areas.empty()) return 0;
+    double total = 0;
+    for (const float a : mesh.vertex_areas) total += a;
+    return total / double(mesh.vertex_areas.size());
+}
+
 MeshTopology mesh_topology(const TriangleMesh& mesh) {
     if (!mesh.grid_adjacency() && mesh.neighbor_offsets.size() != mesh.vertex_count() + 1) {
         TriangleMesh finished = mesh;  // no adjacency yet

@@ -124,12 +124,10 @@ SegmentOptions resolve_options(const SegmentOptions& options, bool dem) {
 double min_area_m2(const SegmentOptions& options, const TriangleMesh& mesh) {
     if (options.min_area.empty()) return 0;
     if (options.min_area != "auto") return parse_area(options.min_area);
-    double area = 0;
-    for (const float a : mesh.vertex_areas) area += a;
-    const double n = double(std::max<std::size_t>(1, mesh.vertex_areas.size()));
-    if (!(area > 0) || !std::isfinite(area))
+    const double pixel = mean_vertex_area(mesh);
+    if (!(pixel > 0) || !std::isfinite(pixel))
         throw Error("segment", "--min-area auto needs a mesh with a positive area");
-    return kAutoMinAreaPixels * area / n;
+    return kAutoMinAreaPixels * pixel;
 }
 
 double parse_area(const std::string& text, const std::string& option) {
@@ -406,7 +404,6 @@ SegmentResult segment(Input input, const SegmentOptions& requested, const Progre
     // A polygon format that cannot hold the DEM's coordinates is refused before any work.
     if (input.dem) io::check_polygon_format(*input.dem, options.format);
     SegmentResult result;
-    result.options = options;
     result.input = std::move(input);
     result.timings.push_back({"read", result.input.read_seconds});
     if (result.input.dem) result.timings.push_back({"mesh", result.input.mesh_seconds});

@@ -43,9 +43,9 @@ struct ShapeIndexOptions {
     // is a peak; a vertex takes its first significant peak (c >= contrast_curvedness) unless
     // a later one is peak_dominance times as strong, or its strongest peak when none is
     // significant; a rise to the ladder's top is no peak (the landform is wider than the
-    // ladder: a quarter of that rung's contrast, nearly planar). The field is 50 + 50 SI w, the shape index of the chosen radius with
-    // its contrast w = c^2 / (c^2 + contrast_curvedness^2): shapes too weak to be seen at
-    // any scale read as planar. rings and radius are ignored.
+    // ladder: a quarter of that rung's contrast, nearly planar). The field is 50 + 50 SI w, the
+    // shape index of the chosen radius with its contrast w = c^2 / (c^2 + contrast_curvedness^2):
+    // shapes too weak to be seen at any scale read as planar. rings and radius are ignored.
     bool auto_scale = false;
     std::vector<double> radii;
     double contrast_curvedness = 0.2;

@@ -200,6 +200,10 @@ void finish_grid_mesh(TriangleMesh& mesh, const ProgressFn& progress = {});
 
 MeshTopology mesh_topology(const TriangleMesh& mesh);
 
+// The mean of the vertex areas (the vertex areas summed in order as doubles, over their
+// count); 0 for a mesh without areas. On a DEM mesh, the ground area of a pixel.
+double mean_vertex_area(const TriangleMesh& mesh);
+
 // Each vertex's first slot among the directed edges (the prefix sums of the degrees, n + 1 of
 // them): the edge a -> b is slot first[a] + b's rank among a's neighbours. Throws
 // terrain::Error (stage "mesh") past 2^31 directed edges.

@@ -180,7 +180,6 @@ struct SegmentResult {
     // (metres) and each vertex's index in it, freed once the region table holds the scale.
     std::vector<double> field_radii;
     std::vector<std::uint8_t> field_scale;
-    SegmentOptions options;  // as resolved for this input (resolve_options)
 
     const Dem* dem() const { return input.dem ? &*input.dem : nullptr; }
     void add_time(const std::string& name, double seconds);
