@@ -25,24 +25,6 @@ std::vector<double> ramp(int n) {
     return v;
 }
 
-// info, mesh and segment on `input` each exit 1 with one line containing `expected`.
-void check_refused(const std::string& input, const std::filesystem::path& dir,
-                   const std::string& expected) {
-    const std::vector<std::vector<std::string>> commands = {
-        {"info", input},
-        {"mesh", input, "-o", (dir / "m.ply").string(), "-q"},
-        {"segment", input, "-o", (dir / "seg").string(), "-q"}};
-    for (const auto& args : commands) {
-        INFO(args[0] << " " << input);
-        const auto r = run_limited(args, 30, 2048);
-        CHECK(r.status == 1);
-        CHECK(line_count(r.err) == 1);
-        CHECK_THAT(r.err, Contains(expected));
-    }
-    CHECK_FALSE(std::filesystem::exists(dir / "m.ply"));
-    CHECK_FALSE(std::filesystem::exists(dir / "seg"));
-}
-
 }  // namespace
 
 TEST_CASE("absurd pixel sizes are refused before anything loops", "[robustness][dem]") {
@@ -54,14 +36,14 @@ TEST_CASE("absurd pixel sizes are refused before anything loops", "[robustness][
         spec.values = ramp(64);
         spec.crs = "EPSG:4326";
         spec.geotransform = {0, size, 0, 0, 0, -size};
-        check_refused(write_raster(dir / "huge_degrees.tif", spec), dir, "degrees");
+        check_refused(write_raster(dir / "huge_degrees.tif", spec), dir, {"degrees"}, 30);
     }
     // A PDS label with MAP_SCALE = 1e30 <KM/PIXEL> hung the same way.
     const auto huge = edited_vesta_label(dir, "scale1e30.lbl", "0.06954046238414907", "1e30");
-    check_refused(huge, dir, "half the circumference of Vesta");
+    check_refused(huge, dir, {"half the circumference of Vesta"}, 30);
     // MAP_SCALE = 0: pixels of no area gave an area of 0 and one flat region.
     const auto zero = edited_vesta_label(dir, "scale0.lbl", "0.06954046238414907", "0");
-    check_refused(zero, dir, "degenerate geotransform");
+    check_refused(zero, dir, {"degenerate geotransform"}, 30);
 }
 
 TEST_CASE("geographic grids beyond the poles are refused", "[robustness][dem]") {
@@ -71,7 +53,7 @@ TEST_CASE("geographic grids beyond the poles are refused", "[robustness][dem]") 
     spec.values = ramp(64);
     spec.crs = "EPSG:4326";
     spec.geotransform = {0, 10, 0, 95, 0, -80};  // latitudes 95 to -545: "the seam closes"
-    check_refused(write_raster(dir / "poles.tif", spec), dir, "inside +-90");
+    check_refused(write_raster(dir / "poles.tif", spec), dir, {"inside +-90"}, 30);
 }
 
 TEST_CASE("values are checked after scale and offset", "[robustness][dem]") {
@@ -81,7 +63,7 @@ TEST_CASE("values are checked after scale and offset", "[robustness][dem]") {
     scaled.values = ramp(64);
     for (auto& v : scaled.values) v += 1;
     scaled.scale = 1e308;  // values inf, area -nan, one region
-    check_refused(write_raster(dir / "scale.tif", scaled), dir, "after scale and offset");
+    check_refused(write_raster(dir / "scale.tif", scaled), dir, {"after scale and offset"}, 30);
 
     RasterSpec huge;
     huge.width = huge.height = 8;
@@ -89,13 +71,13 @@ TEST_CASE("values are checked after scale and offset", "[robustness][dem]") {
     huge.values = ramp(64);
     huge.values[27] = 1e300;
     huge.values[28] = -1e300;
-    check_refused(write_raster(dir / "e300.tif", huge), dir, "not a surface");
+    check_refused(write_raster(dir / "e300.tif", huge), dir, {"not a surface"}, 30);
 
     RasterSpec one;
     one.width = one.height = 8;
     one.values = ramp(64);
     one.values[18] = 1e30;
-    check_refused(write_raster(dir / "e30.tif", one), dir, "not a surface");
+    check_refused(write_raster(dir / "e30.tif", one), dir, {"not a surface"}, 30);
 }
 
 TEST_CASE("a sparse 20000x20000 GeoTIFF is described in bounded memory", "[robustness][dem]") {

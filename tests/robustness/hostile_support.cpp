@@ -1,5 +1,7 @@
 #include "hostile_support.hpp"
 
+#include <catch2/catch.hpp>
+
 #include <algorithm>
 #include <cstdlib>
 #include <fstream>
@@ -63,6 +65,26 @@ std::string edited_vesta_label(const std::filesystem::path& dir, const std::stri
 
 std::size_t line_count(const std::string& text) {
     return static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n'));
+}
+
+void check_refused(const std::string& input, const std::filesystem::path& dir,
+                   const std::vector<std::string>& expected, int seconds) {
+    const std::vector<std::vector<std::string>> commands = {
+        {"info", input},
+        {"mesh", input, "-o", (dir / "m.ply").string(), "-q"},
+        {"segment", input, "-o", (dir / "seg").string(), "-q"}};
+    for (const auto& args : commands) {
+        INFO(args[0] << " " << input);
+        const auto r = run_limited(args, seconds, 2048);
+        INFO(r.err);
+        CHECK(r.status == 1);
+        CHECK(line_count(r.err) == 1);
+        for (const auto& text : expected) CHECK_THAT(r.err, Catch::Matchers::Contains(text));
+        CHECK_THAT(r.err, !Catch::Matchers::Contains("divide_absorbed"));
+        CHECK(r.out.find("nan") == std::string::npos);
+    }
+    CHECK_FALSE(std::filesystem::exists(dir / "m.ply"));
+    CHECK_FALSE(std::filesystem::exists(dir / "seg"));
 }
 
 }  // namespace terrain::test

@@ -32,4 +32,10 @@ std::string edited_vesta_label(const std::filesystem::path& dir, const std::stri
 
 std::size_t line_count(const std::string& text);
 
+// info, mesh and segment on `input` each exit 1 within `seconds` with one line holding every
+// `expected` (never the name of an internal step such as divide_absorbed, no "nan" printed),
+// and write nothing into `dir`.
+void check_refused(const std::string& input, const std::filesystem::path& dir,
+                   const std::vector<std::string>& expected, int seconds = 60);
+
 }  // namespace terrain::test

@@ -118,28 +118,6 @@ bool ply_finite(const std::filesystem::path& path, std::size_t& vertices) {
     return bool(in);
 }
 
-// info, mesh and segment on `input` each exit 1 with one line containing every `expected`,
-// and write nothing.
-void check_refused(const std::string& input, const std::filesystem::path& dir,
-                   const std::vector<std::string>& expected) {
-    const std::vector<std::vector<std::string>> commands = {
-        {"info", input},
-        {"mesh", input, "-o", (dir / "m.ply").string(), "-q"},
-        {"segment", input, "-o", (dir / "seg").string(), "-q"}};
-    for (const auto& args : commands) {
-        INFO(args[0] << " " << input);
-        const auto r = run_limited(args, 60, 2048);
-        INFO(r.err);
-        CHECK(r.status == 1);
-        CHECK(line_count(r.err) == 1);
-        for (const auto& text : expected) CHECK_THAT(r.err, Contains(text));
-        CHECK_THAT(r.err, !Contains("divide_absorbed"));
-        CHECK(r.out.find("nan") == std::string::npos);
-    }
-    CHECK_FALSE(std::filesystem::exists(dir / "m.ply"));
-    CHECK_FALSE(std::filesystem::exists(dir / "seg"));
-}
-
 }  // namespace
 
 TEST_CASE("a PDS3 label whose radius lost its unit is refused, naming the key",
