@@ -9,7 +9,7 @@ using namespace terrain;
 TEST_CASE("describe_dem on LDEM_4: the Moon, radii, 7581 m pixels, global",
           "[describe_dem][real_data]") {
     const auto path = test::real_data("moon_lola_ldem4/LDEM_4.LBL");
-    REQUIRE(path.has_value());  // CI always has ../shared beside the project
+    REQUIRE(path.has_value());  // tests/data is in the repository
     const auto d = io::describe_dem(io::read_dem(*path));
     CHECK(d.body.name == "Moon");
     CHECK(d.body.semi_major_axis == 1737400);
@@ -40,7 +40,7 @@ TEST_CASE("describe_dem on the bundled global Moon and a crop", "[describe_dem]"
 
 TEST_CASE("describe_dem on the SRTM tile: Earth, 30 m, heights", "[describe_dem][real_data]") {
     const auto path = test::real_data("earth/bigtujunga_srtm30m_utm11.tif");
-    REQUIRE(path.has_value());  // CI always has ../shared beside the project
+    REQUIRE(path.has_value());  // tests/data is in the repository
     const auto d = io::describe_dem(io::read_dem(*path));
     CHECK(d.body.name == "Earth");
     CHECK(d.elevation == ElevationKind::height);

@@ -61,7 +61,7 @@ TEST_CASE("read_dem applies scale and offset and turns NoData into holes", "[rea
 
 TEST_CASE("read_dem on the real LOLA PDS3 product", "[read_dem][real_data]") {
     const auto path = test::real_data("moon_lola_ldem4/LDEM_4.LBL");
-    REQUIRE(path.has_value());  // CI always has ../shared beside the project
+    REQUIRE(path.has_value());  // tests/data is in the repository
     const Dem dem = io::read_dem(*path);
     CHECK(dem.width == 1440);
     CHECK(dem.height == 720);

@@ -281,7 +281,7 @@ TEST_CASE("sweep.png: axis titles and legend text", "[write_sweep_plot]") {
 TEST_CASE("preview.png on a UTM tile: north leans by the grid convergence, ticks follow it",
           "[write_preview][real_data]") {
     const auto path = test::real_data("earth/bigtujunga_srtm30m_utm11.tif");
-    REQUIRE(path.has_value());  // CI always has ../shared beside the project
+    REQUIRE(path.has_value());  // tests/data is in the repository
     const Dem dem = io::read_dem(*path);
     const std::vector<float> field(dem.size(), 50.f);
     const std::vector<std::uint32_t> pixels(dem.size(), 1);

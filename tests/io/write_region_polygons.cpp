@@ -184,7 +184,7 @@ TEST_CASE("regions.geojson on the Moon: lon/lat on the Moon, CRS recorded, areas
 
 TEST_CASE("regions.geojson on Earth is RFC 7946 lon/lat", "[write_region_polygons][real_data]") {
     const auto source = test::real_data("earth/bigtujunga_srtm30m_utm11.tif");
-    REQUIRE(source.has_value());  // CI always has ../shared beside the project
+    REQUIRE(source.has_value());  // tests/data is in the repository
     const Dem srtm = test::crop(io::read_dem(*source), 500, 300, 36, 30);
     const auto t = test::segment_tile(srtm, designed_labels(srtm));
     const auto dir = test::scratch_dir("write_region_polygons_earth");

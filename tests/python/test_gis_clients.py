@@ -182,7 +182,7 @@ def test_kml_on_earth_is_wgs84(cli, tmp_path):
 
     from conftest import SOURCE_DIR
 
-    srtm = SOURCE_DIR.parent / "shared" / "data" / "earth" / "bigtujunga_srtm30m_utm11.tif"
+    srtm = SOURCE_DIR / "tests" / "data" / "earth" / "bigtujunga_srtm30m_utm11.tif"
     assert srtm.exists(), srtm
     out = tmp_path / "out"
     done = cli("segment", srtm, "-o", out, "-q", "--format", "KML")

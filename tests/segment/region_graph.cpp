@@ -198,7 +198,7 @@ TEST_CASE("region_graph areas on the Moon are the pixels' footprints on the sphe
 
 TEST_CASE("region_graph areas on a UTM tile match geodesic pixel areas", "[regions][real_data]") {
     const auto path = test::real_data("earth/bigtujunga_srtm30m_utm11.tif");
-    REQUIRE(path.has_value());  // CI always has ../shared beside the project
+    REQUIRE(path.has_value());  // tests/data is in the repository
     const Dem srtm = test::crop(io::read_dem(*path), 300, 200, 40, 20);
     // One region per pixel: each area is one pixel's, interpolated between exact nodes.
     // (PolygonArea itself is good to about 1e-6 m^2 on a 30 m pixel far from the equator.)
