@@ -226,6 +226,15 @@ py::dict region_columns(const segment::RegionGraph& graph) {
         for (std::size_t i = 0; i < n; ++i) scale.mutable_at(i) = r[i].field_scale_m;
         d["field_scale_m"] = scale;
     }
+    if (graph.has_area_range) {  // the area thresholds each region lives over (--min-area auto)
+        py::array_t<double> from(n), to(n);
+        for (std::size_t i = 0; i < n; ++i) {
+            from.mutable_at(i) = r[i].min_area_from_m2;
+            to.mutable_at(i) = r[i].min_area_to_m2;
+        }
+        d["min_area_from_m2"] = from;
+        d["min_area_to_m2"] = to;
+    }
     return d;
 }
 

@@ -353,3 +353,35 @@ TEST_CASE("pipeline::segment on a large grid: every stage reports, never going b
         CHECK(reported.count(stage) == 1);
     }
 }
+
+TEST_CASE("pipeline::segment: a mesh file's defaults are the paper's, absorbed nodes whole",
+          "[pipeline]") {
+    // The landform defaults are for DEMs: a closed mesh with no option keeps the paper's
+    // behaviour (the shape diameter function or any field, the absorbed nodes whole), the
+    // same labels as --absorbed whole, other labels than --absorbed divide.
+    const auto run = [](const std::string& absorbed) {
+        pipeline::Input input;
+        input.mesh = test::torus_mesh(3, 1, 96, 48, false);
+        // Bumps on it, so that the simplification cancels and absorbs.
+        for (auto& p : input.mesh.positions)
+            p[2] += 0.3f * float(std::sin(5 * std::atan2(double(p[1]), double(p[0])) + p[2]) +
+                                 0.2 * std::sin(40.0 * p[0]));
+        pipeline::SegmentOptions options;
+        options.landform_defaults = true;  // as the command line sets it with no scale option
+        options.field = "height";
+        options.simplify.persistence = 0.02;
+        options.simplify.area_ratio = 2;
+        if (!absorbed.empty()) options.absorbed = absorbed;
+        return pipeline::segment(std::move(input), options);
+    };
+    const auto by_default = run("");
+    const auto whole = run("whole");
+    const auto divide = run("divide");
+    INFO(by_default.segmentation.region_count << " regions, " << by_default.after.critical << " critical");
+    CHECK_FALSE(by_default.regions.has_field_scale);
+    CHECK_FALSE(by_default.regions.has_area_range);
+    CHECK(by_default.segmentation.labels == whole.segmentation.labels);
+    CHECK(by_default.divided.absorbed == 0);
+    CHECK(divide.divided.absorbed > 0);
+    CHECK(divide.segmentation.labels != whole.segmentation.labels);
+}

@@ -237,3 +237,47 @@ def test_the_default_regions_carry_their_field_scale(moon, cli, tmp_path):
     assert set(scale[result.regions["vertex_count"] > 0]) <= set(radii)
     assert len(set(scale)) >= 2
     assert "field_scale_m" not in terrain.segment(moon, area_ratio=0.5).regions
+
+
+def test_the_default_regions_carry_their_range_of_area_thresholds(moon, cli, tmp_path):
+    # With --min-area auto each region records the area thresholds it lives over: from the
+    # map's own to the first doubling at which its seed is cancelled or has taken in its
+    # neighbours. The table, labels.tif's attribute table, regions.geojson and run.json say
+    # the same; a single scale has no such columns.
+    import json
+    result = terrain.segment(moon)
+    lo, hi = result.regions["min_area_from_m2"], result.regions["min_area_to_m2"]
+    seeded = result.regions["vertex_count"] > 0
+    out = tmp_path / "seg"
+    assert cli("segment", moon, "-o", out, "-q").returncode == 0
+    run = json.loads((out / "run.json").read_text())["parameters"]
+    floor = run["min_area_m2"]
+    assert np.all(lo[seeded] == floor) and np.all(hi[seeded] >= 2 * floor)
+    levels = np.log2(hi[seeded] / floor)
+    whole = hi[seeded] == hi.max()
+    assert np.allclose(levels[~whole], np.round(levels[~whole]))
+    assert whole.sum() >= 1 and (~whole).sum() > seeded.sum() // 2
+    features = json.loads((out / "regions.geojson").read_text())["features"]
+    by_id = {f["properties"]["id"]: f["properties"]["min_area_to_m2"] for f in features}
+    assert [by_id[int(i)] for i in result.regions["id"]] == list(hi)
+    labels = gdal.Open(str(out / "labels.tif"))
+    rat = labels.GetRasterBand(1).GetDefaultRAT()
+    names = [rat.GetNameOfCol(c) for c in range(rat.GetColumnCount())]
+    column = names.index("min_area_to_m2")
+    assert [rat.GetValueAsDouble(r, column) for r in range(rat.GetRowCount())] == \
+        pytest.approx(list(hi))
+    ladder = run["area_range"]
+    assert ladder["step"] == 2
+    assert ladder["thresholds_m2"][0] == floor
+    for t, n in zip(ladder["thresholds_m2"], ladder["regions"]):
+        assert n == int((hi > t).sum())
+    # A nested sweep from the map's threshold up: a region whose range passes a level has a
+    # seed there, so the sweep's regions at that level are at least as many.
+    areas = [floor * 2 ** k for k in range(0, 5)]
+    sweep = terrain.sweep(moon, min_areas=areas, radius="auto")
+    assert sweep.scales[0].region_count == result.region_count
+    for area, scale in zip(areas[1:], sweep.scales[1:]):
+        found = int((scale.regions["vertex_count"] > 0).sum())
+        assert int((hi > area).sum()) <= found < seeded.sum()
+    single = terrain.segment(moon, area_ratio=0.5).regions
+    assert "min_area_from_m2" not in single and "min_area_to_m2" not in single

@@ -83,6 +83,10 @@ std::vector<Attribute> region_attributes(const segment::RegionGraph& graph,
     a.push_back({"landform", std::string(segment::to_string(r.landform))});
     a.push_back({"neighbor_count", as_int(r.neighbor_count)});
     if (graph.has_field_scale) a.push_back({"field_scale_m", r.field_scale_m});
+    if (graph.has_area_range) {
+        a.push_back({"min_area_from_m2", r.min_area_from_m2});
+        a.push_back({"min_area_to_m2", r.min_area_to_m2});
+    }
     a.push_back({"representative_vertex", std::int64_t{r.representative_vertex}});
     const bool lonlat = graph.point_frame == segment::PointFrame::lonlat;
     const bool mesh = graph.point_frame == segment::PointFrame::mesh;

@@ -13,6 +13,7 @@
 #include "../core/release.hpp"
 #include "../core/significant.hpp"
 #include "parked_arrays.hpp"
+#include "region_scales.hpp"
 #include "terrain/core/error.hpp"
 #include "terrain/core/huge_pages.hpp"
 #include "terrain/core/json_writer.hpp"
@@ -26,6 +27,7 @@
 #include "terrain/io/write_segment_outputs.hpp"
 #include "terrain/mesh/dem_to_mesh.hpp"
 #include "terrain/pipeline/memory_plan.hpp"
+#include "terrain/segment/area_range.hpp"
 
 namespace terrain::pipeline {
 
@@ -376,28 +378,6 @@ ScaleResult segment_scale(const Input& input, const std::vector<float>& field,
                       scaled_progress(progress, 0.3, 1));
 }
 
-// Each region's field scale: the ladder's radius most of its vertices took (ties to the
-// smaller), then the per-vertex scales are freed.
-void set_region_scales(SegmentResult& result) {
-    auto& scale = result.field_scale;
-    const auto& labels = result.segmentation.labels;
-    auto& regions = result.regions.regions;
-    if (scale.empty() || scale.size() != labels.size()) return;
-    const std::size_t rungs = result.field_radii.size();
-    std::vector<std::uint32_t> counts(regions.size() * rungs, 0);
-    for (std::size_t v = 0; v < labels.size(); ++v)
-        if (labels[v] >= 1 && labels[v] <= regions.size() && scale[v] < rungs)
-            ++counts[(labels[v] - 1) * rungs + scale[v]];
-    for (std::size_t r = 0; r < regions.size(); ++r) {
-        std::size_t best = 0;
-        for (std::size_t k = 1; k < rungs; ++k)
-            if (counts[r * rungs + k] > counts[r * rungs + best]) best = k;
-        regions[r].field_scale_m = counts[r * rungs + best] > 0 ? result.field_radii[best] : 0;
-    }
-    result.regions.has_field_scale = true;
-    std::vector<std::uint8_t>().swap(scale);
-}
-
 SegmentResult segment(Input input, const SegmentOptions& requested, const ProgressFn& progress) {
     check_options(requested);
     const SegmentOptions options = resolve_options(requested, input.dem.has_value());
@@ -540,10 +520,23 @@ SegmentResult segment(Input input, const SegmentOptions& requested, const Progre
     result.parked_growing = parked.parked_bytes();
     const double placing = since(t2);
     auto scale = grow_scale(result.input, result.field, options, simplified, seconds,
-                            scaled_progress(progress, 0.62, 0.9));
+                            scaled_progress(progress, 0.62, 0.86));
     result.segmentation = std::move(scale.segmentation);
     result.after = scale.after;
     result.divided = scale.divided;
+    // The regions' range of area thresholds, simplifying the graph on (counted with the
+    // simplification): the graph goes as it is read.
+    std::vector<double> ranges;
+    if (options.min_area == "auto") {
+        const auto tr = clock::now();
+        segment::AreaRangeOptions range;
+        range.floor_m2 = result.min_area_m2;
+        range.persistence = thresholds.persistence;
+        ranges =
+            segment::seed_area_ranges(mesh, std::move(simplified.graph), result.segmentation.seeds,
+                                      range, scaled_progress(progress, 0.86, 0.9));
+        scale.simplify_seconds += since(tr);
+    }
     result.add_time("simplify", scale.simplify_seconds);
     // The simplified graph, its rewritten field and its absorbed flags are read no more: they
     // go before the DEM comes back as doubles for the region graph (the growing's peak).
@@ -555,7 +548,8 @@ SegmentResult segment(Input input, const SegmentOptions& requested, const Progre
         result.segmentation.region_count, result.dem(), scaled_progress(progress, 0.905, 1));
     // On a DEM, with the regions of valid pixels in no triangle (segment::label_pixels).
     result.segmentation.region_count = static_cast<std::uint32_t>(result.regions.regions.size());
-    set_region_scales(result);
+    internal::set_region_scales(result);
+    if (options.min_area == "auto") internal::set_area_ranges(result, ranges);
     result.add_time("grow", placing + scale.grow_seconds + since(t1));
     result.parked_file = parked.file_peak();
     result.parked_most = parked.most_parked();
@@ -699,6 +693,7 @@ void write_run_json(const SegmentResult& result, const std::string& input_path,
                options.min_area.empty() ? options.simplify.area_ratio : result.area_ratio_percent);
     if (!options.min_area.empty())
         j.field("min_area", options.min_area).field("min_area_m2", result.min_area_m2);
+    if (result.regions.has_area_range) internal::write_area_range(j, result);
     j.field("cost", options.cost == "auto" ? (dem ? "graph" : "standard") : options.cost.c_str())
         .field("saddle_penalty", options.saddle_penalty)
         .field("absorbed", options.absorbed)

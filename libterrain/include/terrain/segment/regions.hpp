@@ -63,6 +63,11 @@ struct Region {
     // The field's radius (metres) most of the region's vertices took when it was chosen per
     // vertex (--radius auto; ties to the smaller), 0 otherwise.
     double field_scale_m = 0;
+    // The area thresholds (m^2) over which the region exists (--min-area auto): from the
+    // threshold of this segmentation up to the first threshold, doubling, at which its seed is
+    // cancelled (segment::seed_area_ranges); 0 for a region with no seed (pixels in no
+    // triangle).
+    double min_area_from_m2 = 0, min_area_to_m2 = 0;
 };
 
 // Two regions that share at least one mesh edge.
@@ -84,6 +89,7 @@ struct RegionGraph {
     // on Earth), as WKT; empty otherwise.
     std::string point_crs_wkt;
     bool has_field_scale = false;  // the regions' field_scale_m are set (--radius auto)
+    bool has_area_range = false;   // their min_area_from_m2 and min_area_to_m2 are set
 };
 
 // The regions of `labels` (one per vertex, 1..region_count, every id used) with their
