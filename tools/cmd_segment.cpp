@@ -21,15 +21,19 @@ int run_segment(int argc, char** argv) {
         po::options_description options("terrain segment options");
         add_common_options(options, common, "OUTDIR: the directory to write");
         add_segment_options(options, segment_values);
+        options.add_options()("craters", po::value(&segment_values.craters)->default_value("on"),
+                              "on: a DEM's craters read from the regions (craters.csv, "
+                              "craters.scc; docs/craters.md); off");
         add_field_options(options, field_values);
         add_input_options(options, input_values);
         po::variables_map vm;
-        if (!parse_command(argc, argv,
-                           "terrain segment INPUT -o OUTDIR [--radius auto|M] [--persistence 10] "
-                           "[--area-ratio 0.5 | --min-area auto|AREA] [--cost graph|standard] "
-                           "[--saddle-penalty 20] [--absorbed auto|divide|whole] "
-                           "[--format GeoJSON|GPKG|...] [--timings]",
-                           options, vm))
+        if (!parse_command(
+                argc, argv,
+                "terrain segment INPUT -o OUTDIR [--radius auto|M] [--persistence 10] "
+                "[--area-ratio 0.5 | --min-area auto|AREA] [--cost graph|standard] "
+                "[--saddle-penalty 20] [--absorbed auto|divide|whole] [--craters on|off] "
+                "[--format GeoJSON|GPKG|...] [--timings]",
+                options, vm))
             return 0;
         // (refuses contradictions: exit status 2)
         field_values.options = to_field_options(field_values, vm);

@@ -51,6 +51,9 @@ pipeline::SegmentOptions to_pipeline_options(const FieldOptionValues& field,
     out.absorbed = values.absorbed;
     out.format = values.format;
     out.landform_defaults = values.landform_defaults;
+    if (values.craters != "on" && values.craters != "off")
+        throw UsageError("--craters takes on or off, not '" + values.craters + "'");
+    out.craters = values.craters == "on";
     pipeline::check_options(out);
     return out;
 }

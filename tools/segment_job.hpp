@@ -18,6 +18,7 @@ struct SegmentOptionValues {
     segment::GrowOptions grow;
     std::string cost = "auto";
     std::string absorbed = "auto";
+    std::string craters = "on";      // --craters on|off
     bool landform_defaults = false;  // no scale option given (no_scale_option)
     std::string format = "GeoJSON";
     bool timings = false;

@@ -238,6 +238,41 @@ py::dict region_columns(const segment::RegionGraph& graph) {
     return d;
 }
 
+// The crater table as numpy columns (docs/craters.md); lon, lat are map x, y without a CRS.
+py::dict crater_columns(const segment::CraterTable& table) {
+    const auto& k = table.craters;
+    const std::size_t n = k.size();
+    py::dict d;
+    const auto column = [&](const char* name, auto get) {
+        py::array_t<double> a(n);
+        for (std::size_t i = 0; i < n; ++i) a.mutable_at(i) = get(k[i]);
+        d[name] = a;
+    };
+    py::array_t<std::uint32_t> id(n), floor(n);
+    py::list rims;
+    for (std::size_t i = 0; i < n; ++i) {
+        id.mutable_at(i) = k[i].id;
+        floor.mutable_at(i) = k[i].floor_region;
+        rims.append(py::cast(k[i].rim_regions));
+    }
+    d["id"] = id;
+    column(table.lonlat ? "lon" : "x", [](const segment::Crater& c) { return c.lon; });
+    column(table.lonlat ? "lat" : "y", [](const segment::Crater& c) { return c.lat; });
+    column("col", [](const segment::Crater& c) { return c.col; });
+    column("row", [](const segment::Crater& c) { return c.row; });
+    column("diameter_m", [](const segment::Crater& c) { return c.diameter_m; });
+    column("depth_m", [](const segment::Crater& c) { return c.depth_m; });
+    column("rim_height_m", [](const segment::Crater& c) { return c.rim_height_m; });
+    column("circularity", [](const segment::Crater& c) { return c.circularity; });
+    column("rim_fraction", [](const segment::Crater& c) { return c.rim_fraction; });
+    column("fit_rms_m", [](const segment::Crater& c) { return c.fit_rms_m; });
+    column("field_scale_m", [](const segment::Crater& c) { return c.field_scale_m; });
+    d["floor_region"] = floor;
+    d["rim_regions"] = rims;
+    column("confidence", [](const segment::Crater& c) { return c.confidence; });
+    return d;
+}
+
 py::dict edge_columns(const segment::RegionGraph& graph) {
     const auto& e = graph.edges;
     const std::size_t n = e.size();
@@ -465,6 +500,7 @@ PYBIND11_MODULE(_terrain, m) {
         .def_readwrite("saddle_penalty", &pipeline::SegmentOptions::saddle_penalty)
         .def_readwrite("absorbed", &pipeline::SegmentOptions::absorbed)
         .def_readwrite("format", &pipeline::SegmentOptions::format)
+        .def_readwrite("craters", &pipeline::SegmentOptions::craters)
         .def("check", &pipeline::check_options);
 
     py::class_<pipeline::SegmentResult>(m, "SegmentResult")
@@ -507,6 +543,16 @@ PYBIND11_MODULE(_terrain, m) {
                                })
         .def_property_readonly(
             "point_crs", [](const pipeline::SegmentResult& r) { return r.regions.point_crs_wkt; })
+        .def_property_readonly("crater_columns",
+                               [](const pipeline::SegmentResult& r) -> py::object {
+                                   if (!r.craters) return py::none();
+                                   return crater_columns(*r.craters);
+                               })
+        .def_property_readonly("crater_crs",
+                               [](const pipeline::SegmentResult& r) -> py::object {
+                                   if (!r.craters || !r.craters->lonlat) return py::none();
+                                   return py::str(r.craters->lonlat_crs_wkt);
+                               })
         .def_property_readonly("dem",
                                [](const pipeline::SegmentResult& r) -> py::object {
                                    if (!r.input.dem) return py::none();

@@ -42,7 +42,7 @@ __all__ = [
 _SEGMENT_OPTIONS = (
     "field", "rings", "radius", "radii", "window", "rays", "cone_angle", "postprocess", "allow_open",
     "persistence", "area_ratio", "min_area", "cost", "saddle_penalty", "absorbed",
-    "format",
+    "format", "craters",
 )
 # The options that set a scale: given none, a DEM takes the landform defaults (radius "auto",
 # min_area "auto"; docs/segment.md), as `terrain segment` does.
@@ -180,6 +180,8 @@ class SegmentResult:
     regions: the region table, a dict of numpy columns (id, area_m2, field_mean, landform,
         point_x/y/z, ...; docs/outputs.md).
     graph: the adjacency graph (RegionGraph; .to_networkx()).
+    craters: the craters read from the regions, a geopandas.GeoDataFrame of points at their
+        centres (docs/craters.md); None for a mesh file or with craters=False.
     region_count, critical_before, critical_after, timings, dem.
     """
 
@@ -199,6 +201,22 @@ class SegmentResult:
     timings = property(lambda self: self._native.timings)
     dem = property(lambda self: self._native.dem)
     point_frame = property(lambda self: self._native.point_frame)
+
+    @property
+    def craters(self):
+        columns = self._native.crater_columns
+        if columns is None:
+            return None
+        import geopandas
+        import pandas
+
+        table = pandas.DataFrame(columns)
+        x, y = ("lon", "lat") if "lon" in columns else ("x", "y")
+        crs = self._native.crater_crs
+        if crs is None and "lon" not in columns:
+            crs = self.dem.crs if self.dem is not None and self.dem.crs else None
+        return geopandas.GeoDataFrame(
+            table, geometry=geopandas.points_from_xy(table[x], table[y]), crs=crs)
 
     def to_geodataframe(self):
         """The region polygons with the region table's columns, as a geopandas.GeoDataFrame

@@ -77,6 +77,16 @@ def inputs(terrain, work, tiles, size, global_width):
     return out
 
 
+def input_arguments(parser):
+    """The arguments of the crater benchmarks: the build, the inputs made and the options."""
+    parser.add_argument("build")
+    parser.add_argument("--tiles", type=int, default=3)
+    parser.add_argument("--tile-size", type=int, default=1024)
+    parser.add_argument("--global-width", type=int, default=2048)
+    parser.add_argument("--work")
+    parser.add_argument("--args", default="")
+
+
 def run(terrain, cases, work, args, title):
     total = {}
     print(f"\n== {title}: terrain segment {' '.join(args) or '(no options)'}")
@@ -104,12 +114,7 @@ def _ratio(a, b):
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("build")
-    parser.add_argument("--tiles", type=int, default=3)
-    parser.add_argument("--tile-size", type=int, default=1024)
-    parser.add_argument("--global-width", type=int, default=2048)
-    parser.add_argument("--work")
-    parser.add_argument("--args", default="")
+    input_arguments(parser)
     parser.add_argument("--compare")
     parser.add_argument("--concave-below", type=float, default=crater_score.CONCAVE_BELOW,
                         help="the mean shape index x100 under which a region is concave "

@@ -281,3 +281,42 @@ def test_the_default_regions_carry_their_range_of_area_thresholds(moon, cli, tmp
         assert int((hi > area).sum()) <= found < seeded.sum()
     single = terrain.segment(moon, area_ratio=0.5).regions
     assert "min_area_from_m2" not in single and "min_area_to_m2" not in single
+
+
+def test_the_crater_table_in_python_and_files(moon, cli, tmp_path):
+    # The craters read from the regions: a GeoDataFrame of points at their centres in the
+    # body's lon/lat, the same rows as craters.csv; craters.scc holds them for craterstats
+    # with the DEM's valid area; craters=False / --craters off make none.
+    import csv
+    result = terrain.segment(moon)
+    craters = result.craters
+    assert craters is not None and len(craters) > 0
+    assert craters.crs is not None and craters.crs.is_geographic
+    assert np.allclose(craters.geometry.x, craters["lon"]) and np.allclose(craters.geometry.y,
+                                                                          craters["lat"])
+    assert (craters["diameter_m"] > 0).all() and (craters["depth_m"] > 0).all()
+    assert craters["confidence"].between(0.4, 1).all()
+    ids = set(result.regions["id"])
+    for floor, rims in zip(craters["floor_region"], craters["rim_regions"]):
+        assert floor in ids and rims and set(rims) <= ids
+    mean = dict(zip(result.regions["id"], result.regions["field_mean"]))
+    assert all(mean[f] < 50 for f in craters["floor_region"])
+    out = tmp_path / "seg"
+    assert cli("segment", moon, "-o", out, "-q").returncode == 0
+    with open(out / "craters.csv") as f:
+        rows = list(csv.DictReader(f))
+    assert len(rows) == len(craters)
+    assert [float(r["diameter_m"]) for r in rows] == pytest.approx(list(craters["diameter_m"]))
+    assert [float(r["lon"]) for r in rows] == pytest.approx(list(craters["lon"]))
+    scc = (out / "craters.scc").read_text().splitlines()
+    area = [line for line in scc if line.startswith("Total_area")][0]
+    assert float(area.split("=")[1].split("<")[0]) == pytest.approx(
+        result.regions["area_m2"].sum() / 1e6, rel=1e-9)
+    start = scc.index("crater = {diam,lon,lat")
+    table = [line.split("\t") for line in scc[start + 1:scc.index("}", start)]]
+    assert [float(t[0]) for t in table] == pytest.approx(list(craters["diameter_m"] / 1000))
+    assert [float(t[1]) for t in table] == pytest.approx(list(craters["lon"]))
+    assert terrain.segment(moon, craters=False).craters is None
+    off = tmp_path / "off"
+    assert cli("segment", moon, "-o", off, "-q", "--craters", "off").returncode == 0
+    assert not (off / "craters.csv").exists() and not (off / "craters.scc").exists()

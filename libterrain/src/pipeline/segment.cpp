@@ -21,6 +21,7 @@
 #include "terrain/core/version.hpp"
 #include "terrain/io/dependency_versions.hpp"
 #include "terrain/io/mesh_files.hpp"
+#include "terrain/io/write_craters.hpp"
 #include "terrain/io/write_label_raster.hpp"
 #include "terrain/io/write_preview.hpp"
 #include "terrain/io/write_region_polygons.hpp"
@@ -550,6 +551,9 @@ SegmentResult segment(Input input, const SegmentOptions& requested, const Progre
     result.segmentation.region_count = static_cast<std::uint32_t>(result.regions.regions.size());
     internal::set_region_scales(result);
     if (options.min_area == "auto") internal::set_area_ranges(result, ranges);
+    if (options.craters && result.input.dem)
+        result.craters = segment::find_craters(mesh, *result.input.dem, result.segmentation.labels,
+                                               result.regions);
     result.add_time("grow", placing + scale.grow_seconds + since(t1));
     result.parked_file = parked.file_peak();
     result.parked_most = parked.most_parked();
@@ -645,7 +649,6 @@ std::vector<std::string> write_segment_directory(SegmentResult& result, const Se
     const auto paths =
         io::write_segment_outputs(dir, result.input.mesh, result.field, result.segmentation.labels,
                                   result.regions, result.dem(), out, progress);
-    result.add_time("write", since(t0));
     std::vector<std::string> names;
     for (const auto& p : paths) {
         names.push_back(fs::path(p).filename().string());
@@ -653,6 +656,18 @@ std::vector<std::string> write_segment_directory(SegmentResult& result, const Se
         if (result.dem() && p == paths.front())
             names.push_back(fs::path(io::label_style_path(p)).filename().string());
     }
+    if (result.craters) {
+        io::write_craters_csv(*result.craters, (fs::path(dir) / "craters.csv").string(), false);
+        names.push_back("craters.csv");
+        if (result.craters->lonlat) {
+            double area = 0;
+            for (const auto& r : result.regions.regions) area += r.area_m2;
+            io::write_craters_scc(*result.craters, result.dem()->body, area,
+                                  (fs::path(dir) / "craters.scc").string(), false);
+            names.push_back("craters.scc");
+        }
+    }
+    result.add_time("write", since(t0));
     if (write.release_memory) release_large_data(result);
     if (deferred) {
         const auto t1 = clock::now();
@@ -733,8 +748,9 @@ void write_run_json(const SegmentResult& result, const std::string& input_path,
         .field("parked_bytes_field", result.parked_field)
         .field("parked_bytes_growing", result.parked_growing)
         .field("parked_bytes_most", result.parked_most)
-        .field("parked_file_bytes", result.parked_file)
-        .end_object();
+        .field("parked_file_bytes", result.parked_file);
+    if (result.craters) j.field("craters", result.craters->craters.size());
+    j.end_object();
     j.key("timings_seconds").begin_object();
     double total = 0;
     for (const auto& t : result.timings) {

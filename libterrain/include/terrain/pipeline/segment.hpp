@@ -26,6 +26,7 @@
 #include "terrain/mesh/triangle_mesh.hpp"
 #include "terrain/reeb/reeb_graph.hpp"
 #include "terrain/reeb/simplify.hpp"
+#include "terrain/segment/craters.hpp"
 #include "terrain/segment/divide_absorbed.hpp"
 #include "terrain/segment/grow_regions.hpp"
 #include "terrain/segment/regions.hpp"
@@ -95,6 +96,9 @@ struct SegmentOptions {
     // min_area "auto", whatever shape_index and min_area say; a mesh file is left as it is.
     // The command line and the Python module set it when no scale option is given.
     bool landform_defaults = false;
+    // DEM input: the craters read from the regions (segment::find_craters; craters.csv and
+    // craters.scc, docs/craters.md).
+    bool craters = true;
     // Large arrays that wait unread through the Reeb graph and the simplification (the DEM's
     // values, the field, the mesh's pixel maps) are parked in an unlinked temporary file in
     // this directory (empty: $TMPDIR, else /tmp) when they hold park_min_bytes or more; a
@@ -180,6 +184,7 @@ struct SegmentResult {
     // (metres) and each vertex's index in it, freed once the region table holds the scale.
     std::vector<double> field_radii;
     std::vector<std::uint8_t> field_scale;
+    std::optional<segment::CraterTable> craters;  // DEM input with SegmentOptions::craters
 
     const Dem* dem() const { return input.dem ? &*input.dem : nullptr; }
     void add_time(const std::string& name, double seconds);

@@ -1,0 +1,24 @@
+#pragma once
+// The crater table as files (docs/craters.md). Like every writer of io/: atomic, refuses an
+// existing file unless `overwrite`, throws one terrain::Error (stage "write") on failure, and
+// writes the same bytes for the same input.
+
+#include <string>
+
+#include "terrain/core/body.hpp"
+#include "terrain/segment/craters.hpp"
+
+namespace terrain::io {
+
+// craters.csv: one row per crater, id, lon, lat (x, y without lon/lat), col, row, diameter_m, depth_m,
+// rim_height_m, circularity, rim_fraction, fit_rms_m, field_scale_m, floor_region,
+// rim_regions (space-separated ids), confidence.
+void write_craters_csv(const segment::CraterTable& table, const std::string& path, bool overwrite);
+
+// craters.scc: craterstats' spatial crater count: the body's axes, the counted area
+// (`area_m2`, the DEM's valid area on the body) and the craters' diameters (km) and centres.
+// Throws terrain::Error (stage "write") for a table without lon/lat.
+void write_craters_scc(const segment::CraterTable& table, const Body& body, double area_m2,
+                       const std::string& path, bool overwrite);
+
+}  // namespace terrain::io

@@ -1,0 +1,71 @@
+#pragma once
+// Craters read from the regions (docs/craters.md): a crater is a concave floor region ringed
+// by convex rim regions. The table is a reading of a segmentation; the regions are unchanged.
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "terrain/core/dem.hpp"
+#include "terrain/mesh/triangle_mesh.hpp"
+#include "terrain/segment/regions.hpp"
+
+namespace terrain::segment {
+
+struct Crater {
+    std::uint32_t id = 0;  // 1..N, by floor region id
+    // The rim circle's centre: lon, lat in degrees (planetocentric, east-positive) on a body
+    // frame or a DEM with a CRS; map x, y without one.
+    double lon = 0, lat = 0;
+    double col = 0, row = 0;   // the centre on the DEM's grid (0, 0: its top-left corner)
+    double diameter_m = 0;     // rim crest to rim crest: the fitted circle's diameter
+    double depth_m = 0;        // mean rim crest height minus the floor's lowest height
+    double rim_height_m = 0;   // mean rim crest height minus the mean height 1.5-2 R out
+    double circularity = 0;    // of the floor region: 4 pi area / perimeter^2
+    double rim_fraction = 0;   // share of the 36 directions with a rim crest on the circle
+    double fit_rms_m = 0;      // the crest points' RMS distance to the circle
+    double field_scale_m = 0;  // the floor region's field scale (0 without one)
+    std::uint32_t floor_region = 0;
+    std::vector<std::uint32_t> rim_regions;  // the convex regions the crest was found in
+    // rim_fraction x fit quality (1 - 4 fit_rms_m / radius, at least 0) x roundness (the
+    // floor's circularity over CraterOptions::round_floor, at most 1): in [0, 1].
+    double confidence = 0;
+};
+
+struct CraterTable {
+    std::vector<Crater> craters;
+    bool lonlat = false;  // lon/lat (else map x, y)
+    std::string lonlat_crs_wkt;
+};
+
+struct CraterOptions {
+    double concave_below = 50;  // a floor's mean field (shape index x 100) is below this
+    double convex_above = 50;   // a rim region's mean field is above this
+    double min_rim_fraction = 0.5;
+    double min_confidence = 0.4;
+    // A floor this round (4 pi area / perimeter^2) or rounder takes its whole confidence; a
+    // less round one, in proportion.
+    double round_floor = 0.4;
+
+    // The rim crest is looked for between these multiples of the floor's radius (of a disk
+    // of its area) from its centroid.
+    double crest_from = 0.8, crest_to = 1.4;
+};
+
+// The craters of a DEM's segmentation: `labels` per mesh vertex (1..regions), `graph` its
+// region graph (segment::region_graph), `dem` the DEM the mesh was made from. For each
+// concave region with convex neighbours: the highest vertex of those neighbours in each of 36
+// directions from the floor's centroid (between crest_from and crest_to floor radii) is a rim crest
+// point; a circle is fitted to them (twice, dropping points more than a quarter radius off);
+// kept when crest points are found in half the directions or more, the radius is between
+// 0.8 crest_from and crest_to floor radii, the depth positive and the confidence at least
+// min_confidence. Of two craters
+// whose centres are within half the larger radius and whose radii are within 1.5x, the more
+// confident stays. Deterministic. Throws terrain::Error (stage "craters") on sizes that do
+// not match.
+CraterTable find_craters(const TriangleMesh& mesh, const Dem& dem,
+                         const std::vector<std::uint32_t>& labels, const RegionGraph& graph,
+                         const CraterOptions& options = {});
+
+}  // namespace terrain::segment

@@ -1,0 +1,383 @@
+// Craters read from the regions (craters.hpp, docs/craters.md).
+//
+// Each concave region with convex neighbours is a possible crater floor. Its centroid and the
+// plane tangent to the body there give a local frame in metres; the rim crest is looked for
+// in 36 directions around the centroid, as the highest vertex of the convex neighbours in each
+// direction; a circle fitted to those points is the rim. The floor's own vertices also give
+// the affine map from the frame to the grid's pixels, which places the circle's centre on the
+// grid (and so on the body, as the regions' points are) and finds the ring of surroundings.
+#include "terrain/segment/craters.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+#include "terrain/core/error.hpp"
+
+namespace terrain::segment {
+namespace {
+
+using V3 = std::array<double, 3>;
+constexpr int kSectors = 36;
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+V3 sub(const V3& a, const V3& b) {
+    return {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
+}
+double dot(const V3& a, const V3& b) {
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+V3 cross(const V3& a, const V3& b) {
+    return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+}
+V3 unit(const V3& a) {
+    const double n = std::sqrt(dot(a, a));
+    return n > 0 ? V3{a[0] / n, a[1] / n, a[2] / n} : V3{0, 0, 1};
+}
+
+// Solves the 3 x 3 system m x = b (Cramer); false when it is singular.
+bool solve3(const std::array<std::array<double, 3>, 3>& m, const V3& b, V3& x) {
+    const auto det = [](const std::array<std::array<double, 3>, 3>& a) {
+        return a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) -
+               a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0]) +
+               a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0]);
+    };
+    const double d = det(m);
+    if (!(std::abs(d) > 0) || !std::isfinite(d)) return false;
+    for (int k = 0; k < 3; ++k) {
+        auto a = m;
+        for (int i = 0; i < 3; ++i) a[std::size_t(i)][std::size_t(k)] = b[std::size_t(i)];
+        x[std::size_t(k)] = det(a) / d;
+    }
+    return true;
+}
+
+// Least squares of y ~ c0 + c1 u + c2 v, accumulated point by point.
+struct Affine {
+    std::array<std::array<double, 3>, 3> m{};
+    V3 b{};
+    void add(double u, double v, double y) {
+        const V3 p{1, u, v};
+        for (std::size_t i = 0; i < 3; ++i) {
+            for (std::size_t j = 0; j < 3; ++j) m[i][j] += p[i] * p[j];
+            b[i] += p[i] * y;
+        }
+    }
+};
+
+struct Circle {
+    double x = 0, y = 0, r = 0, rms = 0;
+    int points = 0;
+};
+
+// Kasa's algebraic fit (x^2 + y^2 + a x + b y + c = 0) to the points with `use`.
+bool fit_circle(const std::array<double, kSectors>& px, const std::array<double, kSectors>& py,
+                const std::array<bool, kSectors>& use, Circle& out) {
+    std::array<std::array<double, 3>, 3> m{};
+    V3 b{};
+    int n = 0;
+    for (int s = 0; s < kSectors; ++s) {
+        if (!use[std::size_t(s)]) continue;
+        const double x = px[std::size_t(s)], y = py[std::size_t(s)], z = -(x * x + y * y);
+        const V3 p{x, y, 1};
+        for (std::size_t i = 0; i < 3; ++i) {
+            for (std::size_t j = 0; j < 3; ++j) m[i][j] += p[i] * p[j];
+            b[i] += p[i] * z;
+        }
+        ++n;
+    }
+    V3 abc;
+    if (n < 3 || !solve3(m, b, abc)) return false;
+    out.x = -abc[0] / 2;
+    out.y = -abc[1] / 2;
+    const double r2 = out.x * out.x + out.y * out.y - abc[2];
+    if (!(r2 > 0)) return false;
+    out.r = std::sqrt(r2);
+    double e2 = 0;
+    for (int s = 0; s < kSectors; ++s)
+        if (use[std::size_t(s)]) {
+            const double e =
+                std::hypot(px[std::size_t(s)] - out.x, py[std::size_t(s)] - out.y) - out.r;
+            e2 += e * e;
+        }
+    out.rms = std::sqrt(e2 / n);
+    out.points = n;
+    return true;
+}
+
+// A possible floor and what the passes gather for it.
+struct Floor {
+    std::uint32_t region = 0;
+    V3 sum{};
+    std::size_t count = 0;
+    V3 centre{}, e1{}, e2{};
+    double radius = 0;  // of a disk of the region's area
+    double lowest = kInf;
+    int first_col = -1;  // columns unwrapped around this one on a closed grid
+    Affine col, row;     // pixel column and row from the frame's x, y
+    std::array<double, kSectors> x{}, y{}, h{};
+    std::array<std::uint32_t, kSectors> from{};
+    Circle circle;
+    std::array<bool, kSectors> kept{};
+    double crest = 0;
+};
+
+}  // namespace
+
+CraterTable find_craters(const TriangleMesh& mesh, const Dem& dem,
+                         const std::vector<std::uint32_t>& labels, const RegionGraph& graph,
+                         const CraterOptions& options) {
+    const std::size_t n = mesh.vertex_count();
+    if (labels.size() != n || mesh.vertex_pixel.size() != n ||
+        mesh.pixel_vertex.size() != std::size_t(dem.width) * std::size_t(dem.height))
+        throw Error("craters", "the labels, the mesh and the DEM do not match");
+    const auto& regions = graph.regions;
+    const std::size_t m = regions.size();
+    const double crest_from = options.crest_from, crest_to = options.crest_to;
+    const auto mean = [&](std::uint32_t id) { return regions[id - 1].field_mean; };
+    const auto convex = [&](std::uint32_t id) { return mean(id) > options.convex_above; };
+    // Perimeters and the length shared with convex neighbours.
+    std::vector<double> perimeter(m + 1, 0), rim(m + 1, 0);
+    for (const auto& e : graph.edges) {
+        perimeter[e.a] += e.boundary_length_m;
+        perimeter[e.b] += e.boundary_length_m;
+        if (convex(e.b)) rim[e.a] += e.boundary_length_m;
+        if (convex(e.a)) rim[e.b] += e.boundary_length_m;
+    }
+    std::vector<Floor> floors;
+    std::vector<std::int32_t> floor_of(m + 1, -1);
+    for (const auto& r : regions) {
+        if (!(r.field_mean < options.concave_below) || r.vertex_count < 3 ||
+            !(perimeter[r.id] > 0) || rim[r.id] < 0.5 * options.min_rim_fraction * perimeter[r.id])
+            continue;
+        floor_of[r.id] = std::int32_t(floors.size());
+        floors.push_back({});
+        floors.back().region = r.id;
+        floors.back().radius = std::sqrt(r.area_m2 / std::numbers::pi);
+    }
+    // The convex neighbours of each floor, as lists by convex region.
+    std::vector<std::vector<std::int32_t>> rim_of(m + 1);
+    for (const auto& e : graph.edges) {
+        if (floor_of[e.a] >= 0 && convex(e.b)) rim_of[e.b].push_back(floor_of[e.a]);
+        if (floor_of[e.b] >= 0 && convex(e.a)) rim_of[e.a].push_back(floor_of[e.b]);
+    }
+    const auto height = [&](std::size_t v) {
+        const auto p = std::size_t(mesh.vertex_pixel[v]);
+        return dem.height_at(int(p % std::size_t(dem.width)), int(p / std::size_t(dem.width)));
+    };
+    // Pass 1: the floors' centroids, lowest heights and a column of each.
+    for (std::size_t v = 0; v < n; ++v) {
+        const auto f = labels[v] <= m ? floor_of[labels[v]] : -1;
+        if (f < 0) continue;
+        auto& fl = floors[std::size_t(f)];
+        const auto p = mesh.position(v);
+        for (int k = 0; k < 3; ++k) fl.sum[std::size_t(k)] += p[std::size_t(k)];
+        ++fl.count;
+        fl.lowest = std::min(fl.lowest, height(v));
+        if (fl.first_col < 0)
+            fl.first_col = int(std::size_t(mesh.vertex_pixel[v]) % std::size_t(dem.width));
+    }
+    for (auto& fl : floors) {
+        const double c = double(std::max<std::size_t>(fl.count, 1));
+        fl.centre = {fl.sum[0] / c, fl.sum[1] / c, fl.sum[2] / c};
+        const V3 up = mesh.frame == MeshFrame::body ? unit(fl.centre) : V3{0, 0, 1};
+        const V3 axis = std::abs(up[2]) < 0.9 ? V3{0, 0, 1} : V3{1, 0, 0};
+        fl.e1 = unit(cross(axis, up));
+        fl.e2 = cross(up, fl.e1);
+        fl.h.fill(-kInf);
+    }
+    // Pass 2: the affine maps to pixels over each floor; the highest rim vertex by direction.
+    const double width = dem.width;
+    const auto unwrapped = [&](const Floor& fl, double col) {
+        if (!mesh.seam_closed) return col;
+        if (col - fl.first_col > width / 2) return col - width;
+        if (fl.first_col - col > width / 2) return col + width;
+        return col;
+    };
+    for (std::size_t v = 0; v < n; ++v) {
+        const auto label = labels[v];
+        if (label == 0 || label > m) continue;
+        const auto f = floor_of[label];
+        if (f < 0 && rim_of[label].empty()) continue;
+        const auto p = mesh.position(v);
+        if (f >= 0) {
+            auto& fl = floors[std::size_t(f)];
+            const V3 d = sub(p, fl.centre);
+            const double x = dot(d, fl.e1), y = dot(d, fl.e2);
+            const auto pixel = std::size_t(mesh.vertex_pixel[v]);
+            fl.col.add(x, y, unwrapped(fl, double(pixel % std::size_t(dem.width)) + 0.5));
+            fl.row.add(x, y, double(pixel / std::size_t(dem.width)) + 0.5);
+            continue;
+        }
+        const double h = height(v);
+        for (const auto fi : rim_of[label]) {
+            auto& fl = floors[std::size_t(fi)];
+            const V3 d = sub(p, fl.centre);
+            const double x = dot(d, fl.e1), y = dot(d, fl.e2), r = std::hypot(x, y);
+            if (r < crest_from * fl.radius || r > crest_to * fl.radius) continue;
+            const double turn = (std::atan2(y, x) + std::numbers::pi) / (2 * std::numbers::pi);
+            const auto s = std::size_t(std::min(kSectors - 1, int(turn * kSectors)));
+            if (h > fl.h[s]) {
+                fl.h[s] = h;
+                fl.x[s] = x;
+                fl.y[s] = y;
+                fl.from[s] = label;
+            }
+        }
+    }
+    // The circles.
+    std::vector<std::size_t> found;
+    for (std::size_t f = 0; f < floors.size(); ++f) {
+        auto& fl = floors[f];
+        for (int s = 0; s < kSectors; ++s) fl.kept[std::size_t(s)] = fl.h[std::size_t(s)] > -kInf;
+        Circle c;
+        if (!fit_circle(fl.x, fl.y, fl.kept, c)) continue;
+        for (int s = 0; s < kSectors; ++s) {
+            const auto i = std::size_t(s);
+            if (fl.kept[i] && std::abs(std::hypot(fl.x[i] - c.x, fl.y[i] - c.y) - c.r) > 0.25 * c.r)
+                fl.kept[i] = false;
+        }
+        if (!fit_circle(fl.x, fl.y, fl.kept, c)) continue;
+        fl.circle = c;
+        double crest = 0;
+        for (int s = 0; s < kSectors; ++s)
+            if (fl.kept[std::size_t(s)]) crest += fl.h[std::size_t(s)];
+        fl.crest = crest / c.points;
+        const double fraction = double(c.points) / kSectors;
+        if (fraction < options.min_rim_fraction || c.r < 0.8 * crest_from * fl.radius ||
+            c.r > crest_to * fl.radius || !(fl.crest > fl.lowest))
+            continue;
+        found.push_back(f);
+    }
+    // The table, with the ring of surroundings from the grid around each centre.
+    CraterTable table;
+    std::vector<double> cx, cy;
+    for (const auto f : found) {
+        const auto& fl = floors[f];
+        const auto& c = fl.circle;
+        const double quality = std::max(0.0, 1 - 4 * c.rms / c.r);
+        Crater k;
+        k.floor_region = fl.region;
+        k.diameter_m = 2 * c.r;
+        k.depth_m = fl.crest - fl.lowest;
+        k.rim_fraction = double(c.points) / kSectors;
+        k.fit_rms_m = c.rms;
+        const auto& region = regions[fl.region - 1];
+        k.field_scale_m = region.field_scale_m;
+        k.circularity = std::min(1.0, 4 * std::numbers::pi * region.area_m2 /
+                                          (perimeter[fl.region] * perimeter[fl.region]));
+        const double roundness =
+            options.round_floor > 0 ? std::min(1.0, k.circularity / options.round_floor) : 1.0;
+        k.confidence = k.rim_fraction * quality * roundness;
+        if (k.confidence < options.min_confidence) continue;
+        for (int s = 0; s < kSectors; ++s)
+            if (fl.kept[std::size_t(s)]) k.rim_regions.push_back(fl.from[std::size_t(s)]);
+        std::sort(k.rim_regions.begin(), k.rim_regions.end());
+        k.rim_regions.erase(std::unique(k.rim_regions.begin(), k.rim_regions.end()),
+                            k.rim_regions.end());
+        V3 ac, ar;
+        if (!solve3(fl.col.m, fl.col.b, ac) || !solve3(fl.row.m, fl.row.b, ar)) continue;
+        const auto to_pixel = [&](double x, double y) {
+            return std::array<double, 2>{ac[0] + ac[1] * x + ac[2] * y,
+                                         ar[0] + ar[1] * x + ar[2] * y};
+        };
+        const auto centre = to_pixel(c.x, c.y);
+        k.col = centre[0];
+        k.row = centre[1];
+        // The surroundings: pixels 1.5 to 2 radii from the centre.
+        double lo_c = kInf, hi_c = -kInf, lo_r = kInf, hi_r = -kInf;
+        for (const double sx : {-2.0, 2.0})
+            for (const double sy : {-2.0, 2.0}) {
+                const auto q = to_pixel(c.x + sx * c.r, c.y + sy * c.r);
+                lo_c = std::min(lo_c, q[0]);
+                hi_c = std::max(hi_c, q[0]);
+                lo_r = std::min(lo_r, q[1]);
+                hi_r = std::max(hi_r, q[1]);
+            }
+        double ring = 0;
+        std::size_t ring_n = 0;
+        const int r0 = std::max(0, int(std::floor(lo_r))),
+                  r1 = std::min(dem.height - 1, int(std::ceil(hi_r)));
+        const int c0 = std::max(0, int(std::floor(lo_c))),
+                  c1 = std::min(dem.width - 1, int(std::ceil(hi_c)));
+        for (int row = r0; row <= r1; ++row)
+            for (int col = c0; col <= c1; ++col) {
+                const auto v =
+                    mesh.pixel_vertex[std::size_t(row) * std::size_t(dem.width) + std::size_t(col)];
+                if (v < 0) continue;
+                const V3 d = sub(mesh.position(std::size_t(v)), fl.centre);
+                const double r = std::hypot(dot(d, fl.e1) - c.x, dot(d, fl.e2) - c.y);
+                if (r < 1.5 * c.r || r > 2 * c.r) continue;
+                ring += dem.height_at(col, row);
+                ++ring_n;
+            }
+        k.rim_height_m = ring_n > 0 ? fl.crest - ring / double(ring_n)
+                                    : std::numeric_limits<double>::quiet_NaN();
+        const auto xy = dem.map_xy(centre[0], centre[1]);
+        cx.push_back(xy[0]);
+        cy.push_back(xy[1]);
+        table.craters.push_back(std::move(k));
+    }
+    // Of two craters at one place and size, the more confident (ties: the lower floor id).
+    std::vector<V3> at;
+    std::vector<double> radius;
+    for (const auto& k : table.craters) {
+        const auto& fl = floors[std::size_t(floor_of[k.floor_region])];
+        const auto& c = fl.circle;
+        V3 p = fl.centre;
+        for (std::size_t i = 0; i < 3; ++i) p[i] += c.x * fl.e1[i] + c.y * fl.e2[i];
+        at.push_back(p);
+        radius.push_back(c.r);
+    }
+    std::vector<std::size_t> by_x(at.size());
+    for (std::size_t i = 0; i < by_x.size(); ++i) by_x[i] = i;
+    std::sort(by_x.begin(), by_x.end(), [&](std::size_t a, std::size_t b) {
+        return at[a][0] < at[b][0] || (at[a][0] == at[b][0] && a < b);
+    });
+    std::vector<std::uint8_t> gone(at.size(), 0);
+    const auto better = [&](std::size_t a, std::size_t b) {
+        const auto &ka = table.craters[a], &kb = table.craters[b];
+        return ka.confidence > kb.confidence ||
+               (ka.confidence == kb.confidence && ka.floor_region < kb.floor_region);
+    };
+    for (std::size_t i = 0; i < by_x.size(); ++i)
+        for (std::size_t j = i + 1; j < by_x.size(); ++j) {
+            const auto a = by_x[i], b = by_x[j];
+            // Radii within 1.5x and centres within half the larger: |dx| < 0.75 of a's.
+            if (at[b][0] - at[a][0] > 0.75 * radius[a]) break;
+            const double big = std::max(radius[a], radius[b]),
+                         small = std::min(radius[a], radius[b]);
+            if (big > 1.5 * small ||
+                std::sqrt(dot(sub(at[a], at[b]), sub(at[a], at[b]))) > 0.5 * big)
+                continue;
+            gone[better(a, b) ? b : a] = 1;
+        }
+    std::size_t kept = 0;
+    for (std::size_t i = 0; i < table.craters.size(); ++i) {
+        if (gone[i]) continue;
+        if (kept != i) table.craters[kept] = std::move(table.craters[i]);
+        cx[kept] = cx[i];
+        cy[kept] = cy[i];
+        ++kept;
+    }
+    table.craters.resize(kept);
+    cx.resize(kept);
+    cy.resize(kept);
+    table.lonlat = false;
+    if (!dem.crs_wkt.empty() && dem.georef_current() && dem.georef.output_lonlat) {
+        const LonLatMapping& frame = *dem.georef.output_lonlat;
+        if (!frame.to_lonlat(cx.size(), cx.data(), cy.data()))
+            throw Error("craters", "a crater's centre has no longitude/latitude on the body");
+        table.lonlat = true;
+        table.lonlat_crs_wkt = frame.lonlat_crs_wkt();
+    }
+    for (std::size_t i = 0; i < table.craters.size(); ++i) {
+        table.craters[i].id = std::uint32_t(i + 1);
+        table.craters[i].lon = cx[i];
+        table.craters[i].lat = cy[i];
+    }
+    return table;
+}
+
+}  // namespace terrain::segment

@@ -1,0 +1,88 @@
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <cmath>
+
+#include "support/test_meshes.hpp"
+#include "terrain/core/error.hpp"
+#include "terrain/pipeline/segment.hpp"
+#include "terrain/segment/craters.hpp"
+
+using namespace terrain;
+
+namespace {
+
+// A paraboloid bowl of radius R and depth `depth` whose rim rises `rim` above a plane, centred
+// at (cx, cy) in pixel coordinates (1 m pixels, no CRS): the rim crest is the circle of radius
+// R, `depth + rim` above the bowl's bottom.
+Dem bowl_dem(int size, double cx, double cy, double R, double depth, double rim) {
+    return test::grid_dem(size, size, [=](int c, int r) {
+        const double d = std::hypot(c + 0.5 - cx, r + 0.5 - cy);
+        const double bowl = d < R ? depth * ((d / R) * (d / R) - 1) : 0.0;
+        const double w = (d - R) / (0.3 * R);
+        return bowl + rim * std::exp(-w * w);
+    });
+}
+
+pipeline::SegmentResult segment_dem(Dem dem) {
+    pipeline::SegmentOptions options;
+    options.landform_defaults = true;
+    return pipeline::segment(pipeline::input_from_dem(std::move(dem)), options);
+}
+
+}  // namespace
+
+TEST_CASE("Craters: an analytic bowl's centre, diameter and depth", "[craters]") {
+    for (const double R : {12.0, 30.0}) {
+        const double cx = 80.3, cy = 79.6, depth = 0.2 * R, rim = 0.04 * R;
+        auto result = segment_dem(bowl_dem(160, cx, cy, R, depth, rim));
+        REQUIRE(result.craters);
+        const auto& table = result.craters->craters;
+        INFO("R = " << R << " px, " << table.size() << " craters");
+        REQUIRE(!table.empty());
+        CHECK_FALSE(result.craters->lonlat);
+        // The most confident is the bowl.
+        const auto& k = *std::max_element(
+            table.begin(), table.end(),
+            [](const auto& a, const auto& b) { return a.confidence < b.confidence; });
+        CHECK(std::hypot(k.col - cx, k.row - cy) < 1.0);
+        CHECK(k.diameter_m == Approx(2 * R).epsilon(0.05));
+        CHECK(k.depth_m == Approx(depth + rim).epsilon(0.05));
+        CHECK(k.rim_fraction > 0.9);
+        CHECK(k.confidence > 0.6);
+        // Map coordinates without a CRS: the grid's x and y of the centre.
+        const auto xy = result.dem()->map_xy(k.col, k.row);
+        CHECK(k.lon == Approx(xy[0]));
+        CHECK(k.lat == Approx(xy[1]));
+        // The floor is concave and its rims convex.
+        const auto& floor = result.regions.regions[k.floor_region - 1];
+        CHECK(floor.field_mean < 50);
+        REQUIRE(!k.rim_regions.empty());
+        for (const auto r : k.rim_regions) CHECK(result.regions.regions[r - 1].field_mean > 50);
+    }
+}
+
+TEST_CASE("Craters: a plane and a dome have none; off gives no table", "[craters]") {
+    auto plane =
+        segment_dem(test::grid_dem(96, 96, [](int c, int r) { return 0.01 * c + 0.02 * r; }));
+    REQUIRE(plane.craters);
+    CHECK(plane.craters->craters.empty());
+    auto dome = segment_dem(bowl_dem(120, 60, 60, 25, -5, 0));  // (a negative depth: a dome)
+    REQUIRE(dome.craters);
+    CHECK(dome.craters->craters.empty());
+    pipeline::SegmentOptions off;
+    off.landform_defaults = true;
+    off.craters = false;
+    const auto none =
+        pipeline::segment(pipeline::input_from_dem(bowl_dem(96, 48, 48, 12, 3, 0.5)), off);
+    CHECK_FALSE(none.craters);
+}
+
+TEST_CASE("Craters: sizes that do not match are refused", "[craters]") {
+    const auto dem = bowl_dem(40, 20, 20, 8, 2, 0.3);
+    auto result = segment_dem(dem);
+    auto labels = result.segmentation.labels;
+    labels.pop_back();
+    CHECK_THROWS_AS(segment::find_craters(result.input.mesh, *result.dem(), labels, result.regions),
+                    Error);
+}
