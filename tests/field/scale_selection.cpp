@@ -125,6 +125,25 @@ TEST_CASE("the scale-selected field is the same on any thread count", "[scale_se
     CHECK(field::shape_index_field(mesh, options) == many.field);
 }
 
+TEST_CASE("the ladder's field is the same with the normals made by bands of rows",
+          "[scale_selection]") {
+    // With the triangles freed the grid method makes its normals a row of tiles at a time
+    // (band_normals); with them held, the whole mesh's at once: the same bits either way.
+    const int n = 160;
+    const auto dem = grid(n, [](double x, double y) {
+        return crater(x, y, 40, 60, 7) + crater(x, y, 100, 90, 22) + 0.3 * std::sin(0.7 * x + y);
+    });
+    const auto held = mesh::dem_to_mesh(dem);
+    auto freed = held;
+    REQUIRE(freed.release_triangles());
+    field::ShapeIndexOptions options;
+    options.auto_scale = true;
+    const auto whole = field::scale_selected_shape_index(held, options);
+    const auto bands = field::scale_selected_shape_index(freed, options);
+    CHECK(whole.field == bands.field);
+    CHECK(whole.scale == bands.scale);
+}
+
 TEST_CASE("a ladder of radii is checked", "[scale_selection]") {
     const auto mesh = mesh::dem_to_mesh(grid(64, [](double, double) { return 0.0; }));
     field::ShapeIndexOptions options;

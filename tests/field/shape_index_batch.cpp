@@ -194,3 +194,38 @@ TEST_CASE("shape index: rings gathered with a small set of the vertices seen are
     CHECK(largest > 700);  // a pole's two rings
     CHECK(differing == 0);
 }
+
+TEST_CASE("shape index: the normals made a band of pixel rows at a time are the whole mesh's",
+          "[shape_index]") {
+    // band_normals against vertex_normals of the mesh with its triangles held, bit for bit, on
+    // bands of 1, 5 and 64 rows: poles and the seam (the global Moon), NoData, the grid's edges.
+    std::size_t meshes = 0, compared = 0, differing = 0;
+    auto dems = test_meshes();
+    dems.push_back(mesh::dem_to_mesh(grid_dem(83, 70, [](int c, int r) {
+        return (c / 9 + r / 7) % 5 == 0 && c % 9 > 2 && r % 7 > 2
+                   ? kNaN
+                   : std::cos(c * 0.21) * std::sin(r * 0.17) * 600 + ((c * 13 + r * 7) % 5) * 30.0;
+    })));
+    for (auto& mesh : dems) {
+        const auto whole = field::detail::vertex_normals(mesh);
+        if (!mesh.release_triangles() || !field::detail::normals_by_bands(mesh)) continue;
+        ++meshes;
+        const int W = mesh.grid_width, H = mesh.grid_height;
+        field::detail::Normals band;
+        for (const int rows : {1, 5, 64})
+            for (int r0 = 0; r0 < H; r0 += rows) {
+                const int r1 = std::min(H, r0 + rows);
+                field::detail::band_normals(mesh, r0, r1, band);
+                for (std::size_t p = std::size_t(r0) * W; p < std::size_t(r1) * W; ++p) {
+                    const auto v = mesh.pixel_vertex[p];
+                    if (v < 0) continue;
+                    ++compared;
+                    for (int k = 0; k < 3; ++k)
+                        differing += !same_bits(band[std::size_t(v)][k], whole[std::size_t(v)][k]);
+                }
+            }
+    }
+    CHECK(meshes >= 3);
+    CHECK(compared > 100000);
+    CHECK(differing == 0);
+}

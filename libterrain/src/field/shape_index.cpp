@@ -21,23 +21,34 @@
 namespace terrain::field {
 namespace detail {
 
-// Area-weighted vertex normals; triangles are counter-clockwise seen from outside/above. Each
-// vertex's sum is taken in triangle order; a DEM mesh whose rows of blocks can be made alone
-// (terrain::detail::rows_of_triangles) sums them on every thread by bands of block rows
-// (terrain::detail::add_in_order_by_bands), the sums of one pass in order.
+namespace {
+
+// Adds triangle t's area-weighted normal (counter-clockwise seen from outside/above) to its
+// corners v that take(v) takes, at normals[v - first].
+template <class Take>
+void add_normal(const TriangleMesh& mesh, const std::array<std::int32_t, 3>& t, std::size_t first,
+                std::vector<Vec3>& normals, const Take& take) {
+    const auto& p = mesh.positions;
+    const Vec3 n = cross(sub(p[t[1]], p[t[0]]), sub(p[t[2]], p[t[0]]));
+    for (auto v : t)
+        if (take(v))
+            for (int k = 0; k < 3; ++k) normals[std::size_t(v) - first][k] += n[k];
+}
+
+}  // namespace
+
+// Area-weighted vertex normals. Each vertex's sum is taken in triangle order; a DEM mesh whose
+// rows of blocks can be made alone (terrain::detail::rows_of_triangles) sums them on every
+// thread by bands of block rows (terrain::detail::add_in_order_by_bands), the sums of one
+// pass in order.
 std::vector<Vec3> vertex_normals(const TriangleMesh& mesh, const ProgressFn& progress) {
     const terrain::detail::PassProgress summed(progress, 0.3, 0.8, "shape index");
     std::vector<Vec3> normals;  // made a slice at a time: the first touch of a block is slow
     terrain::detail::assign_in_slices(
         normals, mesh.vertex_count(), Vec3{0, 0, 0},
         terrain::detail::PassProgress(progress, 0, 0.3, "shape index"));
-    const auto& p = mesh.positions;
-    // Adds triangle t's normal to its corners that `take` takes.
     const auto add = [&](const std::array<std::int32_t, 3>& t, auto&& take) {
-        const Vec3 n = cross(sub(p[t[1]], p[t[0]]), sub(p[t[2]], p[t[0]]));
-        for (auto v : t)
-            if (take(v))
-                for (int k = 0; k < 3; ++k) normals[v][k] += n[k];
+        add_normal(mesh, t, 0, normals, take);
     };
     if (terrain::detail::rows_of_triangles(mesh)) {
         const std::int64_t W = mesh.grid_width;
@@ -60,6 +71,45 @@ std::vector<Vec3> vertex_normals(const TriangleMesh& mesh, const ProgressFn& pro
                                              normals[v] = normalized(normals[v]);
                                      });
     return normals;
+}
+
+bool normals_by_bands(const TriangleMesh& mesh) {
+    return terrain::detail::rows_of_triangles(mesh) && mesh.pinched_vertices == 0 &&
+           mesh.vertex_pixel.size() == mesh.vertex_count();
+}
+
+// A vertex of pixel row p is a corner only in block rows p - 1 and p: the band's sums take
+// block rows r0 - 1 to r1 - 1 through add_in_order_by_bands, as vertex_normals does, adding
+// only to the band's vertices, each of whose sums thus runs in triangle order.
+void band_normals(const TriangleMesh& mesh, int r0, int r1, Normals& out) {
+    const std::size_t W = std::size_t(mesh.grid_width);
+    std::int32_t lo = std::numeric_limits<std::int32_t>::max(), hi = -1;
+    for (std::size_t p = std::size_t(r0) * W; p < std::size_t(r1) * W; ++p)
+        if (const auto v = mesh.pixel_vertex[p]; v >= 0) lo = std::min(lo, v), hi = std::max(hi, v);
+    out.first = hi < lo ? 0 : std::size_t(lo);
+    out.values.assign(hi < lo ? 0 : std::size_t(hi - lo) + 1, Vec3{0, 0, 0});
+    if (out.values.empty()) return;
+    const int base = std::max(r0 - 1, 0), end = std::min(r1, mesh.grid_height - 1);
+    const auto pixel_row = [&](std::int32_t v) {
+        return int(std::size_t(mesh.vertex_pixel[std::size_t(v)]) / W);
+    };
+    terrain::detail::add_in_order_by_bands(
+        end - base, [&](std::int32_t v) { return pixel_row(v) - base; },
+        [&](int row, const auto& f) {
+            terrain::detail::for_each_row_triangle(mesh, base + row, f);
+        },
+        [&](const std::array<std::int32_t, 3>& t, const auto& take) {
+            add_normal(mesh, t, out.first, out.values, [&](std::int32_t v) {
+                const int row = pixel_row(v);
+                return row >= r0 && row < r1 && take(v);
+            });
+        },
+        {}, 0, 1, "shape index");
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, out.values.size(), std::size_t{1} << 14),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                          for (std::size_t i = r.begin(); i < r.end(); ++i)
+                              out.values[i] = normalized(out.values[i]);
+                      });
 }
 
 namespace {
@@ -609,7 +659,7 @@ void fit_from_moments(double* moments, const Vec3& centre, const Vec3& ref, cons
 }
 
 // The vertices of one tile of output pixels [c0, c0 + kTile) x [r0, r0 + kTile).
-void grid_tile(const TriangleMesh& mesh, const GridLayout& g, const std::vector<Vec3>& normals,
+void grid_tile(const TriangleMesh& mesh, const GridLayout& g, const Normals& normals,
                const ShapeIndexOptions& options, int r0, int c0, GridScratch& s,
                std::size_t& mesh_fallbacks, const VertexFn& body) {
     const int W = g.width, H = g.height;
@@ -762,10 +812,48 @@ bool grid_applies(const TriangleMesh& mesh, const ShapeIndexOptions& options) {
     return grid;
 }
 
-// Every vertex once through `body`, by tiles of pixels; vertices no pixel owns (pinched
-// copies, collapsed poles) and windows the tiles cannot hold take the mesh path.
+// The normals the grid method reads, a band of pixel rows at a time where band_normals
+// applies (24 bytes a vertex of the band, not of the mesh: a ladder of radii holds its fits'
+// normals beside its own state), else the whole mesh's.
+class GridNormals {
+  public:
+    GridNormals(const TriangleMesh& mesh, const ProgressFn& progress)
+        : mesh_(mesh), by_bands_(normals_by_bands(mesh)) {
+        if (!by_bands_) normals_.values = vertex_normals(mesh, progress);
+    }
+    // The normals of (at least) the vertices of pixel rows [r0, r1).
+    const Normals& rows(int r0, int r1) {
+        if (by_bands_) band_normals(mesh_, r0, r1, normals_);
+        return normals_;
+    }
+
+  private:
+    const TriangleMesh& mesh_;
+    bool by_bands_;
+    Normals normals_;
+};
+
+// The vertices no pixel of g owns (pinched copies, collapsed poles), by their pixel's row.
+std::vector<std::int32_t> unowned_vertices(const TriangleMesh& mesh, const GridLayout& g) {
+    std::vector<std::int32_t> unowned;
+    for (std::size_t v = 0; v < mesh.vertex_count(); ++v) {
+        const auto p = std::size_t(mesh.vertex_pixel[v]);
+        if (g.vertex_at(int(p % std::size_t(g.width)), int(p / std::size_t(g.width))) !=
+            std::int32_t(v))
+            unowned.push_back(std::int32_t(v));
+    }
+    std::stable_sort(unowned.begin(), unowned.end(), [&](std::int32_t a, std::int32_t b) {
+        return mesh.vertex_pixel[std::size_t(a)] / g.width <
+               mesh.vertex_pixel[std::size_t(b)] / g.width;
+    });
+    return unowned;
+}
+
+// Every vertex once through `body`, by tiles of pixels, a row of tiles at a time; vertices no
+// pixel owns and windows the tiles cannot hold take the mesh path, the former after the
+// tiles with the normals kept from their row's band.
 std::size_t grid_for_each_vertex(const TriangleMesh& mesh, const GridLayout& g,
-                                 const ShapeIndexOptions& options, const std::vector<Vec3>& normals,
+                                 const ShapeIndexOptions& options, GridNormals& normals,
                                  const ProgressFn& progress, const VertexFn& body) {
     const bool disk = disk_applies(mesh, options);
     const GridLayout* disk_grid = disk ? &g : nullptr;
@@ -773,20 +861,22 @@ std::size_t grid_for_each_vertex(const TriangleMesh& mesh, const GridLayout& g,
     tbb::enumerable_thread_specific<std::size_t> fallbacks(0);
     const int tile = disk ? g.disk_tile : kTile;
     const int tile_rows = (g.height + tile - 1) / tile, tile_cols = (g.width + tile - 1) / tile;
+    const auto unowned = unowned_vertices(mesh, g);
+    std::vector<Vec3> unowned_normals(unowned.size());
+    std::size_t next_unowned = 0;
     for (int tr = 0; tr < tile_rows; ++tr) {
+        const int r0 = tr * tile, r1 = std::min(g.height, r0 + tile);
+        const Normals& band = normals.rows(r0, r1);
         tbb::parallel_for(tbb::blocked_range<int>(0, tile_cols, 1), [&](const auto& r) {
             for (int tc = r.begin(); tc < r.end(); ++tc)
-                (disk ? disk_tile : grid_tile)(mesh, g, normals, options, tr * tile, tc * tile,
+                (disk ? disk_tile : grid_tile)(mesh, g, band, options, r0, tc * tile,
                                                scratch.local(), fallbacks.local(), body);
         });
+        for (; next_unowned < unowned.size() &&
+               mesh.vertex_pixel[std::size_t(unowned[next_unowned])] / g.width < r1;
+             ++next_unowned)
+            unowned_normals[next_unowned] = band[std::size_t(unowned[next_unowned])];
         report_progress(progress, double(tr + 1) / tile_rows, "shape index");
-    }
-    std::vector<std::int32_t> unowned;
-    for (std::size_t v = 0; v < mesh.vertex_count(); ++v) {
-        const auto p = std::size_t(mesh.vertex_pixel[v]);
-        if (g.vertex_at(int(p % std::size_t(g.width)), int(p / std::size_t(g.width))) !=
-            std::int32_t(v))
-            unowned.push_back(std::int32_t(v));
     }
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, unowned.size(), 64), [&](const auto& r) {
         auto& s = scratch.local();
@@ -795,7 +885,7 @@ std::size_t grid_for_each_vertex(const TriangleMesh& mesh, const GridLayout& g,
             PrincipalCurvatures k;
             double scale = 0;
             const bool ok =
-                mesh_fit(mesh, v, normals[std::size_t(v)], options, disk_grid, s.mesh, k, scale);
+                mesh_fit(mesh, v, unowned_normals[i], options, disk_grid, s.mesh, k, scale);
             body(v, ok, k, scale);
         }
     });
@@ -856,17 +946,21 @@ void for_each_vertex(const TriangleMesh& mesh, const ShapeIndexOptions& options,
         throw Error("field", "--rings must be at least 1");
     if (options.radius < 0 || !std::isfinite(options.radius))
         throw Error("field", "--radius must be a positive number of metres");
-    // Normals 0 to 0.05 of the progress, the grid's layout to 0.06, the vertices to 1.
-    const auto normals = vertex_normals(mesh, scaled_progress(progress, 0, 0.05));
+    // Normals 0 to 0.05 of the progress (the grid method's, when made by bands, with its
+    // tiles), the grid's layout to 0.06, the vertices to 1.
     const bool grid = grid_applies(mesh, options), disk = disk_applies(mesh, options);
-    GridLayout layout;
-    if (grid || disk) layout = grid_layout(mesh, options.disk_tile_angle);
-    report_progress(progress, 0.06, "shape index");
     if (grid) {
+        GridNormals normals(mesh, scaled_progress(progress, 0, 0.05));
+        const auto layout = grid_layout(mesh, options.disk_tile_angle);
+        report_progress(progress, 0.06, "shape index");
         grid_for_each_vertex(mesh, layout, options, normals, scaled_progress(progress, 0.06, 1),
                              body);
         return;
     }
+    const auto normals = vertex_normals(mesh, scaled_progress(progress, 0, 0.05));
+    GridLayout layout;
+    if (disk) layout = grid_layout(mesh, options.disk_tile_angle);
+    report_progress(progress, 0.06, "shape index");
     const GridLayout* disk_grid = disk ? &layout : nullptr;
     // The rings window fits its vertices kFitLanes at a time (fit_curvatures_batch; a lane
     // with fewer neighbours than the others keeps its sums while they go on).

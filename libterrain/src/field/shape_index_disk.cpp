@@ -297,7 +297,7 @@ bool disk_mesh_fit(const TriangleMesh& mesh, const GridLayout& g, std::int32_t v
 // with the disk window: the region's row sums of the 22 Monge moments are summed down the rows too
 // (summed-area tables), so that each of a window's six bands costs four look-ups whatever
 // its size.
-void disk_tile(const TriangleMesh& mesh, const GridLayout& g, const std::vector<Vec3>& normals,
+void disk_tile(const TriangleMesh& mesh, const GridLayout& g, const Normals& normals,
                const ShapeIndexOptions& options, int r0, int c0, GridScratch& s,
                std::size_t& mesh_fallbacks, const VertexFn& body) {
     const int W = g.width, H = g.height;

@@ -174,6 +174,24 @@ std::array<Vec3, 2> tangent_frame(const Vec3& normal);
 // Area-weighted unit vertex normals, each vertex's sum taken in triangle order (shape_index.cpp).
 std::vector<Vec3> vertex_normals(const TriangleMesh& mesh, const ProgressFn& progress = {});
 
+// Unit vertex normals of the vertices [first, first + values.size()): all of a mesh's, or
+// those of a band of a DEM grid's pixel rows (band_normals).
+struct Normals {
+    std::size_t first = 0;
+    std::vector<Vec3> values;
+    const Vec3& operator[](std::size_t v) const { return values[v - first]; }
+};
+
+// Whether band_normals applies: a DEM mesh whose rows of triangles can be made alone, without
+// a split pinch (each vertex then owns its pixel, or its collapsed pole row's).
+bool normals_by_bands(const TriangleMesh& mesh);
+
+// The normals of the vertices of pixel rows [r0, r1), as vertex_normals gives them: the same
+// sums in the same order, so the same bits (shape_index.cpp). `out` spans the ids of the
+// vertices the rows' pixels own; where it holds a vertex of another row, that entry is no
+// normal.
+void band_normals(const TriangleMesh& mesh, int r0, int r1, Normals& out);
+
 // Fits h = a u^2 + b uv + c v^2 (+ d u + e v) to the m neighbours of v in the tangent frame of
 // `normal` (shape_index.cpp): the normal equations, then solve_curvatures. False when the
 // neighbourhood is too small.
@@ -363,7 +381,7 @@ bool disk_mesh_fit(const TriangleMesh& mesh, const GridLayout& g, std::int32_t v
 
 // The vertices of one tile of output pixels [c0, c0 + t) x [r0, r0 + t), t = g.disk_tile,
 // with the disk window, through `body` (shape_index_disk.cpp).
-void disk_tile(const TriangleMesh& mesh, const GridLayout& g, const std::vector<Vec3>& normals,
+void disk_tile(const TriangleMesh& mesh, const GridLayout& g, const Normals& normals,
                const ShapeIndexOptions& options, int r0, int c0, GridScratch& s,
                std::size_t& mesh_fallbacks, const VertexFn& body);
 
