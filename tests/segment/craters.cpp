@@ -62,7 +62,7 @@ TEST_CASE("Craters: an analytic bowl's centre, diameter and depth", "[craters]")
     }
 }
 
-TEST_CASE("Craters: a plane and a dome have none; off gives no table", "[craters]") {
+TEST_CASE("Craters: a plane and a dome have none, and off gives no table", "[craters]") {
     auto plane =
         segment_dem(test::grid_dem(96, 96, [](int c, int r) { return 0.01 * c + 0.02 * r; }));
     REQUIRE(plane.craters);
