@@ -316,7 +316,23 @@ def test_the_crater_table_in_python_and_files(moon, cli, tmp_path):
     table = [line.split("\t") for line in scc[start + 1:scc.index("}", start)]]
     assert [float(t[0]) for t in table] == pytest.approx(list(craters["diameter_m"] / 1000))
     assert [float(t[1]) for t in table] == pytest.approx(list(craters["lon"]))
+    # craters.geojson: a centre and a rim ring per crater, the ring on the body's sphere at
+    # the crater's radius from the centre, in the Moon's geographic CRS.
+    import geopandas
+    layer = geopandas.read_file(out / "craters.geojson")
+    assert layer.crs is not None and "Moon" in layer.crs.name
+    centres, rims = layer[layer["kind"] == "centre"], layer[layer["kind"] == "rim"]
+    assert len(centres) == len(rims) == len(craters)
+    assert np.allclose(centres.geometry.x, craters["lon"])
+    radius = 1737400.0
+    for (_, c), (_, r) in zip(centres.iterrows(), rims.iterrows()):
+        lon, lat = np.radians(np.array(r.geometry.exterior.coords)).T
+        lon0, lat0 = np.radians(c.geometry.x), np.radians(c.geometry.y)
+        cos = (np.sin(lat) * np.sin(lat0) + np.cos(lat) * np.cos(lat0) * np.cos(lon - lon0))
+        distance = radius * np.arccos(np.clip(cos, -1, 1))
+        assert np.allclose(distance, c["diameter_m"] / 2, rtol=0.03)
     assert terrain.segment(moon, craters=False).craters is None
     off = tmp_path / "off"
     assert cli("segment", moon, "-o", off, "-q", "--craters", "off").returncode == 0
-    assert not (off / "craters.csv").exists() and not (off / "craters.scc").exists()
+    assert not any((off / name).exists()
+                   for name in ("craters.csv", "craters.scc", "craters.geojson"))

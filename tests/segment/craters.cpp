@@ -54,6 +54,12 @@ TEST_CASE("Craters: an analytic bowl's centre, diameter and depth", "[craters]")
         const auto xy = result.dem()->map_xy(k.col, k.row);
         CHECK(k.lon == Approx(xy[0]));
         CHECK(k.lat == Approx(xy[1]));
+        // The rim ring: closed, on the bowl's rim (1 m pixels: map units are metres).
+        REQUIRE(k.rim.size() == std::size_t(segment::kRimPoints) + 1);
+        CHECK(k.rim.front() == k.rim.back());
+        const auto truth = result.dem()->map_xy(cx, cy);
+        for (const auto& p : k.rim)
+            CHECK(std::abs(std::hypot(p[0] - truth[0], p[1] - truth[1]) - R) < 1.5);
         // The floor is concave and its rims convex.
         const auto& floor = result.regions.regions[k.floor_region - 1];
         CHECK(floor.field_mean < 50);

@@ -2,7 +2,10 @@
 
 #include <cmath>
 
+#include "../geo/iau_crs.hpp"
 #include "dataset_files.hpp"
+#include "geojson_file.hpp"
+#include "lonlat_frame.hpp"
 #include "terrain/core/error.hpp"
 #include "terrain/core/json_writer.hpp"
 
@@ -32,6 +35,49 @@ void write_craters_csv(const segment::CraterTable& table, const std::string& pat
                 << field(k.field_scale_m) << ',' << k.floor_region << ',' << rims << ','
                 << field(k.confidence) << '\n';
         }
+    });
+}
+
+void write_craters_geojson(const segment::CraterTable& table, const std::string& path,
+                           bool overwrite) {
+    write_file_atomically(path, overwrite, [&](std::ostream& out) {
+        const std::string crs = table.lonlat
+                                    ? geojson_crs_name(geo::output_crs_wkt(table.lonlat_crs_wkt))
+                                    : local_grid_crs_wkt();
+        GeoJsonFile file(out, "craters", crs, table.lonlat ? 9 : 6);
+        std::int64_t id = 0;
+        for (const auto& k : table.craters) {
+            std::string rims;
+            for (const auto r : k.rim_regions)
+                rims += (rims.empty() ? "" : " ") + std::to_string(r);
+            std::vector<Attribute> a{{"kind", std::string("centre")},
+                                     {"id", std::int64_t{k.id}},
+                                     {table.lonlat ? "lon" : "x", k.lon},
+                                     {table.lonlat ? "lat" : "y", k.lat},
+                                     {"diameter_m", k.diameter_m},
+                                     {"depth_m", k.depth_m},
+                                     {"rim_height_m", k.rim_height_m},
+                                     {"circularity", k.circularity},
+                                     {"rim_fraction", k.rim_fraction},
+                                     {"fit_rms_m", k.fit_rms_m},
+                                     {"field_scale_m", k.field_scale_m},
+                                     {"floor_region", std::int64_t{k.floor_region}},
+                                     {"rim_regions", rims},
+                                     {"confidence", k.confidence}};
+            file.feature(++id, a, [&](JsonWriter& json) {
+                json.begin_object().field("type", "Point").key("coordinates");
+                file.position(json, k.lon, k.lat);
+                json.end_object();
+            });
+            a.front().value = std::string("rim");
+            file.feature(++id, a, [&](JsonWriter& json) {
+                json.begin_object().field("type", "Polygon").key("coordinates").begin_array();
+                json.begin_array();
+                for (const auto& p : k.rim) file.position(json, p[0], p[1]);
+                json.end_array().end_array().end_object();
+            });
+        }
+        file.finish();
     });
 }
 

@@ -658,7 +658,10 @@ std::vector<std::string> write_segment_directory(SegmentResult& result, const Se
     }
     if (result.craters) {
         io::write_craters_csv(*result.craters, (fs::path(dir) / "craters.csv").string(), false);
+        io::write_craters_geojson(*result.craters, (fs::path(dir) / "craters.geojson").string(),
+                                  false);
         names.push_back("craters.csv");
+        names.push_back("craters.geojson");
         if (result.craters->lonlat) {
             double area = 0;
             for (const auto& r : result.regions.regions) area += r.area_m2;

@@ -285,6 +285,11 @@ CraterTable find_craters(const TriangleMesh& mesh, const Dem& dem,
         const auto centre = to_pixel(c.x, c.y);
         k.col = centre[0];
         k.row = centre[1];
+        for (int i = 0; i <= kRimPoints; ++i) {
+            const double t = 2 * std::numbers::pi * (i % kRimPoints) / kRimPoints;
+            const auto q = to_pixel(c.x + c.r * std::cos(t), c.y + c.r * std::sin(t));
+            k.rim.push_back(dem.map_xy(q[0], q[1]));
+        }
         // The surroundings: pixels 1.5 to 2 radii from the centre.
         double lo_c = kInf, hi_c = -kInf, lo_r = kInf, hi_r = -kInf;
         for (const double sx : {-2.0, 2.0})
@@ -369,6 +374,18 @@ CraterTable find_craters(const TriangleMesh& mesh, const Dem& dem,
         const LonLatMapping& frame = *dem.georef.output_lonlat;
         if (!frame.to_lonlat(cx.size(), cx.data(), cy.data()))
             throw Error("craters", "a crater's centre has no longitude/latitude on the body");
+        for (std::size_t i = 0; i < table.craters.size(); ++i) {
+            auto& ring = table.craters[i].rim;
+            std::vector<double> x, y;
+            for (const auto& p : ring) {
+                x.push_back(p[0]);
+                y.push_back(p[1]);
+            }
+            if (!frame.to_lonlat(x.size(), x.data(), y.data()))
+                throw Error("craters", "a crater's rim has no longitude/latitude on the body");
+            for (std::size_t j = 0; j < ring.size(); ++j)
+                ring[j] = {x[j] + 360 * std::round((cx[i] - x[j]) / 360), y[j]};
+        }
         table.lonlat = true;
         table.lonlat_crs_wkt = frame.lonlat_crs_wkt();
     }

@@ -10,10 +10,16 @@
 
 namespace terrain::io {
 
-// craters.csv: one row per crater, id, lon, lat (x, y without lon/lat), col, row, diameter_m, depth_m,
-// rim_height_m, circularity, rim_fraction, fit_rms_m, field_scale_m, floor_region,
+// craters.csv: one row per crater, id, lon, lat (x, y without lon/lat), col, row, diameter_m,
+// depth_m, rim_height_m, circularity, rim_fraction, fit_rms_m, field_scale_m, floor_region,
 // rim_regions (space-separated ids), confidence.
 void write_craters_csv(const segment::CraterTable& table, const std::string& path, bool overwrite);
+
+// craters.geojson: per crater a Point at its centre and a Polygon, its rim circle, each with
+// the crater's columns and `kind` ("centre" or "rim"), in the CRS handling of regions.geojson
+// (the body's geographic CRS named; a local grid's CRS without one).
+void write_craters_geojson(const segment::CraterTable& table, const std::string& path,
+                           bool overwrite);
 
 // craters.scc: craterstats' spatial crater count: the body's axes, the counted area
 // (`area_m2`, the DEM's valid area on the body) and the craters' diameters (km) and centres.

@@ -31,7 +31,11 @@ struct Crater {
     // rim_fraction x fit quality (1 - 4 fit_rms_m / radius, at least 0) x roundness (the
     // floor's circularity over CraterOptions::round_floor, at most 1): in [0, 1].
     double confidence = 0;
+    // The rim circle as a closed ring of kRimPoints + 1 points, in the centre's coordinates
+    // (lon, lat, longitudes kept within 180 degrees of the centre's; or map x, y).
+    std::vector<std::array<double, 2>> rim;
 };
+constexpr int kRimPoints = 72;
 
 struct CraterTable {
     std::vector<Crater> craters;
