@@ -44,6 +44,8 @@ _SEGMENT_OPTIONS = (
     "persistence", "area_ratio", "min_area", "cost", "saddle_penalty", "absorbed",
     "format", "craters",
 )
+# The options of the calls that read no crater table (sweep, shape_index, reeb_graph).
+_OPTIONS_BUT_CRATERS = tuple(o for o in _SEGMENT_OPTIONS if o != "craters")
 # The options that set a scale: given none, a DEM takes the landform defaults (radius "auto",
 # min_area "auto"; docs/segment.md), as `terrain segment` does.
 _SCALE_OPTIONS = ("rings", "radius", "radii", "persistence", "area_ratio", "min_area")
@@ -252,7 +254,8 @@ def segment(dem, geotransform=None, crs=None, *, progress=None, **options):
         the body: m^2 as a number, or "5km2", "2000m2", "3ha"; an arc is cancelled when its
         area is below it, whatever the tile's extent), cost="auto" ("graph",
         "standard"), saddle_penalty=20, absorbed="auto" ("divide" for DEMs, "whole", the
-        paper's growing, for meshes), format="GeoJSON"; reading: band=1,
+        paper's growing, for meshes), format="GeoJSON", craters=True (segment only: the
+        craters read from the regions, .craters; docs/craters.md); reading: band=1,
         elevation="auto", nan_nodata=False, pixel_size=None, frame="auto", repair=False,
         max_memory=None (bytes, or "512M", "4G" as --max-memory: a file whose estimated
         peak memory exceeds it, or the memory available, is refused before it is read).
@@ -323,7 +326,7 @@ def sweep(dem, geotransform=None, crs=None, *, area_ratios=None, min_areas=None,
     areas = [a if isinstance(a, str) else repr(float(a)) for a in (min_areas or [])]
     if min_areas is not None and not areas:
         raise Error("sweep: --min-areas needs at least one value")
-    native_options, read = _split_options(options, _SEGMENT_OPTIONS)
+    native_options, read = _split_options(options, _OPTIONS_BUT_CRATERS)
     source = _source(dem, geotransform, crs, read.pop("elevation"))
     native = _terrain.sweep(source, [float(r) for r in area_ratios], native_options,
                             progress=progress, min_areas=areas, **read)
@@ -339,7 +342,7 @@ def shape_index(dem, geotransform=None, crs=None, *, rings=2, radius=0.0, window
     options = {"field": "shape-index", "radius": radius, "window": window, **read}
     if not radius:
         options["rings"] = rings
-    native_options, read = _split_options(options, _SEGMENT_OPTIONS)
+    native_options, read = _split_options(options, _OPTIONS_BUT_CRATERS)
     source = _source(dem, geotransform, crs, read.pop("elevation"))
     return _terrain.field(source, native_options, progress=progress, **read)
 
@@ -385,7 +388,7 @@ def reeb_graph(dem, geotransform=None, crs=None, *, persistence=0.0, area_ratio=
         options["min_area"] = min_area
     else:
         options["area_ratio"] = 0.0 if area_ratio is None else area_ratio
-    native_options, read = _split_options(options, _SEGMENT_OPTIONS)
+    native_options, read = _split_options(options, _OPTIONS_BUT_CRATERS)
     source = _source(dem, geotransform, crs, read.pop("elevation"))
     nodes, arcs, before = _terrain.reeb_graph(source, native_options, progress=progress, **read)
     return ReebGraph(nodes, arcs, before)

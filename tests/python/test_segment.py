@@ -332,6 +332,8 @@ def test_the_crater_table_in_python_and_files(moon, cli, tmp_path):
         distance = radius * np.arccos(np.clip(cos, -1, 1))
         assert np.allclose(distance, c["diameter_m"] / 2, rtol=0.03)
     assert terrain.segment(moon, craters=False).craters is None
+    with pytest.raises(TypeError, match="unknown option 'craters'"):
+        terrain.sweep(moon, area_ratios=[1], craters=False)
     off = tmp_path / "off"
     assert cli("segment", moon, "-o", off, "-q", "--craters", "off").returncode == 0
     assert not any((off / name).exists()
