@@ -316,6 +316,11 @@ def test_the_crater_table_in_python_and_files(moon, cli, tmp_path):
     table = [line.split("\t") for line in scc[start + 1:scc.index("}", start)]]
     assert [float(t[0]) for t in table] == pytest.approx(list(craters["diameter_m"] / 1000))
     assert [float(t[1]) for t in table] == pytest.approx(list(craters["lon"]))
+    # craters.png: the two panels, with the craters' dots drawn in blue.
+    png = gdal.Open(str(out / "craters.png"))
+    assert (png.RasterXSize, png.RasterYSize, png.RasterCount) == (1000, 500, 3)
+    r, g, b = (png.GetRasterBand(i).ReadAsArray().astype(int) for i in (1, 2, 3))
+    assert ((b > 150) & (r < 100)).sum() > 10 * len(craters)
     # craters.geojson: a centre and a rim ring per crater, the ring on the body's sphere at
     # the crater's radius from the centre, in the Moon's geographic CRS.
     import geopandas
@@ -337,4 +342,4 @@ def test_the_crater_table_in_python_and_files(moon, cli, tmp_path):
     off = tmp_path / "off"
     assert cli("segment", moon, "-o", off, "-q", "--craters", "off").returncode == 0
     assert not any((off / name).exists()
-                   for name in ("craters.csv", "craters.scc", "craters.geojson"))
+                   for name in ("craters.csv", "craters.scc", "craters.geojson", "craters.png"))

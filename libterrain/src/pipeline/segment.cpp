@@ -662,9 +662,14 @@ std::vector<std::string> write_segment_directory(SegmentResult& result, const Se
                                   false);
         names.push_back("craters.csv");
         names.push_back("craters.geojson");
+        double area = 0;
+        for (const auto& r : result.regions.regions) area += r.area_m2;
+        if (area > 0) {
+            io::write_craters_plot(*result.craters, area, (fs::path(dir) / "craters.png").string(),
+                                   false);
+            names.push_back("craters.png");
+        }
         if (result.craters->lonlat) {
-            double area = 0;
-            for (const auto& r : result.regions.regions) area += r.area_m2;
             io::write_craters_scc(*result.craters, result.dem()->body, area,
                                   (fs::path(dir) / "craters.scc").string(), false);
             names.push_back("craters.scc");

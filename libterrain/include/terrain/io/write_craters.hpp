@@ -21,6 +21,12 @@ void write_craters_csv(const segment::CraterTable& table, const std::string& pat
 void write_craters_geojson(const segment::CraterTable& table, const std::string& path,
                            bool overwrite);
 
+// craters.png: a quick look at the table, two log-log panels: depth / diameter against the
+// diameter (one dot per crater), and the cumulative size-frequency distribution (craters at
+// least D across per km^2 of `area_m2`, the DEM's valid area) against D.
+void write_craters_plot(const segment::CraterTable& table, double area_m2, const std::string& path,
+                        bool overwrite);
+
 // craters.scc: craterstats' spatial crater count: the body's axes, the counted area
 // (`area_m2`, the DEM's valid area on the body) and the craters' diameters (km) and centres.
 // Throws terrain::Error (stage "write") for a table without lon/lat.
