@@ -10,6 +10,7 @@
 
 #include "image_module.hpp"
 #include "terrain/core/error.hpp"
+#include "terrain/io/output_file.hpp"
 #include "terrain/io/write_preview.hpp"
 
 namespace terrain::io {
@@ -279,6 +280,17 @@ void Canvas::disc(double cx, double cy, double radius, Rgba colour, double ring)
                 ring > 0 ? ring / 2 + 0.5 - std::abs(d - radius) : radius + 0.5 - d;
             blend(x, y, colour, std::clamp(coverage, 0.0, 1.0));
         }
+}
+
+void write_canvas(const Canvas& canvas, const std::string& path, bool overwrite) {
+    const int w = canvas.width(), h = canvas.height();
+    std::vector<std::uint8_t> rgb(static_cast<std::size_t>(w) * h * 3);  // opaque: no alpha
+    for (std::size_t i = 0, n = rgb.size() / 3; i < n; ++i)
+        std::copy_n(canvas.rgba().begin() + std::ptrdiff_t(i * 4), 3,
+                    rgb.begin() + std::ptrdiff_t(i * 3));
+    AtomicOutput output(path, overwrite);
+    write_image(output.temp_path(), path, w, h, 3, rgb.data());
+    output.commit();
 }
 
 }  // namespace detail

@@ -68,4 +68,8 @@ class Canvas {
 // A UTF-8 string's code points (for width estimates).
 std::size_t utf8_length(const std::string& text);
 
+// The canvas as an opaque RGB image file (PNG from the extension), written atomically:
+// refused when `path` exists unless `overwrite` (terrain::Error, stage "write").
+void write_canvas(const Canvas& canvas, const std::string& path, bool overwrite);
+
 }  // namespace terrain::io::detail

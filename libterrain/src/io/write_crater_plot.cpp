@@ -9,10 +9,8 @@
 #include <vector>
 
 #include "../core/significant.hpp"
-#include "image_module.hpp"
 #include "map_canvas.hpp"
 #include "terrain/core/error.hpp"
-#include "terrain/io/output_file.hpp"
 #include "terrain/io/write_craters.hpp"
 
 namespace terrain::io {
@@ -103,13 +101,7 @@ void write_craters_plot(const segment::CraterTable& table, double area_m2, const
                               : terrain::detail::significant(area_km2, 4)) +
                " km²",
            kFont + 1, kBlack, AlignX::centre, AlignY::top);
-    std::vector<std::uint8_t> rgb(static_cast<std::size_t>(W) * H * 3);  // opaque: no alpha
-    for (std::size_t i = 0, m = rgb.size() / 3; i < m; ++i)
-        std::copy_n(c.rgba().begin() + std::ptrdiff_t(i * 4), 3,
-                    rgb.begin() + std::ptrdiff_t(i * 3));
-    AtomicOutput output(path, overwrite);
-    detail::write_image(output.temp_path(), path, W, H, 3, rgb.data());
-    output.commit();
+    detail::write_canvas(c, path, overwrite);
 }
 
 }  // namespace terrain::io

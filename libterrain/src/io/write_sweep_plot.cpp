@@ -11,10 +11,8 @@
 #include <vector>
 
 #include "../core/significant.hpp"
-#include "image_module.hpp"
 #include "map_canvas.hpp"
 #include "terrain/core/error.hpp"
-#include "terrain/io/output_file.hpp"
 #include "terrain/io/write_sweep_plot.hpp"
 
 namespace terrain::io {
@@ -105,13 +103,7 @@ void write_sweep_plot(const std::vector<double>& ratios, const std::vector<doubl
         lx += 40 + c.text(lx + 40, ly, name, f, black, AlignX::left, AlignY::middle) + 40;
     }
 
-    std::vector<std::uint8_t> rgb(static_cast<std::size_t>(W) * H * 3);  // opaque: no alpha
-    for (std::size_t i = 0, n = rgb.size() / 3; i < n; ++i)
-        std::copy_n(c.rgba().begin() + std::ptrdiff_t(i * 4), 3,
-                    rgb.begin() + std::ptrdiff_t(i * 3));
-    AtomicOutput output(path, overwrite);
-    detail::write_image(output.temp_path(), path, W, H, 3, rgb.data());
-    output.commit();
+    detail::write_canvas(c, path, overwrite);
 }
 
 }  // namespace terrain::io
