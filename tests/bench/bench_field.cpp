@@ -16,12 +16,13 @@
 #include <string>
 
 #include "bench_dem.hpp"
+#include "bench_main.hpp"
 #include "terrain/field/shape_index.hpp"
 #include "terrain/mesh/dem_to_mesh.hpp"
 
 using namespace terrain;
 
-int main(int argc, char** argv) {
+static int run_bench(int argc, char** argv) {
     const int n = argc > 1 ? std::atoi(argv[1]) : 1000;
     const int runs = argc > 2 ? std::max(1, std::atoi(argv[2])) : 3;
     const std::string only = argc > 3 ? argv[3] : "";
@@ -79,4 +80,13 @@ int main(int argc, char** argv) {
     std::printf("peak resident %.0f MB, %.0f bytes per pixel (DEM, mesh and one field)\n",
                 usage.ru_maxrss / 1024.0, usage.ru_maxrss * 1024.0 / mesh.vertex_count());
     return 0;
+}
+
+int main(int argc, char** argv) {
+    return terrain::bench::bench_main(
+        argc, argv,
+        "bench_field [size] [runs] [only]: the shape index's fits on a size x size DEM of 30 m "
+        "pixels (default 1000), each case `runs` times; `only`: the cases whose name holds one of "
+        "these '|'-separated strings (--rings 2 always runs).",
+        run_bench);
 }

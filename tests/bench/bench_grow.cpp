@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <string>
 
+#include "bench_main.hpp"
 #include "bench_measure.hpp"
 #include "terrain/field/shape_index.hpp"
 #include "terrain/geo/georeference.hpp"
@@ -27,7 +28,7 @@ using namespace terrain;
 
 using bench::best_of;
 
-int main(int argc, char** argv) {
+static int run_bench(int argc, char** argv) {
     const std::string arg = argc > 1 ? argv[1] : "1000";
     Dem dem;
     if (arg.find_first_not_of("0123456789") == std::string::npos) {
@@ -80,4 +81,12 @@ int main(int argc, char** argv) {
     // The whole benchmark's peak: the mesh, the field, the graphs and the growing's arrays.
     std::printf("peak resident set %.0f bytes/vertex\n", bench::status_kb("VmHWM") * 1024.0 / nv);
     return 0;
+}
+
+int main(int argc, char** argv) {
+    return terrain::bench::bench_main(
+        argc, argv,
+        "bench_grow [DEM | size]: the growing stage (regions, division of the absorbed vertices, "
+        "region graph) on a DEM or a size x size synthetic Vesta tile.",
+        run_bench);
 }

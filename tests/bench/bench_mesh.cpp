@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <string>
 
+#include "bench_main.hpp"
 #include "terrain/geo/georeference.hpp"
 #include "terrain/mesh/dem_to_mesh.hpp"
 
@@ -50,7 +51,7 @@ void run(const char* name, const Dem& dem) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+static int run_bench(int argc, char** argv) {
     const int n = argc > 1 ? std::atoi(argv[1]) : 1000;
     std::printf("bench_mesh: %dx%d DEM, %d threads\n", n, n, tbb::info::default_concurrency());
     run("map frame (UTM 11N, 30 m)",
@@ -58,4 +59,11 @@ int main(int argc, char** argv) {
     run("body frame (Vesta lon/lat)", synthetic(n, "+proj=longlat +R=255000 +no_defs",
                                                 {10, 1.0 / 64, 0, -20, 0, -1.0 / 64}, 255000));
     return 0;
+}
+
+int main(int argc, char** argv) {
+    return terrain::bench::bench_main(
+        argc, argv,
+        "bench_mesh [size]: DEM to mesh on a size x size grid (default 1000), map and body frames.",
+        run_bench);
 }

@@ -13,6 +13,7 @@
 #include <string>
 
 #include "bench_dem.hpp"
+#include "bench_main.hpp"
 #include "bench_measure.hpp"
 #include "terrain/field/vertex_field.hpp"
 #include "terrain/io/write_adjacency.hpp"
@@ -56,7 +57,7 @@ double hash(std::uint32_t x) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+static int run_bench(int argc, char** argv) {
     const int n = argc > 1 ? std::atoi(argv[1]) : 1000;
     const int wanted = argc > 2 ? std::atoi(argv[2]) : 2000;
     const Dem dem = bench::utm_hills(n);
@@ -141,4 +142,12 @@ int main(int argc, char** argv) {
     for (const auto& e : std::filesystem::directory_iterator(dir))
         std::printf("  %-22s %8.1f kB\n", e.path().filename().c_str(), e.file_size() / 1e3);
     return 0;
+}
+
+int main(int argc, char** argv) {
+    return terrain::bench::bench_main(
+        argc, argv,
+        "bench_outputs [size] [regions]: the region graph and every segment output of a size x "
+        "size DEM cut into about `regions` regions.",
+        run_bench);
 }

@@ -22,6 +22,7 @@
 #include <cstdlib>
 #include <vector>
 
+#include "bench_main.hpp"
 #include "terrain/core/memory_budget.hpp"
 
 namespace {
@@ -90,7 +91,7 @@ Costs measure(std::size_t bytes) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+static int run_bench(int argc, char** argv) {
     std::vector<double> sizes;
     for (int i = 1; i < argc; ++i) sizes.push_back(std::atof(argv[i]));
     if (sizes.empty()) sizes = {0.25, 1, 4, 12};
@@ -115,4 +116,11 @@ int main(int argc, char** argv) {
                     c.chained_ns, c.near_ns[0], c.near_ns[1], c.near_ns[2]);
     }
     return 0;
+}
+
+int main(int argc, char** argv) {
+    return terrain::bench::bench_main(argc, argv,
+                                      "bench_random_access [GiB ...]: nanoseconds a random read of "
+                                      "memory blocks of these sizes (default 0.25 1 4 12).",
+                                      run_bench);
 }

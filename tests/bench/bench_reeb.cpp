@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <cstdlib>
 
+#include "bench_main.hpp"
 #include "bench_measure.hpp"
 #include "terrain/field/shape_index.hpp"
 #include "terrain/geo/georeference.hpp"
@@ -21,7 +22,7 @@ using namespace terrain;
 
 using bench::best_of;
 
-int main(int argc, char** argv) {
+static int run_bench(int argc, char** argv) {
     synth::VestaTileOptions options;
     options.width = options.height = argc > 1 ? std::atoi(argv[1]) : 1000;
     Dem dem = synth::generate_vesta_tile(options);
@@ -67,4 +68,12 @@ int main(int argc, char** argv) {
             ratio, t, nv / t / 1e6, s.critical, r.critical, result.graph.memory_bytes() / nv);
     }
     return 0;
+}
+
+int main(int argc, char** argv) {
+    return terrain::bench::bench_main(
+        argc, argv,
+        "bench_reeb [size]: Reeb graph construction and simplification on a size x size synthetic "
+        "Vesta tile (default 1000).",
+        run_bench);
 }

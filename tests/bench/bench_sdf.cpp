@@ -14,6 +14,7 @@
 #include <filesystem>
 #include <vector>
 
+#include "bench_main.hpp"
 #include "support/cgal_reference_sdf.hpp"
 #include "terrain/field/sdf.hpp"
 #include "terrain/io/mesh_files.hpp"
@@ -31,7 +32,7 @@ double seconds(F&& f) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+static int run_bench(int argc, char** argv) {
     if (argc < 2) {
         std::fprintf(stderr, "usage: bench_sdf MESH.off...\n");
         return 2;
@@ -93,4 +94,11 @@ int main(int argc, char** argv) {
                     faces_total / ours_total, faces_total / single_total, faces_total / cgal_total,
                     cgal_total / ours_total);
     return 0;
+}
+
+int main(int argc, char** argv) {
+    return terrain::bench::bench_main(argc, argv,
+                                      "bench_sdf MESH.off...: our Shape Diameter Function against "
+                                      "CGAL's sdf_values on closed meshes.",
+                                      run_bench);
 }
