@@ -343,3 +343,28 @@ def test_the_crater_table_in_python_and_files(moon, cli, tmp_path):
     assert cli("segment", moon, "-o", off, "-q", "--craters", "off").returncode == 0
     assert not any((off / name).exists()
                    for name in ("craters.csv", "craters.scc", "craters.geojson", "craters.png"))
+
+
+def test_a_geopackage_holds_the_craters_beside_the_regions(moon, cli, tmp_path):
+    # With --format GPKG, regions.gpkg also holds the layers "craters" (points) and
+    # "crater_rims" (polygons) in the Moon's geographic CRS, the rows of craters.csv, and the
+    # file's bytes repeat run to run.
+    import csv
+    import geopandas
+    out, again = tmp_path / "seg", tmp_path / "again"
+    for d in (out, again):
+        assert cli("segment", moon, "-o", d, "-q", "--format", "GPKG").returncode == 0
+    assert (out / "regions.gpkg").read_bytes() == (again / "regions.gpkg").read_bytes()
+    with open(out / "craters.csv") as f:
+        rows = list(csv.DictReader(f))
+    centres = geopandas.read_file(out / "regions.gpkg", layer="craters")
+    rims = geopandas.read_file(out / "regions.gpkg", layer="crater_rims")
+    assert len(rows) > 0 and len(centres) == len(rims) == len(rows)
+    assert centres.crs.is_geographic and "Moon" in centres.crs.name
+    assert rims.crs == centres.crs
+    assert list(centres["id"]) == [int(r["id"]) for r in rows]
+    assert list(centres.geometry.x) == pytest.approx([float(r["lon"]) for r in rows])
+    assert (rims.geometry.geom_type == "Polygon").all()
+    assert all(r.contains(c) for r, c in zip(rims.geometry, centres.geometry))
+    regions = geopandas.read_file(out / "regions.gpkg", layer="regions")
+    assert len(regions) > 0

@@ -1,16 +1,47 @@
 #include "terrain/io/write_craters.hpp"
 
+#include <ogrsf_frmts.h>
+
 #include <cmath>
+#include <memory>
+#include <variant>
 
 #include "../geo/iau_crs.hpp"
 #include "dataset_files.hpp"
 #include "geojson_file.hpp"
+#include "gpkg_support.hpp"
 #include "lonlat_frame.hpp"
 #include "terrain/core/error.hpp"
 #include "terrain/core/json_writer.hpp"
 
 namespace terrain::io {
 namespace {
+
+// The columns of a crater as feature attributes (`kind` first).
+std::vector<Attribute> crater_attributes(const segment::CraterTable& table,
+                                         const segment::Crater& k, const std::string& kind) {
+    std::string rims;
+    for (const auto r : k.rim_regions) rims += (rims.empty() ? "" : " ") + std::to_string(r);
+    return {{"kind", kind},
+            {"id", std::int64_t{k.id}},
+            {table.lonlat ? "lon" : "x", k.lon},
+            {table.lonlat ? "lat" : "y", k.lat},
+            {"diameter_m", k.diameter_m},
+            {"depth_m", k.depth_m},
+            {"rim_height_m", k.rim_height_m},
+            {"circularity", k.circularity},
+            {"rim_fraction", k.rim_fraction},
+            {"fit_rms_m", k.fit_rms_m},
+            {"field_scale_m", k.field_scale_m},
+            {"floor_region", std::int64_t{k.floor_region}},
+            {"rim_regions", rims},
+            {"confidence", k.confidence}};
+}
+
+// The CRS of the craters' coordinates, as the regions' polygons name it.
+std::string crater_crs_wkt(const segment::CraterTable& table) {
+    return table.lonlat ? geo::output_crs_wkt(table.lonlat_crs_wkt) : local_grid_crs_wkt();
+}
 
 // A number as JSON writes it (shortest round trip); NaN as an empty field.
 std::string field(double x) {
@@ -41,29 +72,12 @@ void write_craters_csv(const segment::CraterTable& table, const std::string& pat
 void write_craters_geojson(const segment::CraterTable& table, const std::string& path,
                            bool overwrite) {
     write_file_atomically(path, overwrite, [&](std::ostream& out) {
-        const std::string crs = table.lonlat
-                                    ? geojson_crs_name(geo::output_crs_wkt(table.lonlat_crs_wkt))
-                                    : local_grid_crs_wkt();
+        const std::string crs =
+            table.lonlat ? geojson_crs_name(crater_crs_wkt(table)) : local_grid_crs_wkt();
         GeoJsonFile file(out, "craters", crs, table.lonlat ? 9 : 6);
         std::int64_t id = 0;
         for (const auto& k : table.craters) {
-            std::string rims;
-            for (const auto r : k.rim_regions)
-                rims += (rims.empty() ? "" : " ") + std::to_string(r);
-            std::vector<Attribute> a{{"kind", std::string("centre")},
-                                     {"id", std::int64_t{k.id}},
-                                     {table.lonlat ? "lon" : "x", k.lon},
-                                     {table.lonlat ? "lat" : "y", k.lat},
-                                     {"diameter_m", k.diameter_m},
-                                     {"depth_m", k.depth_m},
-                                     {"rim_height_m", k.rim_height_m},
-                                     {"circularity", k.circularity},
-                                     {"rim_fraction", k.rim_fraction},
-                                     {"fit_rms_m", k.fit_rms_m},
-                                     {"field_scale_m", k.field_scale_m},
-                                     {"floor_region", std::int64_t{k.floor_region}},
-                                     {"rim_regions", rims},
-                                     {"confidence", k.confidence}};
+            auto a = crater_attributes(table, k, "centre");
             file.feature(++id, a, [&](JsonWriter& json) {
                 json.begin_object().field("type", "Point").key("coordinates");
                 file.position(json, k.lon, k.lat);
@@ -79,6 +93,51 @@ void write_craters_geojson(const segment::CraterTable& table, const std::string&
         }
         file.finish();
     });
+}
+
+void add_crater_layers(const segment::CraterTable& table, const std::string& path) {
+    ensure_gdal_registered();
+    const GdalErrorCapture errors;
+    const FixedGpkgDate fixed_date;
+    std::unique_ptr<GDALDataset> ds(
+        GDALDataset::Open(path.c_str(), GDAL_OF_VECTOR | GDAL_OF_UPDATE));
+    if (!ds)
+        throw Error("write", "cannot open '" + path + "' to add the craters" + errors.suffix());
+    OGRSpatialReference srs;
+    srs.SetFromUserInput(crater_crs_wkt(table).c_str());
+    srs.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+    const auto fail = [&](const std::string& what) {
+        return Error("write", "cannot " + what + " in '" + path + "'" + errors.suffix());
+    };
+    const segment::Crater none;
+    for (const bool rims : {false, true}) {
+        OGRLayer* layer = ds->CreateLayer(rims ? "crater_rims" : "craters", &srs,
+                                          rims ? wkbPolygon : wkbPoint, nullptr);
+        if (!layer) throw fail("create the crater layers");
+        create_attribute_fields(*layer, crater_attributes(table, none, ""), path, errors);
+        const bool transaction = ds->StartTransaction() == OGRERR_NONE;
+        for (const auto& k : table.craters) {
+            OGRFeature feature(layer->GetLayerDefn());
+            set_attribute_fields(feature, crater_attributes(table, k, rims ? "rim" : "centre"));
+            if (rims) {
+                auto ring = std::make_unique<OGRLinearRing>();
+                for (const auto& p : k.rim) ring->addPoint(p[0], p[1]);
+                auto polygon = std::make_unique<OGRPolygon>();
+                polygon->addRingDirectly(ring.release());
+                feature.SetGeometryDirectly(polygon.release());
+            } else {
+                feature.SetGeometryDirectly(new OGRPoint(k.lon, k.lat));
+            }
+            if (layer->CreateFeature(&feature) != OGRERR_NONE)
+                throw fail("write crater " + std::to_string(k.id));
+        }
+        if (transaction && ds->CommitTransaction() != OGRERR_NONE) throw fail("write the craters");
+    }
+    add_wkt2_definitions(*ds, &srs, path, errors);
+    CPLErrorReset();
+    ds.reset();
+    if (CPLGetLastErrorType() >= CE_Failure)
+        throw Error("write", "closing '" + path + "' failed" + errors.suffix());
 }
 
 void write_craters_scc(const segment::CraterTable& table, const Body& body, double area_m2,

@@ -20,6 +20,7 @@
 #include "gdal_support.hpp"
 #include "geojson_file.hpp"
 #include "global_outline.hpp"
+#include "gpkg_support.hpp"
 #include "label_style.hpp"
 #include "lonlat_frame.hpp"
 #include "region_attributes.hpp"
@@ -404,87 +405,6 @@ void add_layer_style(GDALDataset& ds, const std::string& layer, const std::strin
         throw Error("write", "cannot write the style of '" + path + "'" + errors.suffix());
 }
 
-// Runs one SQL statement on a GeoPackage (SQLite's own dialect); throws on failure.
-void execute_sql(GDALDataset& ds, const std::string& sql, const std::string& path,
-                 const GdalErrorCapture& errors) {
-    CPLErrorReset();
-    if (OGRLayer* result = ds.ExecuteSQL(sql.c_str(), nullptr, nullptr))
-        ds.ReleaseResultSet(result);
-    if (CPLGetLastErrorType() >= CE_Failure)
-        throw Error("write", "cannot record the CRS of '" + path + "'" + errors.suffix());
-}
-
-std::string sql_quoted(const std::string& text) {
-    std::string out = "'";
-    for (const char c : text) out += c == '\'' ? std::string("''") : std::string(1, c);
-    return out + "'";
-}
-
-// Every defined SRS of a GeoPackage also as WKT2 (the gpkg_crs_wkt extension's
-// definition_12_063 column), which readers prefer to the WKT1 `definition`. WKT1 cannot say
-// which version of an authority a code belongs to (IAU_2015 is written AUTHORITY["IAU", ...]),
-// and QGIS 3.22 finds no CRS at all for such a code; WKT2's ID["IAU",30115,2015] it names.
-// `srs` is the layers' CRS; other rows (GDAL's EPSG:4326) are converted from their WKT1.
-void add_wkt2_definitions(GDALDataset& ds, const OGRSpatialReference* srs, const std::string& path,
-                          const GdalErrorCapture& errors) {
-    bool has_column = false;
-    if (OGRLayer* info =
-            ds.ExecuteSQL("PRAGMA table_info(gpkg_spatial_ref_sys)", nullptr, nullptr)) {
-        for (auto& row : *info)
-            if (std::string(row->GetFieldAsString("name")) == "definition_12_063")
-                has_column = true;
-        ds.ReleaseResultSet(info);
-    }
-    if (!has_column) {
-        execute_sql(ds,
-                    "ALTER TABLE gpkg_spatial_ref_sys ADD COLUMN definition_12_063 TEXT NOT NULL "
-                    "DEFAULT 'undefined'",
-                    path, errors);
-        execute_sql(ds,
-                    "INSERT INTO gpkg_extensions (table_name, column_name, extension_name, "
-                    "definition, scope) VALUES ('gpkg_spatial_ref_sys', 'definition_12_063', "
-                    "'gpkg_crs_wkt', 'http://www.geopackage.org/spec120/#extension_crs_wkt', "
-                    "'read-write')",
-                    path, errors);
-    }
-    struct Row {
-        std::int64_t id;
-        std::string wkt1;
-        bool layers;  // the SRS of the layers, made by GDAL from `srs`
-    };
-    std::vector<Row> rows;
-    if (OGRLayer* table = ds.ExecuteSQL(
-            "SELECT srs_id, definition, srs_id IN (SELECT srs_id FROM gpkg_geometry_columns) "
-            "FROM gpkg_spatial_ref_sys WHERE definition <> 'undefined' AND definition_12_063 = "
-            "'undefined' ORDER BY srs_id",
-            nullptr, nullptr)) {
-        for (auto& row : *table)
-            rows.push_back({row->GetFieldAsInteger64(0), row->GetFieldAsString(1),
-                            row->GetFieldAsInteger(2) != 0});
-        ds.ReleaseResultSet(table);
-    }
-    const char* const wkt2_options[] = {"FORMAT=WKT2_2019", nullptr};
-    for (const auto& row : rows) {
-        OGRSpatialReference from_wkt1;
-        const OGRSpatialReference* row_srs = srs;
-        if (!row.layers || !srs) {
-            if (from_wkt1.importFromWkt(row.wkt1.c_str()) != OGRERR_NONE) continue;
-            row_srs = &from_wkt1;
-        }
-        char* wkt2 = nullptr;
-        if (row_srs->exportToWkt(&wkt2, wkt2_options) != OGRERR_NONE || !wkt2) {
-            CPLFree(wkt2);
-            continue;
-        }
-        const std::string text = wkt2;
-        CPLFree(wkt2);
-        execute_sql(ds,
-                    "UPDATE gpkg_spatial_ref_sys SET definition_12_063 = " + sql_quoted(text) +
-                        " WHERE srs_id = " + std::to_string(row.id),
-                    path, errors);
-    }
-}
-
 // Any other OGR driver: one layer "regions", MultiPolygon features, every attribute a field.
 std::vector<std::string> write_ogr(GDALDriver& driver, const std::string& temp,
                                    const std::string& path, const RegionSource& polygon,
@@ -493,12 +413,7 @@ std::vector<std::string> write_ogr(GDALDriver& driver, const std::string& temp,
                                    const std::string& layer_name, bool append) {
     // GeoPackage stamps the current time (on creation, on SQL that changes a table, on close)
     // unless told a fixed one: same bytes every run.
-    struct FixedDate {
-        FixedDate() {
-            CPLSetThreadLocalConfigOption("OGR_CURRENT_DATE", "2000-01-01T00:00:00.000Z");
-        }
-        ~FixedDate() { CPLSetThreadLocalConfigOption("OGR_CURRENT_DATE", nullptr); }
-    } fixed_date;
+    const FixedGpkgDate fixed_date;
     std::unique_ptr<GDALDataset> ds(
         append && std::filesystem::exists(temp)
             ? GDALDataset::Open(temp.c_str(), GDAL_OF_VECTOR | GDAL_OF_UPDATE)
@@ -517,29 +432,11 @@ std::vector<std::string> write_ogr(GDALDriver& driver, const std::string& temp,
         if (gpkg) add_wkt2_definitions(*ds, srs, path, errors);
         return dataset_files(ds.get());
     }
-    for (const auto& [name, value] : region_attributes(graph, graph.regions.front())) {
-        const OGRFieldType type =
-            std::holds_alternative<std::int64_t>(value)
-                ? OFTInteger64
-                : (std::holds_alternative<double>(value) ? OFTReal : OFTString);
-        OGRFieldDefn field(name.c_str(), type);
-        if (layer->CreateField(&field) != OGRERR_NONE)
-            throw Error("write",
-                        "cannot create field '" + name + "' in '" + path + "'" + errors.suffix());
-    }
+    create_attribute_fields(*layer, region_attributes(graph, graph.regions.front()), path, errors);
     const bool transaction = ds->StartTransaction() == OGRERR_NONE;
     for (std::size_t i = 0; i < graph.regions.size(); ++i) {
         OGRFeature feature(layer->GetLayerDefn());
-        int k = 0;
-        for (const auto& [name, value] : region_attributes(graph, graph.regions[i])) {
-            if (const auto* n = std::get_if<std::int64_t>(&value))
-                feature.SetField(k, static_cast<GIntBig>(*n));
-            else if (const auto* d = std::get_if<double>(&value))
-                feature.SetField(k, *d);
-            else
-                feature.SetField(k, std::get<std::string>(value).c_str());
-            ++k;
-        }
+        set_attribute_fields(feature, region_attributes(graph, graph.regions[i]));
         if (Geometry g = polygon(i))
             feature.SetGeometryDirectly(OGRGeometryFactory::forceToMultiPolygon(g.release()));
         if (layer->CreateFeature(&feature) != OGRERR_NONE)

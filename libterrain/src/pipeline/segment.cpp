@@ -662,6 +662,9 @@ std::vector<std::string> write_segment_directory(SegmentResult& result, const Se
                                   false);
         names.push_back("craters.csv");
         names.push_back("craters.geojson");
+        const auto gpkg = fs::path(dir) / "regions.gpkg";
+        if (options.format == "GPKG" && fs::exists(gpkg))
+            io::add_crater_layers(*result.craters, gpkg.string());
         double area = 0;
         for (const auto& r : result.regions.regions) area += r.area_m2;
         if (area > 0) {

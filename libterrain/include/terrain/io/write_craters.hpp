@@ -21,6 +21,13 @@ void write_craters_csv(const segment::CraterTable& table, const std::string& pat
 void write_craters_geojson(const segment::CraterTable& table, const std::string& path,
                            bool overwrite);
 
+// The craters as two layers added to an existing GeoPackage (regions.gpkg of --format
+// GPKG): "craters", a point per crater at its centre, and "crater_rims", its rim circle as a
+// polygon, both with the table's columns, in the body's geographic CRS (a local grid's CRS
+// without one), recorded in WKT2 as regions.gpkg's own. Writes in place: the caller makes
+// the directory atomic (terrain segment writes into a temporary one).
+void add_crater_layers(const segment::CraterTable& table, const std::string& gpkg_path);
+
 // craters.png: a quick look at the table, two log-log panels: depth / diameter against the
 // diameter (one dot per crater), and the cumulative size-frequency distribution (craters at
 // least D across per km^2 of `area_m2`, the DEM's valid area) against D.
