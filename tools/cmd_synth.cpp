@@ -15,7 +15,8 @@ namespace terrain::cli {
 namespace {
 
 // The tile's crater population as CSV, centres in pixels of the tile ((0,0) the top-left
-// corner), diameters on the ground and in pixels along a row.
+// corner), diameters on the ground and in pixels along a row, depths from the rim crest to
+// the floor as made (before later craters and the roughness changed them).
 void write_crater_list(const synth::VestaTileOptions& tile, const Dem& dem, const std::string& path,
                        bool overwrite) {
     if (!overwrite && std::ifstream(path))
@@ -23,12 +24,13 @@ void write_crater_list(const synth::VestaTileOptions& tile, const Dem& dem, cons
     std::ofstream out(path);
     if (!out) throw Error("synth", "cannot write " + path);
     const double pixel = std::abs(dem.transform[1]);
-    out << "id,col,row,diameter_m,diameter_px,degradation,age\n";
+    out << "id,col,row,diameter_m,diameter_px,degradation,age,depth_m\n";
     out.precision(10);
     std::size_t id = 0;
     for (const auto& c : synth::vesta_crater_population(tile))
         out << ++id << ',' << c.col << ',' << c.row << ',' << c.diameter << ','
-            << c.diameter / pixel << ',' << c.degradation << ',' << c.age << '\n';
+            << c.diameter / pixel << ',' << c.degradation << ',' << c.age << ','
+            << tile.depth_ratio * c.diameter * (1 - c.degradation) << '\n';
     if (!out.flush()) throw Error("synth", "cannot write " + path);
 }
 

@@ -58,7 +58,7 @@ def main():
     print(f"bench_crater_table: {os.cpu_count()} cores, inputs in {work}")
     print(f"terrain segment {a.args or '(no options)'}")
     print(f"{'input':32s} {'bin px':>8s} {'recall':>14s} {'precision':>14s} {'craters':>8s} {'s':>6s}")
-    total, errors = {}, {"diameter_error": [], "centre_error": []}
+    total, errors = {}, {"diameter_error": [], "centre_error": [], "depth_error": []}
     for name, dem, truth_csv, wrap in cases:
         out = os.path.join(work, "out_" + os.path.splitext(os.path.basename(dem))[0])
         t0 = time.perf_counter()
@@ -92,6 +92,10 @@ def main():
     print(f"median diameter error {np.median(errors['diameter_error']):.3f} (relative), "
           f"median centre error {np.median(errors['centre_error']):.3f} R, "
           f"over {len(errors['diameter_error'])} matches")
+    if errors["depth_error"]:
+        print(f"median depth error {np.median(errors['depth_error']):.3f} (relative), over "
+              f"{len(errors['depth_error'])} matches on the tiles (the global grid's generator "
+              "writes no depth)")
 
 
 if __name__ == "__main__":

@@ -7,8 +7,9 @@ A scored crater (crater_score.scored: fresh enough, wholly in the grid, not over
 within a factor 1.5 of its diameter; the closest such (by centre) is its match. Precision:
 among the table's craters whose diameter in pixels falls in a bin and whose rim lies in the
 grid, the share that match a generated crater (degradation <= 0.9, any size) by the same rule.
-Errors over the matches: the median relative diameter error |D - D0| / D0 and the median
-centre error in radii |c - c0| / R0. Distances are on the ground: a column counts col_scale
+Errors over the matches: the median relative diameter error |D - D0| / D0, the median
+centre error in radii |c - c0| / R0 and, where the generator gives depths (terrain synth's
+depth_m, rim crest to floor as made), the median relative depth error. Distances are on the ground: a column counts col_scale
 (cos latitude on a global grid) of a row.
 """
 import numpy as np
@@ -35,7 +36,7 @@ def score(table, truth, width, height, pixel_m, wrap=False):
     diameter_px = table["diameter_m"] / pixel_m if n else np.zeros(0)
     empty = {k: np.zeros(0) for k in ("col", "row", "diameter_m")}
     table = table if n else empty
-    out = {"bins": {}, "diameter_error": [], "centre_error": []}
+    out = {"bins": {}, "diameter_error": [], "centre_error": [], "depth_error": []}
     keep = scored(truth, width, height, wrap)
     for lo, hi in BINS:
         found = total = 0
@@ -49,6 +50,8 @@ def score(table, truth, width, height, pixel_m, wrap=False):
                 j = match[0]
                 out["diameter_error"].append(abs(diameter_px[j] / truth["diameter_px"][i] - 1))
                 out["centre_error"].append(dist[j])
+                if "depth_m" in truth and "depth_m" in table and truth["depth_m"][i] > 0:
+                    out["depth_error"].append(abs(table["depth_m"][j] / truth["depth_m"][i] - 1))
         out["bins"][(lo, hi)] = [found, total, 0, 0]
     # Precision over the table.
     fresh = np.nonzero(truth["degradation"] <= 0.9)[0]
@@ -69,7 +72,7 @@ def score(table, truth, width, height, pixel_m, wrap=False):
                 if match.size:
                     counts[2] += 1
                     break
-    for k in ("diameter_error", "centre_error"):
+    for k in ("diameter_error", "centre_error", "depth_error"):
         out[k + "s"] = out[k]
         out[k] = float(np.median(out[k])) if out[k] else float("nan")
     return out

@@ -71,8 +71,8 @@ def test_the_crater_table_of_a_synthetic_tile_finds_the_generators_craters(cli, 
             rows = list(csv.DictReader(f))
         return {k: np.array([float(r[k]) for r in rows]) for k in keys}
 
-    gen = read(craters, ("col", "row", "diameter_px", "degradation"))
-    listed = read(out / "craters.csv", ("col", "row", "diameter_m"))
+    gen = read(craters, ("col", "row", "diameter_px", "degradation", "depth_m"))
+    listed = read(out / "craters.csv", ("col", "row", "diameter_m", "depth_m"))
     from osgeo import gdal
     ds = gdal.Open(str(dem))
     s = crater_table_score.score(listed, gen, 512, 512, abs(ds.GetGeoTransform()[5]))
@@ -84,3 +84,4 @@ def test_the_crater_table_of_a_synthetic_tile_finds_the_generators_craters(cli, 
     assert found >= 0.7 * scored  # (37 of 46 today)
     assert matched >= 0.8 * counted  # (52 of 58 today)
     assert s["diameter_error"] < 0.1 and s["centre_error"] < 0.2
+    assert s["depth_error"] < 0.15
