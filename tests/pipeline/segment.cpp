@@ -377,7 +377,8 @@ TEST_CASE("pipeline::segment: a mesh file's defaults are the paper's, absorbed n
     const auto by_default = run("");
     const auto whole = run("whole");
     const auto divide = run("divide");
-    INFO(by_default.segmentation.region_count << " regions, " << by_default.after.critical << " critical");
+    INFO(by_default.segmentation.region_count << " regions, " << by_default.after.critical
+                                              << " critical");
     CHECK_FALSE(by_default.regions.has_field_scale);
     CHECK_FALSE(by_default.regions.has_area_range);
     CHECK(by_default.segmentation.labels == whole.segmentation.labels);
