@@ -17,11 +17,16 @@
 namespace terrain::io {
 namespace {
 
+// The rim regions' ids, space-separated.
+std::string rim_list(const segment::Crater& k) {
+    std::string rims;
+    for (const auto r : k.rim_regions) rims += (rims.empty() ? "" : " ") + std::to_string(r);
+    return rims;
+}
+
 // The columns of a crater as feature attributes (`kind` first).
 std::vector<Attribute> crater_attributes(const segment::CraterTable& table,
                                          const segment::Crater& k, const std::string& kind) {
-    std::string rims;
-    for (const auto r : k.rim_regions) rims += (rims.empty() ? "" : " ") + std::to_string(r);
     return {{"kind", kind},
             {"id", std::int64_t{k.id}},
             {table.lonlat ? "lon" : "x", k.lon},
@@ -34,7 +39,7 @@ std::vector<Attribute> crater_attributes(const segment::CraterTable& table,
             {"fit_rms_m", k.fit_rms_m},
             {"field_scale_m", k.field_scale_m},
             {"floor_region", std::int64_t{k.floor_region}},
-            {"rim_regions", rims},
+            {"rim_regions", rim_list(k)},
             {"confidence", k.confidence}};
 }
 
@@ -56,14 +61,11 @@ void write_craters_csv(const segment::CraterTable& table, const std::string& pat
             << ",col,row,diameter_m,depth_m,rim_height_m,circularity,rim_fraction,fit_rms_m,"
                "field_scale_m,floor_region,rim_regions,confidence\n";
         for (const auto& k : table.craters) {
-            std::string rims;
-            for (const auto r : k.rim_regions)
-                rims += (rims.empty() ? "" : " ") + std::to_string(r);
             out << k.id << ',' << field(k.lon) << ',' << field(k.lat) << ',' << field(k.col) << ','
                 << field(k.row) << ',' << field(k.diameter_m) << ',' << field(k.depth_m) << ','
                 << field(k.rim_height_m) << ',' << field(k.circularity) << ','
                 << field(k.rim_fraction) << ',' << field(k.fit_rms_m) << ','
-                << field(k.field_scale_m) << ',' << k.floor_region << ',' << rims << ','
+                << field(k.field_scale_m) << ',' << k.floor_region << ',' << rim_list(k) << ','
                 << field(k.confidence) << '\n';
         }
     });

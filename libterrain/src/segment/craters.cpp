@@ -53,17 +53,20 @@ bool solve3(const std::array<std::array<double, 3>, 3>& m, const V3& b, V3& x) {
     return true;
 }
 
-// Least squares of y ~ c0 + c1 u + c2 v, accumulated point by point.
-struct Affine {
+// Linear least squares in three unknowns c (y ~ c . p), its normal equations accumulated
+// point by point.
+struct LeastSquares3 {
     std::array<std::array<double, 3>, 3> m{};
     V3 b{};
-    void add(double u, double v, double y) {
-        const V3 p{1, u, v};
+    int points = 0;
+    void add(const V3& p, double y) {
         for (std::size_t i = 0; i < 3; ++i) {
             for (std::size_t j = 0; j < 3; ++j) m[i][j] += p[i] * p[j];
             b[i] += p[i] * y;
         }
+        ++points;
     }
+    bool solve(V3& c) const { return points >= 3 && solve3(m, b, c); }
 };
 
 struct Circle {
@@ -74,21 +77,15 @@ struct Circle {
 // Kasa's algebraic fit (x^2 + y^2 + a x + b y + c = 0) to the points with `use`.
 bool fit_circle(const std::array<double, kSectors>& px, const std::array<double, kSectors>& py,
                 const std::array<bool, kSectors>& use, Circle& out) {
-    std::array<std::array<double, 3>, 3> m{};
-    V3 b{};
-    int n = 0;
+    LeastSquares3 fit;
     for (int s = 0; s < kSectors; ++s) {
         if (!use[std::size_t(s)]) continue;
-        const double x = px[std::size_t(s)], y = py[std::size_t(s)], z = -(x * x + y * y);
-        const V3 p{x, y, 1};
-        for (std::size_t i = 0; i < 3; ++i) {
-            for (std::size_t j = 0; j < 3; ++j) m[i][j] += p[i] * p[j];
-            b[i] += p[i] * z;
-        }
-        ++n;
+        const double x = px[std::size_t(s)], y = py[std::size_t(s)];
+        fit.add({x, y, 1}, -(x * x + y * y));
     }
     V3 abc;
-    if (n < 3 || !solve3(m, b, abc)) return false;
+    if (!fit.solve(abc)) return false;
+    const int n = fit.points;
     out.x = -abc[0] / 2;
     out.y = -abc[1] / 2;
     const double r2 = out.x * out.x + out.y * out.y - abc[2];
@@ -114,8 +111,8 @@ struct Floor {
     V3 centre{}, e1{}, e2{};
     double radius = 0;  // of a disk of the region's area
     double lowest = kInf;
-    int first_col = -1;  // columns unwrapped around this one on a closed grid
-    Affine col, row;     // pixel column and row from the frame's x, y
+    int first_col = -1;      // columns unwrapped around this one on a closed grid
+    LeastSquares3 col, row;  // pixel column and row from the frame's x, y (affine)
     std::array<double, kSectors> x{}, y{}, h{};
     std::array<std::uint32_t, kSectors> from{};
     Circle circle;
@@ -206,8 +203,8 @@ CraterTable find_craters(const TriangleMesh& mesh, const Dem& dem,
             const V3 d = sub(p, fl.centre);
             const double x = dot(d, fl.e1), y = dot(d, fl.e2);
             const auto pixel = std::size_t(mesh.vertex_pixel[v]);
-            fl.col.add(x, y, unwrapped(fl, double(pixel % std::size_t(dem.width)) + 0.5));
-            fl.row.add(x, y, double(pixel / std::size_t(dem.width)) + 0.5);
+            fl.col.add({1, x, y}, unwrapped(fl, double(pixel % std::size_t(dem.width)) + 0.5));
+            fl.row.add({1, x, y}, double(pixel / std::size_t(dem.width)) + 0.5);
             continue;
         }
         const double h = height(v);
@@ -277,7 +274,7 @@ CraterTable find_craters(const TriangleMesh& mesh, const Dem& dem,
         k.rim_regions.erase(std::unique(k.rim_regions.begin(), k.rim_regions.end()),
                             k.rim_regions.end());
         V3 ac, ar;
-        if (!solve3(fl.col.m, fl.col.b, ac) || !solve3(fl.row.m, fl.row.b, ar)) continue;
+        if (!fl.col.solve(ac) || !fl.row.solve(ar)) continue;
         const auto to_pixel = [&](double x, double y) {
             return std::array<double, 2>{ac[0] + ac[1] * x + ac[2] * y,
                                          ar[0] + ar[1] * x + ar[2] * y};
