@@ -5,11 +5,20 @@ inner bowl is a region of its own (crater_score.py's rule: >= 70 % of it within 
 of the bowl covered) and concave (mean shape index x100 below --concave-below: 43.75 by
 default, the concave landform classes; 50 for a mean shape index below 0).
 
-  moon_craters.py SEGMENT_DIR [--concave-below 43.75]
+  moon_craters.py SEGMENT_DIR [--concave-below 43.75] [--catalogue CSV]
 
 SEGMENT_DIR is `terrain segment`'s output on a global lon/lat grid of the Moon starting at
-0 E (labels.tif, regions.geojson). The positions and diameters are approximate (a few
-tenths of a degree, a few km): a look, not a catalogue.
+0 E (labels.tif, regions.geojson, craters.csv). The positions and diameters are approximate
+(a few tenths of a degree, a few km): a look, not a catalogue.
+
+With --catalogue CSV (columns lon, lat, diameter_km; east-positive longitudes), the craters
+of that catalogue between --min-km and --max-km and within --max-lat of the equator are
+scored instead, per diameter bin: the regions by the rule above (with why each miss is
+missed: the bowl's region not concave, spread beyond 1.3 R, or covering under 40 % of the
+bowl), the share of the concave regions of that size whose centroid lies within 0.6 R of a
+catalogued crater, and the crater table (craters.csv) by crater_table_score.py's rule (a
+table crater within 0.5 R of the centre with a diameter within a factor 1.5). No
+catalogue ships with the project: a published one is the user's to give.
 """
 import argparse
 import json
@@ -48,6 +57,10 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("segment_dir")
     parser.add_argument("--concave-below", type=float, default=crater_score.CONCAVE_BELOW)
+    parser.add_argument("--catalogue", help="CSV of lon, lat, diameter_km to score against")
+    parser.add_argument("--min-km", type=float, default=60)
+    parser.add_argument("--max-km", type=float, default=300)
+    parser.add_argument("--max-lat", type=float, default=60)
     a = parser.parse_args()
     ds = gdal.Open(os.path.join(a.segment_dir, "labels.tif"))
     labels = ds.GetRasterBand(1).ReadAsArray().astype(np.int64)
@@ -58,6 +71,9 @@ def main():
             mean[p["id"]] = np.nan if p["field_mean"] is None else p["field_mean"]
     h, w = labels.shape
     pixel_km = 2 * np.pi * MOON_RADIUS_KM / w
+    if a.catalogue:
+        score_catalogue(a, labels, mean, pixel_km)
+        return
     craters = {
         "col": np.array([(lon % 360) / 360 * w for _, _, lon, _ in CRATERS]),
         "row": np.array([(90 - lat) / 180 * h for _, lat, _, _ in CRATERS]),
@@ -69,6 +85,91 @@ def main():
     for (name, _, _, d), ok, k in zip(CRATERS, found, match):
         print(f"{name:14s} {d:4d} km  region {k:6d}  mean {mean[k]:5.1f}  {'found' if ok else 'missed'}")
     print(f"found {int(found.sum())} of {len(CRATERS)} (concave below {a.concave_below})")
+
+
+def read_catalogue(path, min_km, max_km, max_lat):
+    import csv
+    with open(path, newline="") as f:
+        rows = [(float(r["lon"]), float(r["lat"]), float(r["diameter_km"]))
+                for r in csv.DictReader(f)]
+    rows = [r for r in rows if min_km <= r[2] <= max_km and abs(r[1]) <= max_lat]
+    lon, lat, d = (np.array(c, float) for c in zip(*rows)) if rows else (np.zeros(0),) * 3
+    return lon, lat, d
+
+
+def score_catalogue(a, labels, mean, pixel_km):
+    h, w = labels.shape
+    lon, lat, d = read_catalogue(a.catalogue, a.min_km, a.max_km, a.max_lat)
+    craters = {"col": (lon % 360) / 360 * w, "row": (90 - lat) / 180 * h,
+               "diameter_px": d / pixel_km, "col_scale": np.cos(np.radians(lat))}
+    everything = np.arange(len(d))
+    concave = mean < a.concave_below
+    found, match = crater_score.find(labels, concave, craters, everything, wrap=True)
+    # Why each miss is missed (the rule's three tests, on the region found for it).
+    areas = np.bincount(labels.ravel())
+    why = {"not concave": 0, "spreads beyond 1.3 R": 0, "under 40 % of the bowl": 0}
+    for i in np.nonzero(~found)[0]:
+        k = match[i]
+        if not concave[k]:
+            why["not concave"] += 1
+            continue
+        r = craters["diameter_px"][i] / 2
+        sx = craters["col_scale"][i]
+        window, rows, cols = crater_score._window(labels, craters["col"][i], craters["row"][i],
+                                                  1.4 * r / sx, 1.4 * r, True)
+        dx = crater_score._wrap(cols + 0.5 - craters["col"][i], w, True) * sx
+        dist = np.hypot(dx[None, :], rows[:, None] + 0.5 - craters["row"][i])
+        if np.count_nonzero((window == k) & (dist <= 1.3 * r)) < 0.7 * areas[k]:
+            why["spreads beyond 1.3 R"] += 1
+        else:
+            why["under 40 % of the bowl"] += 1
+    bins = ((60, 100), (100, 150), (150, 300))
+    print(f"{len(d)} catalogued craters {a.min_km:g}-{a.max_km:g} km, |lat| <= {a.max_lat:g}")
+    for lo, hi in bins:
+        sel = (d >= lo) & (d < hi) if hi < a.max_km else (d >= lo) & (d <= hi)
+        print(f"  regions {lo:3d}-{hi:3d} km: {int(found[sel].sum())} of {int(sel.sum())}")
+    print(f"regions: {int(found.sum())} of {len(d)} = {found.mean() if len(d) else 0:.3f}"
+          f" ({', '.join(f'{v} {k}' for k, v in why.items())})")
+    # Concave regions of crater size that are catalogued craters (centroid within 0.6 R).
+    bins_px = tuple((lo / pixel_km, hi / pixel_km) for lo, hi in ((a.min_km, a.max_km),))
+    saved = crater_score.BINS
+    crater_score.BINS = bins_px
+    try:
+        good = crater_score.precision(labels, concave, dict(craters, degradation=np.zeros(len(d))),
+                                      set(match[found].tolist()), wrap=True)
+    finally:
+        crater_score.BINS = saved
+    g, n = next(iter(good.values()))
+    print(f"concave regions {a.min_km:g}-{a.max_km:g} km that are catalogued craters: "
+          f"{g} of {n} = {g / max(n, 1):.3f}")
+    table_path = os.path.join(a.segment_dir, "craters.csv")
+    if not os.path.exists(table_path):
+        return
+    import csv
+    with open(table_path, newline="") as f:
+        rows = list(csv.DictReader(f))
+    t_lon = np.array([float(r["lon"]) for r in rows])
+    t_lat = np.array([float(r["lat"]) for r in rows])
+    t_d = np.array([float(r["diameter_m"]) for r in rows]) / 1000
+    table = {"col": (t_lon % 360) / 360 * w, "row": (90 - t_lat) / 180 * h}
+    hit = np.zeros(len(d), bool)
+    for i in range(len(d)):
+        sx = craters["col_scale"][i]
+        dist = np.hypot(crater_score._wrap(table["col"] - craters["col"][i], w, True) * sx,
+                        table["row"] - craters["row"][i])
+        ratio = t_d / d[i]
+        hit[i] = np.any((dist < 0.25 * craters["diameter_px"][i]) & (ratio < 1.5) & (ratio > 1 / 1.5))
+    in_range = (t_d >= a.min_km) & (t_d <= a.max_km) & (np.abs(t_lat) <= a.max_lat)
+    true = 0
+    for j in np.nonzero(in_range)[0]:
+        sx = np.cos(np.radians(lat))
+        dist = np.hypot(crater_score._wrap(craters["col"] - table["col"][j], w, True) * sx,
+                        craters["row"] - table["row"][j])
+        ratio = t_d[j] / d
+        true += bool(np.any((dist < 0.25 * craters["diameter_px"]) & (ratio < 1.5) & (ratio > 1 / 1.5)))
+    print(f"crater table: recall {int(hit.sum())} of {len(d)} = {hit.mean() if len(d) else 0:.3f};"
+          f" precision {true} of {int(in_range.sum())} = {true / max(int(in_range.sum()), 1):.3f}"
+          " (precision counts only catalogued craters in the same diameter range)")
 
 
 if __name__ == "__main__":

@@ -4,7 +4,9 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <cstdint>
 #include <functional>
+#include <numbers>
 #include <vector>
 
 #include "terrain/core/error.hpp"
@@ -154,4 +156,83 @@ TEST_CASE("a ladder of radii is checked", "[scale_selection]") {
     CHECK_THROWS_AS(field::scale_selected_shape_index(mesh, options), Error);
     options.radii = {2, 4, 8};
     CHECK(field::scale_selected_shape_index(mesh, options).radii == options.radii);
+}
+
+namespace {
+
+// Gaussian white noise of standard deviation `sigma` (Box-Muller on a fixed LCG: the same
+// numbers on every machine).
+struct WhiteNoise {
+    std::uint64_t state = 12345;
+    double uniform() {
+        state = state * 6364136223846793005ull + 1442695040888963407ull;
+        return (double(state >> 11) + 0.5) / double(1ull << 53);
+    }
+    double operator()(double sigma) {
+        return sigma * std::sqrt(-2 * std::log(uniform())) *
+               std::cos(2 * std::numbers::pi * uniform());
+    }
+};
+
+}  // namespace
+
+TEST_CASE("pixel noise: the standard deviation of white noise, none on a bowl or a slope",
+          "[scale_selection]") {
+    WhiteNoise noise;
+    std::vector<double> values;
+    for (int i = 0; i < 300 * 300; ++i) values.push_back(noise(2.5));
+    std::size_t next = 0;
+    const auto noisy = mesh::dem_to_mesh(
+        grid(300, [&](double x, double y) { return 0.3 * x - 0.1 * y + values[next++]; }));
+    CHECK(field::pixel_noise(noisy) == Approx(2.5).epsilon(0.05));
+    // A quadric (here a wide bowl on a slope) is no noise at all.
+    const auto smooth = mesh::dem_to_mesh(grid(300, [](double x, double y) {
+        return 0.002 * ((x - 150) * (x - 150) + (y - 150) * (y - 150)) + 0.5 * x;
+    }));
+    CHECK(field::pixel_noise(smooth) < 1e-3);
+}
+
+TEST_CASE("the fit's noise factor is the least-squares spread of its curvedness",
+          "[scale_selection]") {
+    // A 2 m disk on 1 m pixels holds the 12 pixels around the centre; the 5-term fit
+    // h = a u^2 + b uv + c v^2 + d u + e v over them gives, for white noise of 1 m, a
+    // curvedness sqrt(2 a^2 + b^2 + 2 c^2) of spread 0.5970 1/m (the diagonal of the inverse
+    // normal matrix).
+    const auto mesh = mesh::dem_to_mesh(grid(21, [](double, double) { return 0.0; }));
+    field::ShapeIndexOptions options;
+    options.radius = 2.0;
+    options.window = field::ShapeIndexWindow::disk;
+    const auto k = field::principal_curvatures(mesh, options);
+    CHECK(k[vertex_at(mesh, 21, 10, 10)].noise == Approx(0.5970).epsilon(0.01));
+}
+
+// The field's spread over the pixels [10, n - 10)^2 of a scale-selected field.
+double spread(const Selected& s) {
+    double sum = 0, sum2 = 0;
+    int count = 0;
+    for (int row = 10; row < s.n - 10; ++row)
+        for (int col = 10; col < s.n - 10; ++col) {
+            const double f = s.field_at(col, row);
+            sum += f, sum2 += f * f, ++count;
+        }
+    const double mean = sum / count;
+    return std::sqrt(sum2 / count - mean * mean);
+}
+
+TEST_CASE("white noise reads planar, a crater under it keeps its scale", "[scale_selection]") {
+    WhiteNoise noise;
+    std::vector<double> values;
+    for (int i = 0; i < 2 * 128 * 128; ++i) values.push_back(noise(0.05));
+    // The noise alone makes the 2 m rung's curvedness about 0.06, a third of the contrast
+    // curvedness: kept, it speckles the plane with a spread of 12 around 50 (measured before
+    // the noise was discounted); discounted, 2.4 (what remains is taken at the 4 m rung).
+    std::size_t next = 0;
+    const Selected plain(128, [&](double, double) { return values[next++]; });
+    CHECK(spread(plain) < 4.0);
+    CHECK(plain.out.pixel_noise_m == Approx(0.05).epsilon(0.15));
+    // A crater under the same noise is still a cup at its own scale.
+    const Selected s(128,
+                     [&](double x, double y) { return crater(x, y, 64, 64, 26) + values[next++]; });
+    CHECK(s.radius_at(64, 64) >= 15.9);
+    CHECK(s.field_at(64, 64) < 10);
 }

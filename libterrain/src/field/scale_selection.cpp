@@ -4,8 +4,10 @@
 // with curvedness x radius as the normalised measure: the same for a bowl of any size with
 // the same depth-to-diameter ratio).
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include "shape_index_fit.hpp"
 #include "terrain/core/error.hpp"
@@ -18,6 +20,11 @@ constexpr std::size_t kMaxRadii = 16;  // (a rung in 4 bits)
 // The contrast kept by a vertex whose curvedness rises to the ladder's top: a landform wider
 // than the ladder reads nearly planar, without making plateaus of exactly equal values.
 constexpr float kTopContrast = 0.25f;
+// A curvature is seen at a rung only when it is this many times the spread (standard
+// deviation) of the curvedness the DEM's pixel noise alone gives that rung's fit.
+constexpr double kNoiseSigmas = 3;
+// The most pixels pixel_noise samples.
+constexpr std::size_t kNoiseSamples = std::size_t(1) << 20;
 // The ladder's tiles of sums may span this angle on the body (shape_index.hpp): the tilt of a
 // tile's frame is a slope, which the fit takes up, not a curvature.
 constexpr double kLadderTileAngle = 0.4;
@@ -31,6 +38,51 @@ void check_dem_mesh(const TriangleMesh& mesh) {
 }
 
 }  // namespace
+
+double pixel_noise(const TriangleMesh& mesh) {
+    const int w = mesh.grid_width, h = mesh.grid_height;
+    if (w < 3 || h < 3 || mesh.pixel_vertex.size() != std::size_t(w) * std::size_t(h)) return 0;
+    const std::size_t inner = std::size_t(w - 2) * std::size_t(h - 2);
+    const std::size_t stride = std::max<std::size_t>(1, inner / kNoiseSamples);
+    std::vector<double> response;
+    response.reserve(std::min(inner, kNoiseSamples + 1));
+    static constexpr double kMask[3] = {1, -2, 1};
+    for (std::size_t i = 0; i < inner; i += stride) {
+        const int col = 1 + int(i % std::size_t(w - 2)), row = 1 + int(i / std::size_t(w - 2));
+        const auto at = [&](int c, int r) {
+            return mesh.pixel_vertex[std::size_t(r) * std::size_t(w) + std::size_t(c)];
+        };
+        const auto centre = at(col, row);
+        if (centre < 0) continue;
+        const auto p0 = mesh.position(std::size_t(centre));
+        std::array<double, 3> up{0, 0, 1};
+        if (mesh.frame == MeshFrame::body) {
+            const double r = std::hypot(p0[0], p0[1], p0[2]);
+            if (!(r > 0)) continue;
+            up = {p0[0] / r, p0[1] / r, p0[2] / r};
+        }
+        double sum = 0;
+        bool whole = true;
+        for (int dr = -1; dr <= 1 && whole; ++dr)
+            for (int dc = -1; dc <= 1; ++dc) {
+                const auto v = at(col + dc, row + dr);
+                if (v < 0) {
+                    whole = false;
+                    break;
+                }
+                const auto p = mesh.position(std::size_t(v));
+                const double height =
+                    (p[0] - p0[0]) * up[0] + (p[1] - p0[1]) * up[1] + (p[2] - p0[2]) * up[2];
+                sum += kMask[dc + 1] * kMask[dr + 1] * height;
+            }
+        if (whole && std::isfinite(sum)) response.push_back(std::abs(sum));
+    }
+    if (response.size() < 9) return 0;
+    const auto mid = response.begin() + std::ptrdiff_t(response.size() / 2);
+    std::nth_element(response.begin(), mid, response.end());
+    // |N * z| of white noise is half-normal with sigma 6 sigma_z; its median is 0.6745 of that.
+    return *mid / (6 * 0.674489750196082);
+}
 
 std::vector<double> default_radii(const TriangleMesh& mesh) {
     check_dem_mesh(mesh);
@@ -90,6 +142,8 @@ ScaleSelectedField scale_selected_shape_index(const TriangleMesh& mesh,
     const auto previous_rung = [&](std::size_t v) { return std::uint8_t(state[v] >> 4); };
     out.field.assign(n, 50.0f);
     out.scale.assign(n, 0);
+    out.pixel_noise_m = pixel_noise(mesh);
+    const double noise_threshold = kNoiseSigmas * out.pixel_noise_m;
     const std::size_t rungs = out.radii.size();
     const std::uint16_t significant_c = quantize(sig, kCurvednessUnit);
     // A peak over scale at rung `rung` (curvedness c, field value f): taken when it is the
@@ -134,7 +188,11 @@ ScaleSelectedField scale_selected_shape_index(const TriangleMesh& mesh,
                 const double body = body_curvature(vi);
                 const double k1 = (k.k1 / scale - body) * radius,
                              k2 = (k.k2 / scale - body) * radius;
-                const double cd = std::sqrt(0.5 * (k1 * k1 + k2 * k2));
+                double cd = std::sqrt(0.5 * (k1 * k1 + k2 * k2));
+                // The part of the curvedness the DEM's pixel noise does not explain: less
+                // kNoiseSigmas times what the noise alone gives this fit, in quadrature.
+                const double noisy = noise_threshold * k.noise / (scale * scale) * radius;
+                cd = std::sqrt(std::max(0.0, cd * cd - noisy * noisy));
                 if (!std::isfinite(cd)) return;
                 const auto c = quantize(cd, kCurvednessUnit);
                 const double weight = tau2 > 0 ? cd * cd / (cd * cd + tau2) : 1.0;

@@ -218,6 +218,30 @@ bool solve_spd(std::array<std::array<double, N>, N>& a, std::array<double, N>& b
     return true;
 }
 
+// Row i of the inverse of the matrix whose Cholesky factor solve_spd left in `l`, at i:
+// |L^-1 e_i|^2.
+template <int N>
+double inverse_diagonal(const std::array<std::array<double, N>, N>& l, int i) {
+    std::array<double, N> y{};
+    double sum = 0;
+    for (int r = i; r < N; ++r) {
+        double s = r == i ? 1.0 : 0.0;
+        for (int k = i; k < r; ++k) s -= l[r][k] * y[k];
+        y[r] = s / l[r][r];
+        sum += y[r] * y[r];
+    }
+    return sum;
+}
+
+// The noise factor of PrincipalCurvatures for a fit h = a u^2 + b uv + c v^2 (+ ...) whose
+// normal matrix has the Cholesky factor `l`: the curvedness is sqrt(2 a^2 + b^2 + 2 c^2)
+// (slopes neglected), and white noise of unit variance gives var(a) = (A^-1)_00, ...
+template <int N>
+double curvedness_noise(const std::array<std::array<double, N>, N>& l) {
+    return std::sqrt(2 * inverse_diagonal<N>(l, 0) + inverse_diagonal<N>(l, 1) +
+                     2 * inverse_diagonal<N>(l, 2));
+}
+
 }  // namespace
 
 // Solves the fit with coordinates divided by `scale` (so that it is scale-free; dividing only
@@ -244,6 +268,7 @@ bool solve_curvatures(NormalEquations e, PrincipalCurvatures& out) {
         if (solve_spd<5>(A, B)) {
             a = B[0], b = B[1], c = B[2], du = B[3], dv = B[4];
             full = true;
+            out.noise = curvedness_noise<5>(A);
         }
     }
     if (!full) {
@@ -253,6 +278,7 @@ bool solve_curvatures(NormalEquations e, PrincipalCurvatures& out) {
             for (int j = 0; j <= i; ++j) A[i][j] = ata[i][j];
         if (!solve_spd<3>(A, B)) return false;
         a = B[0], b = B[1], c = B[2];
+        out.noise = curvedness_noise<3>(A);
     }
     // Fundamental forms of the graph surface at the origin (normal pointing up).
     const double E = 1 + du * du, F = du * dv, G = 1 + dv * dv;
@@ -1020,7 +1046,7 @@ std::vector<PrincipalCurvatures> principal_curvatures(const TriangleMesh& mesh,
     std::vector<PrincipalCurvatures> out(mesh.vertex_count());
     for_each_vertex(mesh, options, progress,
                     [&](std::int32_t v, bool ok, const PrincipalCurvatures& k, double scale) {
-                        if (ok) out[v] = {k.k1 / scale, k.k2 / scale};
+                        if (ok) out[v] = {k.k1 / scale, k.k2 / scale, k.noise / (scale * scale)};
                     });
     return out;
 }

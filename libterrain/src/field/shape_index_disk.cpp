@@ -24,26 +24,31 @@ int iceil(double x) {
     return i + (x > i);
 }
 
-// The window {a x^2 + 2 b x y + c y^2 <= 1} of pixel offsets (x columns, y rows).
+// The window {a x^2 + 2 b x y + c y^2 <= 1} of pixel offsets (x columns, y rows), in up to
+// three bands of rows on each side of row 0, each band the ellipse's span at its middle row.
+// A window up to three rows high on each side (radii under four pixels) is therefore the
+// exact set of pixel centres in the ellipse: as wide as it is high, so that a small window
+// weighs the two directions alike (a band's span taken elsewhere than on its own rows would
+// make a two-pixel disk three columns by five rows, and its curvature across the columns
+// three times as sensitive to pixel noise as along them).
 DiskWindow ellipse_window(double a, double b, double c) {
-    // sqrt(1 - m^2) at the middles m = 1/6, 1/2, 5/6 of the thirds of the half-height.
-    static constexpr double kWidth[3] = {0.98601329718326935, 0.86602540378443865,
-                                         0.55277079839256660};
     DiskWindow d;
     const double det = a * c - b * b;
     if (!(a > 0) || !(det > 0)) return d;
     const auto clamp = [](double x) { return std::clamp(x, -kMaxDiskPixels, kMaxDiskPixels); };
     // At row y the ellipse spans the columns -b y / a +- sqrt(a - det y^2) / a; its
-    // half-height is sqrt(a / det), so at y = m sqrt(a / det) the half-width is
-    // sqrt(1 - m^2) / sqrt(a).
-    const double height = clamp(std::sqrt(a / det)), width = 1 / std::sqrt(a), shear = -b / a;
+    // half-height is sqrt(a / det). (The tolerance keeps a pixel centre on the ellipse in.)
+    constexpr double kOnEdge = 1e-9;
+    const double height = clamp(std::sqrt(a / det) * (1 + kOnEdge)), shear = -b / a;
     for (int side : {1, -1}) {
         int previous = side > 0 ? -1 : 0;  // the row 0 band is on the + side
         for (int k = 0; k < 3; ++k) {
             const int hi = ifloor(height * (k + 1) / 3);
             if (hi <= previous) continue;
-            const double centre = side * shear * height * (k + 0.5) / 3;
-            const double half = kWidth[k] * width;
+            const double y = side * 0.5 * (previous + 1 + hi);
+            const double centre = clamp(shear * y);
+            const double half =
+                clamp(std::sqrt(std::max(0.0, a - det * y * y)) / a) * (1 + kOnEdge);
             DiskWindow::Band band;
             band.row_lo = side > 0 ? previous + 1 : -hi;
             band.row_hi = side > 0 ? hi : -(previous + 1);

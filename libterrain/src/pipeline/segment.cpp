@@ -236,6 +236,7 @@ void compute_field(SegmentResult& result, const SegmentOptions& options,
         result.field = std::move(selected.field);
         result.field_scale = std::move(selected.scale);
         result.field_radii = std::move(selected.radii);
+        result.pixel_noise_m = selected.pixel_noise_m;
     } else {
         result.field = field::vertex_field(result.input.mesh, result.dem(), fo, progress);
     }
@@ -710,7 +711,9 @@ void write_run_json(const SegmentResult& result, const std::string& input_path,
     if (options.shape_index.auto_scale) {
         j.field("radius", "auto").key("radii_m").begin_array();
         for (const double r : result.field_radii) j.value(r);
-        j.end_array().field("contrast_curvedness", options.shape_index.contrast_curvedness);
+        j.end_array()
+            .field("contrast_curvedness", options.shape_index.contrast_curvedness)
+            .field("pixel_noise_m", result.pixel_noise_m);
     } else {
         j.field("radius", options.shape_index.radius);
     }

@@ -45,7 +45,10 @@ struct ShapeIndexOptions {
     // significant; a rise to the ladder's top is no peak (the landform is wider than the
     // ladder: a quarter of that rung's contrast, nearly planar). The field is 50 + 50 SI w, the
     // shape index of the chosen radius with its contrast w = c^2 / (c^2 + contrast_curvedness^2):
-    // shapes too weak to be seen at any scale read as planar. rings and radius are ignored.
+    // shapes too weak to be seen at any scale read as planar. Where the DEM is noisy, the
+    // threshold is raised to kNoiseSigmas times the curvedness its pixel noise alone gives the
+    // fit (pixel_noise; docs/field.md, "Pixel noise"): c is taken relative to that threshold.
+    // rings and radius are ignored.
     bool auto_scale = false;
     std::vector<double> radii;
     double contrast_curvedness = 0.2;
@@ -69,13 +72,18 @@ const char* shape_index_window(const TriangleMesh& mesh, const ShapeIndexOptions
 
 struct PrincipalCurvatures {
     double k1 = 0, k2 = 0;  // k1 >= k2, positive where the surface is convex (a cap)
+    // The standard deviation of the curvedness that white noise of unit standard deviation
+    // in the heights alone would give this fit (in the units of k1 and k2 per unit height;
+    // from the fit's normal equations, slopes neglected); 0 where the fit does not say.
+    double noise = 0;
 };
 
 // Shape index in [-1, 1] of principal curvatures (k1 >= k2, convex positive); 0 when both
 // vanish.
 double shape_index(double k1, double k2);
 
-// Per-vertex principal curvatures (convex positive, normals outwards/up).
+// Per-vertex principal curvatures (convex positive, normals outwards/up) in 1/m, and their
+// noise factor in 1/m per metre of height noise.
 std::vector<PrincipalCurvatures> principal_curvatures(const TriangleMesh& mesh,
                                                       const ShapeIndexOptions& options = {},
                                                       const ProgressFn& progress = {});
@@ -96,7 +104,16 @@ struct ScaleSelectedField {
     std::vector<float> field;         // per vertex, in [0, 100] as shape_index_field's
     std::vector<std::uint8_t> scale;  // per vertex, the index in `radii` of its radius
     std::vector<double> radii;        // the ladder, metres
+    double pixel_noise_m = 0;         // the DEM's pixel noise (pixel_noise)
 };
+
+// The standard deviation of a DEM mesh's pixel noise in metres (Immerkaer's estimator, made
+// robust): the 3 x 3 product of the second differences along columns and along rows, which
+// vanishes on any quadric (a slope, a bowl, the body's own curvature), applied to the heights
+// of each pixel's neighbours above its tangent plane; sigma = median |response| / (6 x
+// 0.6745), over up to 2^20 pixels taken on a fixed stride. 0 when fewer than 9 pixels have
+// their whole 3 x 3 block. Deterministic.
+double pixel_noise(const TriangleMesh& mesh);
 
 // The scale-selected shape index of options.auto_scale (options.radii, or default_radii).
 // Throws terrain::Error (stage "field") for a mesh not made from a DEM, a ladder that is

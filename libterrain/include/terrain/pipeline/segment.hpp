@@ -183,6 +183,7 @@ struct SegmentResult {
     // With the scale chosen per vertex (shape_index.auto_scale): the ladder of radii
     // (metres) and each vertex's index in it, freed once the region table holds the scale.
     std::vector<double> field_radii;
+    double pixel_noise_m = 0;  // --radius auto: the DEM's pixel noise (field::pixel_noise)
     std::vector<std::uint8_t> field_scale;
     std::optional<segment::CraterTable> craters;  // DEM input with SegmentOptions::craters
 
