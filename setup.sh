@@ -1,10 +1,13 @@
 #!/usr/bin/env bash
 # terrain's set-up, in one command each (see README.md):
-#   ./setup.sh          install missing Debian packages, build, run the main job on the sample
-#   ./setup.sh test     install missing Debian packages, build, run the whole test suite
-#   ./setup.sh bench    also install the bench-only packages, build, run the benchmarks
-#   ./setup.sh qgis     also install QGIS, build, install the Processing provider into the
-#                       QGIS profile (QGIS_PROFILE, default: the user's default profile)
+#   ./setup.sh          install missing Debian packages, build the library and the `terrain`
+#                       program only, run the main job on the sample
+#   ./setup.sh test     install missing Debian packages, build everything (tests, examples,
+#                       benchmarks, the Python module), run the whole test suite
+#   ./setup.sh bench    also install the bench-only packages, build everything, run the benchmarks
+#   ./setup.sh qgis     also install QGIS, build the program and the Python module, install the
+#                       Processing provider into the QGIS profile (QGIS_PROFILE, default: the
+#                       user's default profile)
 #   ./setup.sh fuzz [SECONDS]  build the libFuzzer targets with clang in build-fuzz and run
 #                       each for SECONDS (default 120) on its seeds (docs/robustness.md)
 # All are idempotent: installed packages are skipped and the build directory is reused.
@@ -61,19 +64,26 @@ install_packages() {
   DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
 }
 
+# build [TARGET...]: configures the build directory once, then builds the targets named
+# (none: every target).
 build() {
   local launcher=()
   command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
   if [ ! -f "$build_dir/CMakeCache.txt" ]; then
     cmake -S . -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE=Release "${launcher[@]}"
   fi
-  cmake --build "$build_dir" -j "$jobs"
+  local targets=()
+  [ $# -gt 0 ] && targets=(--target "$@")
+  cmake --build "$build_dir" -j "$jobs" "${targets[@]}"
 }
 
 case "$mode" in
   run)
     install_packages "${packages[@]}"
-    build
+    # The main job needs the program alone (terrain_cli, which pulls in the library and the
+    # image module it loads); the tests, examples, benchmarks and Python module wait for
+    # `./setup.sh test`.
+    build terrain_cli
     # The main job: the synthetic Vesta HAMO tile segmented with the defaults: landforms at
     # their own scale (the shape index at the radius chosen per pixel, regions down to 20
     # pixels; docs/segment.md). The paper's terrain parameters are --persistence 10
@@ -114,7 +124,7 @@ case "$mode" in
     ;;
   qgis)
     install_packages "${packages[@]}" "${qgis_packages[@]}"
-    build
+    build terrain_cli terrain_python
     # The plugin, with local.json telling it where this build's module and program are.
     profile="${QGIS_PROFILE:-$HOME/.local/share/QGIS/QGIS3/profiles/default}"
     plugin="$profile/python/plugins/terrain_provider"

@@ -4,13 +4,13 @@
 // blocks reused"). tools/big_blocks.cpp routes the program's operator new and delete here;
 // this header holds the bookkeeping so that tests can drive it.
 //
-// A whole-grid run allocates and frees arrays of gigabytes stage after stage: at 16 M pixels
-// about 9 GB of fresh pages over a run whose peak is 1.3 GB. The kernel zeroes every fresh
-// page and, when memory is fragmented, first gathers free 2 MiB pages for it. Here a block of
-// 4 MiB or more is a mapping of its own, 2 MiB aligned; freed, it is kept, and the next large
-// allocation takes it: the smallest kept block at least as large (its tail kept as a block of
-// its own), or else the largest one with fresh pages added behind it (its pages moved by
-// mremap, not copied). Fresh pages are mapped only for what no kept block covers.
+// A whole-grid run allocates and frees arrays of gigabytes stage after stage: several times
+// its peak in fresh pages over the run. The kernel zeroes every fresh page and, when memory
+// is fragmented, first gathers free 2 MiB pages for it. Here a block of 4 MiB or more is a
+// mapping of its own, 2 MiB aligned; freed, it is kept, and the next large allocation takes
+// it: the smallest kept block at least as large (its tail kept as a block of its own), or
+// else the largest one with fresh pages added behind it (its pages moved by mremap, not
+// copied). Fresh pages are mapped only for what no kept block covers.
 //
 // The resident set does not grow for it. The process's resident memory, less the kept blocks
 // (counted as resident), is what the program holds; its highest value so far is the peak.

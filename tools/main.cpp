@@ -60,10 +60,10 @@ void print_usage(std::ostream& out) {
 
 // Huge pages (docs/performance.md): glibc reads GLIBC_TUNABLES once, at start-up, so a
 // command that works on whole grids starts itself again with glibc.malloc.hugetlb=1 added
-// when the kernel gives huge pages on request only. About twice as fast on whole grids; the
-// outputs are the same. (`info`, `synth`, --help and --version start once: the second start
-// costs about 0.1 s.) TERRAIN_HUGE_PAGES=0, or a GLIBC_TUNABLES that sets the tunable
-// already, keeps things as they are; so does an exec that fails.
+// when the kernel gives huge pages on request only: whole grids run faster (fewer TLB misses
+// and page faults); the outputs are the same. (`info`, `synth`, --help and --version start
+// once: they gain nothing from a second start.) TERRAIN_HUGE_PAGES=0, or a GLIBC_TUNABLES
+// that sets the tunable already, keeps things as they are; so does an exec that fails.
 void start_again_with_huge_pages(char** argv) {
     const char* choice = std::getenv("TERRAIN_HUGE_PAGES");
     if (choice && std::strcmp(choice, "0") == 0) return;
@@ -96,8 +96,7 @@ int main(int argc, char** argv) {
             start_again_with_huge_pages(argv);
     // The commands allocate a few arrays of megabytes each. glibc raises its mmap threshold
     // after such an array is freed, so later ones come from the heap and stay resident after
-    // being freed; a fixed threshold gives them back at once (about 16 MB less peak memory
-    // for a 1000x1000 DEM).
+    // being freed; a fixed threshold gives them back at once (a lower peak of memory).
     mallopt(M_MMAP_THRESHOLD, 256 * 1024);
     terrain::cli::install_signal_handlers();
     if (argc < 2) {

@@ -3,7 +3,7 @@
 (the system allocator: a freed block leaves the resident set at once, unlike the program's
 kept blocks) and reads the resident set at the progress callbacks, at most every 20 ms. Prints,
 for each progress message in run order, the most the process held while it was reported, in
-bytes per pixel, and the fraction and second where that was (docs/performance.md, "Now").
+bytes per pixel, and the fraction and second where that was (docs/performance.md, "Memory by stage").
 
     PYTHONPATH=build/python /usr/bin/python3 tests/bench/pass_memory.py DEM
 """

@@ -6,7 +6,7 @@
 //     every 2^shift items (rows of a grid: 2^5).
 //   - assign_in_slices, copy_in_slices: a large vector filled 2^18 elements at a time,
 //     reported after each: the first touch of a large block's pages is a silence of its own
-//     (about 3 s a GB measured on a virtual machine, 0.7 s for the adjacency of 4 M pixels).
+//     (the kernel zeroes each fresh page; a virtual machine also backs it then).
 //     Its pages are touched first on every thread (touch_pages): a fresh page costs the same
 //     on each, so two threads take it in half the time.
 //   - parallel_slices: a parallel pass over n items cut into at most 64 consecutive slices,
@@ -48,9 +48,9 @@ class PassProgress {
 };
 
 // The pages of [first, first + bytes) touched (a zero byte written in each), on every thread,
-// before a serial pass writes them all: the first touch of fresh memory costs about 2.4 s a GB
-// on one thread here, 1.2 on two (docs/performance.md, "Large blocks are made a slice at a
-// time"). The storage is raw (reserved, its elements not made yet) or about to be overwritten.
+// before a serial pass writes them all: the first touch of fresh memory is slow, and two
+// threads share it (docs/performance.md, "Large blocks are made a slice at a time"). The
+// storage is raw (reserved, its elements not made yet) or about to be overwritten.
 inline void touch_pages(void* first, std::size_t bytes) {
     constexpr std::size_t kPage = 4096, kChunk = std::size_t{2} << 20, kWorth = kChunk * 4;
     if (bytes < kWorth) return;

@@ -1,6 +1,6 @@
 // The OpenImageIO module (libterrain_oiio.so): the only code that links OpenImageIO. Debian's
-// OpenImageIO pulls in about 260 shared libraries (a quarter of a second and 90 MiB resident
-// at start-up), so libterrain loads this module with dlopen only when it writes an image
+// OpenImageIO pulls in a few hundred shared libraries (start-up time and resident memory of
+// their own), so libterrain loads this module with dlopen only when it writes an image
 // (image_module.cpp). A C interface keeps the two sides independent of each other's ABI.
 // Text on the figures is drawn here too: OpenImageIO renders it with FreeType
 // (ImageBufAlgo::render_text) from a font file libterrain finds at run time (map_canvas.cpp).

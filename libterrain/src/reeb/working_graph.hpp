@@ -3,7 +3,7 @@
 // graph laid out for few cache misses. Nodes are numbered anew: first the nodes that are in no
 // arc's list (the critical ones, the only possible arc ends), in their order, then the listed
 // regular nodes in the order of arc_nodes, so that each list starts out contiguous. A
-// critical node is one 48-byte record (value, area, flags, arc counts and its arcs: up to 4
+// critical node is one 32-byte record (value, area, flags, arc counts and its arcs: up to 3
 // in the record, more in a run of a shared arena); regular nodes sit in doubly linked lists,
 // one per arc, sorted by value. A list absorbed whole is never walked: its area moves at once
 // and its nodes learn where they went in the output, through union-find sets of lists (see
@@ -81,11 +81,11 @@ class WorkingGraph {
 
   protected:
     // A critical node (one of the first critical_count_): its fields and its `size` arcs, the
-    // newest last, with room for kInline << shift (see arc_run()). 32 bytes, two to a cache
-    // line and never across one: about half the vertices of a noisy grid are critical, and
-    // the 48-byte record before it (4 arcs inline, every field a word of its own) held 8
-    // bytes a pixel more at the simplification's peak. Most nodes have 1 to 3 arcs (an
-    // extremum 1, a saddle 3). Its three slots are, by its state:
+    // newest last, with room for kInline << shift (see arc_run()). 32 bytes (asserted), two to
+    // a cache line and never across one: about half the vertices of a noisy grid are critical,
+    // so every byte of this record counts at the simplification's peak (an earlier record, with
+    // 4 arcs inline and every field a word of its own, was larger). Most nodes have 1 to 3
+    // arcs (an extremum 1, a saddle 3). Its three slots are, by its state:
     //   - a node with arcs, shift == 0 and not big: its arcs;
     //   - a node with a run in arena_ (shift > 0) or big (kBig): slot[0] is the run's offset
     //     or its BigNode;

@@ -56,7 +56,7 @@ struct MapFrame {
 
 // The preview in two steps: the map's pixels (8-bit RGBA, row-major) and its frame, then the
 // PNG, on which the frame is drawn around the map. Writing goes through OpenImageIO, loaded on
-// first use (about 120 MB resident, a quarter of a second): a program low on memory renders
+// first use (its libraries take memory and time to load): a program low on memory renders
 // first, frees its large data, then writes.
 struct PreviewImage {
     int width = 0, height = 0;

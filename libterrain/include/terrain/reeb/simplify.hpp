@@ -62,10 +62,9 @@ void check_simplify_options(const SimplifyOptions& options);
 SimplifyResult simplify(const TriangleMesh& mesh, const ReebGraph& graph,
                         const SimplifyOptions& options, const ProgressFn& progress = {});
 // The same, taking the graph: its arc lists and kinds are freed once the working copy is
-// made (about 11 bytes per vertex less at the peak), and the rest (its nodes' values, vertex
-// lists and links, about 18 bytes per vertex) once the result is written: the graph is left
-// empty, and what follows the simplification (growing, dividing, the region graph) runs
-// without it.
+// made (less memory at the peak), and the rest (its nodes' values, vertex lists and links)
+// once the result is written: the graph is left empty, and what follows the simplification
+// (growing, dividing, the region graph) runs without it.
 // `areas_read`, when given, is called once, as soon as the mesh's vertex areas have been read
 // for the last time (once the working copy has summed its nodes' areas, before it copies the
 // arcs: the copy's end is the simplification's peak of memory): the caller may set them
