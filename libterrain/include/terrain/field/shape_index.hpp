@@ -45,9 +45,9 @@ struct ShapeIndexOptions {
     // significant; a rise to the ladder's top is no peak (the landform is wider than the
     // ladder: a quarter of that rung's contrast, nearly planar). The field is 50 + 50 SI w, the
     // shape index of the chosen radius with its contrast w = c^2 / (c^2 + contrast_curvedness^2):
-    // shapes too weak to be seen at any scale read as planar. Where the DEM is noisy, the
-    // threshold is raised to kNoiseSigmas times the curvedness its pixel noise alone gives the
-    // fit (pixel_noise; docs/field.md, "Pixel noise"): c is taken relative to that threshold.
+    // shapes too weak to be seen at any scale read as planar. c is the part the DEM's pixel
+    // noise does not explain: sqrt(max(0, c^2 - (3 s)^2)), s the spread of curvedness that
+    // noise alone gives the fit (pixel_noise; docs/field.md, "Pixel noise").
     // rings and radius are ignored.
     bool auto_scale = false;
     std::vector<double> radii;
