@@ -2,8 +2,8 @@
 """The equivalence harness: runs the built `terrain` program's segment (the defaults and the
 paper's single scale), reeb, mesh and sweep on every bundled sample DEM and compares the
 SHA-256 of every file they write with the sums committed in reference.sha256 beside this
-script (one `sha256  case/file` line each). run.json is hashed without the fields that hold
-timings, the input's path and the machine's state (VOLATILE below).
+script (one `sha256  case/file` line each). run.json and graph.json are hashed without the
+fields that hold timings, the input's path and the machine's state (VOLATILE below).
 
     tests/equivalence/run.py --terrain build/tools/terrain            # compare; exit 1 on a change
     tests/equivalence/run.py --terrain build/tools/terrain --update   # rewrite the sums
@@ -50,8 +50,11 @@ JOBS = {
 }
 COMMAND = {"segment_paper": "segment"}
 
-# run.json's fields that are not the run's results: timings, the input's path, the pages the
-# process had, the libraries' versions. The rest is hashed, its keys sorted.
+# The JSON files that record how they were made (run.json, and the Reeb graph's graph.json),
+# and their fields that are not the run's results: timings, the input's path (the clone's
+# location), the pages the process had, the libraries' versions. The rest is hashed, its
+# keys sorted.
+RECORDS = {"run.json", "graph.json"}
 VOLATILE = {"timings_seconds", "seconds", "input", "pages", "versions"}
 
 
@@ -65,7 +68,7 @@ def without_volatile(value):
 
 def sha256(path):
     h = hashlib.sha256()
-    if path.name == "run.json":
+    if path.name in RECORDS:
         run = without_volatile(json.loads(path.read_text()))
         h.update(json.dumps(run, sort_keys=True, separators=(",", ":")).encode())
         return h.hexdigest()
