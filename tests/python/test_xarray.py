@@ -196,23 +196,29 @@ def test_bands_and_the_order_of_dimensions():
 
 
 def test_what_is_missing_is_one_clear_error():
-    values = rioxarray.open_rasterio(str(SAMPLE_FILES["moon4c"])).values[0] * 0.5 + 1737400.0
+    path = str(SAMPLE_FILES["moon4c"])
+    full = rioxarray.open_rasterio(path)
+    values = full.values[0] * 0.5 + 1737400.0
     bare = xr.DataArray(values, dims=("y", "x"))
     with pytest.raises(terrain.Error, match=r"^read: the DataArray has no CRS .* and no "
                                             r"transform .*; terrain needs both"):
         terrain.segment(bare)
-    with_crs = bare.rio.write_crs("IAU_2015:30100")
+    with_crs = bare.rio.write_crs(full.rio.crs)
     with pytest.raises(terrain.Error, match=r"^read: the DataArray has no transform \("):
         with_crs.terrain.segment()
-    with_transform = bare.rio.write_transform(
-        rioxarray.open_rasterio(str(SAMPLE_FILES["moon4c"])).rio.transform())
+    with_transform = bare.rio.write_transform(full.rio.transform())
     with pytest.raises(terrain.Error, match=r"^read: the DataArray has no CRS \("):
         terrain.shape_index(with_transform)
+    # Both, without x/y coordinates: the grid mapping's GeoTransform places the grid.
+    both = with_crs.rio.write_transform(full.rio.transform())
+    assert "x" not in both.coords
+    labels = terrain.segment(both).labels
+    assert labels.values.tobytes() == terrain.segment(path).labels.tobytes()
+    assert labels.rio.transform() == full.rio.transform()
     with pytest.raises(terrain.Error, match="no spatial dimensions"):
         terrain.segment(xr.DataArray(values, dims=("row", "col")))
     with pytest.raises(terrain.Error, match="not a Dataset"):
         terrain.segment(xr.Dataset({"h": bare}))
-    full = rioxarray.open_rasterio(str(SAMPLE_FILES["moon4c"]))
     with pytest.raises(terrain.Error, match="do not pass geotransform or crs"):
         terrain.segment(full, crs="IAU_2015:30100")
     with pytest.raises(terrain.Error, match=r"band 2 asked of a DataArray of 1 band"):
