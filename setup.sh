@@ -37,6 +37,10 @@ packages=(
   # The Python module and its tests (docs/python.md).
   pybind11-dev python3-pybind11 python3-dev python3-numpy python3-pytest
   python3-gdal python3-geopandas python3-rasterio python3-networkx
+  # DataArrays in and out of the module, dask chunks (docs/python.md, "xarray").
+  python3-xarray python3-rioxarray python3-dask
+  # The tutorial notebook, docs/tutorial.ipynb, run by the tests (python3's kernel).
+  python3-matplotlib python3-nbclient python3-nbconvert python3-ipykernel
 )
 # For `./setup.sh test` (the headless test of the QGIS provider, ~3 min to install) and
 # `./setup.sh qgis`; the default set-up does not download QGIS.

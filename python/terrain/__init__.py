@@ -9,13 +9,17 @@ The C++ library as Python calls (docs/python.md)::
     result.to_geodataframe()   # the region polygons (geopandas)
     result.graph.to_networkx() # the adjacency graph (networkx)
 
-A DEM can be a path, a terrain.Dem (terrain.read_dem) or a 2-D numpy array (NaN = NoData)
-with its GDAL geotransform and CRS. Long calls release the GIL; `progress` takes a callable
+A DEM can be a path, a terrain.Dem (terrain.read_dem), a 2-D numpy array (NaN = NoData)
+with its GDAL geotransform and CRS, or an xarray DataArray with its CRS and transform
+(rioxarray's .rio), whose results come back as DataArrays on its grid (da.terrain.segment()
+once xarray is imported). Long calls release the GIL; `progress` takes a callable
 progress(fraction, message) that returns False to cancel. The library's errors raise
 terrain.Error with the command line's one-line messages.
 """
 
+import importlib.abc
 import os
+import sys
 import tempfile
 
 import numpy as np
@@ -82,6 +86,40 @@ def _crs(crs):
     if hasattr(crs, "ExportToWkt"):
         return crs.ExportToWkt()
     return str(crs)
+
+
+def _xarray_support(dem):
+    """terrain._xarray when `dem` is an xarray object, else None (xarray is never imported
+    here: an object of xarray's exists only once xarray is)."""
+    xr = sys.modules.get("xarray")
+    if xr is None or not isinstance(dem, (xr.DataArray, xr.Dataset)):
+        return None
+    from . import _xarray
+
+    return _xarray
+
+
+def _prepare(dem, geotransform, crs, read):
+    """(the native source, the read options left, the Grid of a DataArray or None)."""
+    elevation = read.pop("elevation")
+    xa = _xarray_support(dem)
+    if xa is None:
+        return _source(dem, geotransform, crs, elevation), read, None
+    if xa.is_dataset(dem):
+        raise Error("read: give a DataArray (one variable of the Dataset: ds['name']), not a "
+                    "Dataset")
+    if geotransform is not None or crs is not None:
+        raise Error("read: a DataArray carries its own CRS and transform (.rio.write_crs, "
+                    ".rio.write_transform); do not pass geotransform or crs")
+    values, transform, wkt, grid = xa.dem_source(dem, read.pop("band", 1))
+    return _terrain.dem_from_array(values, transform, wkt, elevation), read, grid
+
+
+def _on_grid(grid, values, name, nodata, attrs=None):
+    """`values` as a DataArray on the input DataArray's grid; as they are for other input."""
+    if grid is None or values is None or np.ndim(values) != 2:
+        return values
+    return grid.wrap(values, name, nodata, attrs)
 
 
 def _source(dem, geotransform, crs, elevation):
@@ -184,19 +222,41 @@ class SegmentResult:
     graph: the adjacency graph (RegionGraph; .to_networkx()).
     craters: the craters read from the regions, a geopandas.GeoDataFrame of points at their
         centres (docs/craters.md); None for a mesh file or with craters=False.
+    field_scale_m: with the radius chosen per pixel (the default on DEMs), each pixel's
+        region's field_scale_m (NaN = NoData); None otherwise.
     region_count, critical_before, critical_after, timings, dem.
+    For a DataArray input, labels, field and field_scale_m are DataArrays on its grid (its
+    x/y coordinates, CRS and transform; NoData 0 for the labels, NaN for the others).
     """
 
-    def __init__(self, native, options, input_path):
+    def __init__(self, native, options, input_path, grid=None):
         self._native = native
         self._options = options
         self._input_path = input_path
+        self._grid = grid
         self.regions = native.region_columns
         self.graph = RegionGraph(self.regions, native.edge_columns)
 
-    labels = property(lambda self: self._native.labels)
+    @property
+    def labels(self):
+        return _on_grid(self._grid, self._native.labels, "labels", 0)
+
+    @property
+    def field(self):
+        return _on_grid(self._grid, self._native.field, "field", np.nan,
+                        {"field": self._options.field})
+
+    @property
+    def field_scale_m(self):
+        scale = self.regions.get("field_scale_m")
+        labels = self._native.labels
+        if scale is None or labels is None:
+            return None
+        by_label = np.full(int(self.regions["id"].max(initial=0)) + 1, np.nan)
+        by_label[self.regions["id"]] = scale
+        return _on_grid(self._grid, by_label[labels], "field_scale_m", np.nan)
+
     vertex_labels = property(lambda self: self._native.vertex_labels)
-    field = property(lambda self: self._native.field)
     region_count = property(lambda self: self._native.region_count)
     critical_before = property(lambda self: self._native.critical_before)
     critical_after = property(lambda self: self._native.critical_after)
@@ -245,7 +305,11 @@ def segment(dem, geotransform=None, crs=None, *, progress=None, **options):
 
     dem: a path (DEM or .off/.ply/.obj mesh), a terrain.Dem, or a 2-D numpy array of
         elevations in metres (NaN = NoData) with its GDAL `geotransform` (6 numbers or an
-        affine.Affine) and `crs` (WKT, "EPSG:32611", "IAU_2015:30100", or a CRS object).
+        affine.Affine) and `crs` (WKT, "EPSG:32611", "IAU_2015:30100", or a CRS object);
+        or an xarray DataArray with its CRS and transform (rioxarray's .rio; NoData from
+        .rio.nodata/_FillValue or NaN, scale_factor/add_offset applied, dask chunks read
+        one by one; band=N picks a band), whose labels, field and field_scale_m are then
+        DataArrays on its grid.
     options (keywords, the command line's defaults): field="shape-index" (or "sdf",
         "height"), rings=2, radius=0 (metres, or "auto": chosen per vertex among radii, a
         list of metres; docs/field.md), window="disk" (or "ball"), rays=25, cone_angle=120,
@@ -264,18 +328,20 @@ def segment(dem, geotransform=None, crs=None, *, progress=None, **options):
     Raises terrain.Error on bad input or options, TypeError on an unknown option.
     """
     native_options, read = _split_options(options, _SEGMENT_OPTIONS)
-    source = _source(dem, geotransform, crs, read.pop("elevation"))
+    source, read, grid = _prepare(dem, geotransform, crs, read)
     native = _terrain.segment(source, native_options, progress=progress, **read)
-    return SegmentResult(native, native_options, _input_path(source))
+    return SegmentResult(native, native_options, _input_path(source), grid)
 
 
 class SweepScale:
     """One scale of a sweep: ratio (percent), min_area (m^2, a sweep over areas; else None),
-    labels, vertex_labels, regions, graph, region_count."""
+    labels, vertex_labels, regions, graph, region_count. For a DataArray input, labels is a
+    DataArray on its grid with attributes area_ratio (and min_area_m2)."""
 
-    def __init__(self, sweep, index):
+    def __init__(self, sweep, index, grid=None):
         self._sweep = sweep
         self._index = index
+        self._grid = grid
         self.ratio = sweep.ratios[index]
         self.min_area = sweep.min_areas[index] or None
         self.regions = sweep.region_columns(index)
@@ -283,7 +349,13 @@ class SweepScale:
         self.region_count = sweep.region_count(index)
         self.critical_after = sweep.critical_after(index)
 
-    labels = property(lambda self: self._sweep.labels(self._index))
+    @property
+    def labels(self):
+        attrs = {"area_ratio": self.ratio}
+        if self.min_area is not None:
+            attrs["min_area_m2"] = self.min_area
+        return _on_grid(self._grid, self._sweep.labels(self._index), "labels", 0, attrs)
+
     vertex_labels = property(lambda self: self._sweep.vertex_labels(self._index))
 
     def to_geodataframe(self):
@@ -297,11 +369,11 @@ class SweepResult:
     regions of scale i overlap those of scale i + 1: from_region, to_region, area_m2,
     fraction columns), .write(directory)."""
 
-    def __init__(self, native, options, input_path):
+    def __init__(self, native, options, input_path, grid=None):
         self._native = native
         self._options = options
         self._input_path = input_path
-        self.scales = [SweepScale(native, i) for i in range(native.scale_count())]
+        self.scales = [SweepScale(native, i, grid) for i in range(native.scale_count())]
         self.critical_before = native.critical_before
 
     def lineage(self, index):
@@ -327,10 +399,10 @@ def sweep(dem, geotransform=None, crs=None, *, area_ratios=None, min_areas=None,
     if min_areas is not None and not areas:
         raise Error("sweep: --min-areas needs at least one value")
     native_options, read = _split_options(options, _OPTIONS_BUT_CRATERS)
-    source = _source(dem, geotransform, crs, read.pop("elevation"))
+    source, read, grid = _prepare(dem, geotransform, crs, read)
     native = _terrain.sweep(source, [float(r) for r in area_ratios], native_options,
                             progress=progress, min_areas=areas, **read)
-    return SweepResult(native, native_options, _input_path(source))
+    return SweepResult(native, native_options, _input_path(source), grid)
 
 
 def shape_index(dem, geotransform=None, crs=None, *, rings=2, radius=0.0, window="disk",
@@ -338,13 +410,14 @@ def shape_index(dem, geotransform=None, crs=None, *, rings=2, radius=0.0, window
     """The shape index x100 (0 cup, 50 saddle or plane, 100 cap) of each DEM pixel, a 2-D
     float32 array (NaN = NoData), fitted over the vertices within `rings` mesh edges or
     `radius` metres (window "disk": on the ground, or "ball": in 3-D); per vertex (1-D)
-    for a mesh file."""
+    for a mesh file; a DataArray on the grid of a DataArray input."""
     options = {"field": "shape-index", "radius": radius, "window": window, **read}
     if not radius:
         options["rings"] = rings
     native_options, read = _split_options(options, _OPTIONS_BUT_CRATERS)
-    source = _source(dem, geotransform, crs, read.pop("elevation"))
-    return _terrain.field(source, native_options, progress=progress, **read)
+    source, read, grid = _prepare(dem, geotransform, crs, read)
+    values = _terrain.field(source, native_options, progress=progress, **read)
+    return _on_grid(grid, values, "shape_index", np.nan)
 
 
 class ReebGraph:
@@ -389,6 +462,47 @@ def reeb_graph(dem, geotransform=None, crs=None, *, persistence=0.0, area_ratio=
     else:
         options["area_ratio"] = 0.0 if area_ratio is None else area_ratio
     native_options, read = _split_options(options, _OPTIONS_BUT_CRATERS)
-    source = _source(dem, geotransform, crs, read.pop("elevation"))
+    source, read, _ = _prepare(dem, geotransform, crs, read)
     nodes, arcs, before = _terrain.reeb_graph(source, native_options, progress=progress, **read)
     return ReebGraph(nodes, arcs, before)
+
+
+def _register_xarray_accessor():
+    from . import _xarray
+
+    _xarray.register_accessor()
+
+
+class _AccessorOnXarrayImport(importlib.abc.MetaPathFinder):
+    """Registers DataArray.terrain right after xarray is first imported: `import terrain`
+    itself does not import xarray (it takes seconds), yet da.terrain works whichever of
+    the two is imported first. Finds nothing itself; it leaves sys.meta_path at once."""
+
+    def find_spec(self, name, path=None, target=None):
+        if name != "xarray":
+            return None
+        if self in sys.meta_path:
+            sys.meta_path.remove(self)
+        for finder in sys.meta_path:
+            spec = finder.find_spec(name, path, target) if hasattr(finder, "find_spec") else None
+            if spec is not None:
+                break
+        else:
+            return None
+        loader = spec.loader
+        if loader is None or isinstance(loader, type) or not hasattr(loader, "exec_module"):
+            return spec
+        run = loader.exec_module
+
+        def exec_module(module):
+            run(module)
+            _register_xarray_accessor()
+
+        loader.exec_module = exec_module  # this spec's own loader object
+        return spec
+
+
+if sys.modules.get("xarray") is not None:
+    _register_xarray_accessor()
+else:
+    sys.meta_path.insert(0, _AccessorOnXarrayImport())
