@@ -92,3 +92,73 @@ TEST_CASE("Craters: sizes that do not match are refused", "[craters]") {
     CHECK_THROWS_AS(segment::find_craters(result.input.mesh, *result.dem(), labels, result.regions),
                     Error);
 }
+
+namespace {
+
+// The craters of `result` after its labels were changed: the region graph made again.
+segment::CraterTable craters_of(const pipeline::SegmentResult& result,
+                                const std::vector<std::uint32_t>& labels, std::uint32_t count) {
+    const auto graph =
+        segment::region_graph(result.input.mesh, result.field, labels, count, result.dem());
+    return segment::find_craters(result.input.mesh, *result.dem(), labels, graph);
+}
+
+}  // namespace
+
+TEST_CASE("Craters: a floor cut in two by the segmentation is one crater", "[craters]") {
+    const double cx = 80.3, cy = 79.6, R = 30, depth = 6, rim = 1.2;
+    auto result = segment_dem(bowl_dem(160, cx, cy, R, depth, rim));
+    REQUIRE(result.craters);
+    REQUIRE(!result.craters->craters.empty());
+    const auto floor =
+        std::max_element(result.craters->craters.begin(), result.craters->craters.end(),
+                         [](const auto& a, const auto& b) { return a.confidence < b.confidence; })
+            ->floor_region;
+    // The floor's east half becomes a region of its own.
+    auto labels = result.segmentation.labels;
+    const auto count = std::uint32_t(result.regions.regions.size()) + 1;
+    const auto width = std::size_t(result.dem()->width);
+    std::size_t east = 0;
+    for (std::size_t v = 0; v < labels.size(); ++v) {
+        const auto pixel = std::size_t(result.input.mesh.vertex_pixel[v]);
+        if (labels[v] == floor && double(pixel % width) + 0.5 > cx) {
+            labels[v] = count;
+            ++east;
+        }
+    }
+    REQUIRE(east > 100);
+    const auto table = craters_of(result, labels, count);
+    INFO(table.craters.size() << " craters");
+    const auto near = std::count_if(table.craters.begin(), table.craters.end(), [&](const auto& k) {
+        return std::hypot(k.col - cx, k.row - cy) < 0.25 * R &&
+               k.diameter_m == Approx(2 * R).epsilon(0.1);
+    });
+    CHECK(near == 1);
+}
+
+TEST_CASE("Craters: two floors side by side stay two craters", "[craters]") {
+    // Two bowls whose rims touch: their floors are adjacent concave regions of equal areas;
+    // each is a crater of its own and none spans both.
+    const double R = 20, depth = 4, rim = 0.8;
+    const double ax = 60.3, bx = 100.7, y = 60.2;
+    const auto dem = test::grid_dem(160, 120, [=](int c, int r) {
+        double z = 0;
+        for (const double cx : {ax, bx}) {
+            const double d = std::hypot(c + 0.5 - cx, r + 0.5 - y);
+            const double w = (d - R) / (0.3 * R);
+            z += (d < R ? depth * ((d / R) * (d / R) - 1) : 0.0) + rim * std::exp(-w * w);
+        }
+        return z;
+    });
+    auto result = segment_dem(dem);
+    REQUIRE(result.craters);
+    const auto& table = result.craters->craters;
+    INFO(table.size() << " craters");
+    for (const double cx : {ax, bx})
+        CHECK(std::count_if(table.begin(), table.end(), [&](const auto& k) {
+                  return std::hypot(k.col - cx, k.row - y) < 0.25 * R &&
+                         k.diameter_m == Approx(2 * R).epsilon(0.1);
+              }) == 1);
+    // No crater spans both.
+    for (const auto& k : table) CHECK(k.diameter_m < 3 * R);
+}

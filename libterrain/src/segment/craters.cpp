@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <numbers>
 
@@ -20,6 +21,9 @@ namespace {
 
 using V3 = std::array<double, 3>;
 constexpr int kSectors = 36;
+// Two adjacent concave regions are also tried as one floor when the smaller has at least
+// this share of the larger's area.
+constexpr double kPairAreaRatio = 0.25;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
 V3 sub(const V3& a, const V3& b) {
@@ -105,11 +109,12 @@ bool fit_circle(const std::array<double, kSectors>& px, const std::array<double,
 
 // A possible floor and what the passes gather for it.
 struct Floor {
-    std::uint32_t region = 0;
+    std::array<std::uint32_t, 2> members{};  // its regions: one, or two adjacent (0: none)
+    double area = 0, perimeter = 0;
     V3 sum{};
     std::size_t count = 0;
     V3 centre{}, e1{}, e2{};
-    double radius = 0;  // of a disk of the region's area
+    double radius = 0;  // of a disk of the floor's area
     double lowest = kInf;
     int first_col = -1;      // columns unwrapped around this one on a closed grid
     LeastSquares3 col, row;  // pixel column and row from the frame's x, y (affine)
@@ -120,20 +125,24 @@ struct Floor {
     double crest = 0;
 };
 
-}  // namespace
+// The possible floors of a segmentation and which floors each region is in or rims.
+struct Floors {
+    std::vector<Floor> floors;
+    std::vector<std::vector<std::int32_t>> in;   // by region: the floors it is part of
+    std::vector<std::vector<std::int32_t>> rim;  // by convex region: the floors it borders
+};
 
-CraterTable find_craters(const TriangleMesh& mesh, const Dem& dem,
-                         const std::vector<std::uint32_t>& labels, const RegionGraph& graph,
-                         const CraterOptions& options) {
-    const std::size_t n = mesh.vertex_count();
-    if (labels.size() != n || mesh.vertex_pixel.size() != n ||
-        mesh.pixel_vertex.size() != std::size_t(dem.width) * std::size_t(dem.height))
-        throw Error("craters", "the labels, the mesh and the DEM do not match");
+// The floors: each concave region with enough convex boundary, and each pair of adjacent
+// concave regions of comparable areas (a floor cut in two by the segmentation) that is
+// rounder than one of the two, with enough convex boundary around the two.
+Floors select_floors(const RegionGraph& graph, const CraterOptions& options) {
     const auto& regions = graph.regions;
     const std::size_t m = regions.size();
-    const double crest_from = options.crest_from, crest_to = options.crest_to;
     const auto mean = [&](std::uint32_t id) { return regions[id - 1].field_mean; };
     const auto convex = [&](std::uint32_t id) { return mean(id) > options.convex_above; };
+    const auto concave = [&](std::uint32_t id) {
+        return mean(id) < options.concave_below && regions[id - 1].vertex_count >= 3;
+    };
     // Perimeters and the length shared with convex neighbours.
     std::vector<double> perimeter(m + 1, 0), rim(m + 1, 0);
     for (const auto& e : graph.edges) {
@@ -142,40 +151,76 @@ CraterTable find_craters(const TriangleMesh& mesh, const Dem& dem,
         if (convex(e.b)) rim[e.a] += e.boundary_length_m;
         if (convex(e.a)) rim[e.b] += e.boundary_length_m;
     }
-    std::vector<Floor> floors;
-    std::vector<std::int32_t> floor_of(m + 1, -1);
-    for (const auto& r : regions) {
-        if (!(r.field_mean < options.concave_below) || r.vertex_count < 3 ||
-            !(perimeter[r.id] > 0) || rim[r.id] < 0.5 * options.min_rim_fraction * perimeter[r.id])
-            continue;
-        floor_of[r.id] = std::int32_t(floors.size());
-        floors.push_back({});
-        floors.back().region = r.id;
-        floors.back().radius = std::sqrt(r.area_m2 / std::numbers::pi);
-    }
-    // The convex neighbours of each floor, as lists by convex region.
-    std::vector<std::vector<std::int32_t>> rim_of(m + 1);
-    for (const auto& e : graph.edges) {
-        if (floor_of[e.a] >= 0 && convex(e.b)) rim_of[e.b].push_back(floor_of[e.a]);
-        if (floor_of[e.b] >= 0 && convex(e.a)) rim_of[e.a].push_back(floor_of[e.b]);
-    }
-    const auto height = [&](std::size_t v) {
-        const auto p = std::size_t(mesh.vertex_pixel[v]);
-        return dem.height_at(int(p % std::size_t(dem.width)), int(p / std::size_t(dem.width)));
+    Floors out;
+    out.in.resize(m + 1);
+    out.rim.resize(m + 1);
+    const auto add = [&](std::uint32_t a, std::uint32_t b, double area, double length,
+                         double rim_length) {
+        if (!(length > 0) || rim_length < 0.5 * options.min_rim_fraction * length) return;
+        const auto f = std::int32_t(out.floors.size());
+        Floor fl;
+        fl.members = {a, b};
+        fl.area = area;
+        fl.perimeter = length;
+        fl.radius = std::sqrt(area / std::numbers::pi);
+        out.floors.push_back(fl);
+        out.in[a].push_back(f);
+        if (b != 0) out.in[b].push_back(f);
     };
-    // Pass 1: the floors' centroids, lowest heights and a column of each.
-    for (std::size_t v = 0; v < n; ++v) {
-        const auto f = labels[v] <= m ? floor_of[labels[v]] : -1;
-        if (f < 0) continue;
-        auto& fl = floors[std::size_t(f)];
-        const auto p = mesh.position(v);
-        for (int k = 0; k < 3; ++k) fl.sum[std::size_t(k)] += p[std::size_t(k)];
-        ++fl.count;
-        fl.lowest = std::min(fl.lowest, height(v));
-        if (fl.first_col < 0)
-            fl.first_col = int(std::size_t(mesh.vertex_pixel[v]) % std::size_t(dem.width));
+    for (const auto& r : regions)
+        if (concave(r.id)) add(r.id, 0, r.area_m2, perimeter[r.id], rim[r.id]);
+    for (const auto& e : graph.edges) {
+        if (!concave(e.a) || !concave(e.b)) continue;
+        const double aa = regions[e.a - 1].area_m2, ab = regions[e.b - 1].area_m2;
+        if (std::min(aa, ab) < kPairAreaRatio * std::max(aa, ab)) continue;
+        // Two floors side by side are less round together than either alone; a floor cut in
+        // two is rounder whole than at least one of its pieces.
+        const double length = perimeter[e.a] + perimeter[e.b] - 2 * e.boundary_length_m;
+        const auto roundness = [](double area, double length_m) {
+            return length_m > 0 ? area / (length_m * length_m) : 0.0;
+        };
+        if (roundness(aa + ab, length) <=
+            std::min(roundness(aa, perimeter[e.a]), roundness(ab, perimeter[e.b])))
+            continue;
+        // The larger region first (the crater's floor_region).
+        const bool a_first = aa > ab || (aa == ab && e.a < e.b);
+        add(a_first ? e.a : e.b, a_first ? e.b : e.a, aa + ab, length, rim[e.a] + rim[e.b]);
     }
-    for (auto& fl : floors) {
+    // The convex neighbours of each floor.
+    for (const auto& e : graph.edges)
+        for (const auto& [inner, outer] : {std::pair{e.a, e.b}, std::pair{e.b, e.a}}) {
+            if (!convex(outer)) continue;
+            for (const auto f : out.in[inner]) {
+                auto& list = out.rim[outer];
+                if (std::find(list.begin(), list.end(), f) == list.end()) list.push_back(f);
+            }
+        }
+    return out;
+}
+
+// The height of the DEM at a vertex's pixel.
+double vertex_height(const TriangleMesh& mesh, const Dem& dem, std::size_t v) {
+    const auto p = std::size_t(mesh.vertex_pixel[v]);
+    return dem.height_at(int(p % std::size_t(dem.width)), int(p / std::size_t(dem.width)));
+}
+
+// Pass 1: the floors' centroids, lowest heights and a column of each; then their frames.
+void find_centres(const TriangleMesh& mesh, const Dem& dem,
+                  const std::vector<std::uint32_t>& labels, Floors& floors) {
+    const std::size_t m = floors.in.size() - 1;
+    for (std::size_t v = 0; v < mesh.vertex_count(); ++v) {
+        if (labels[v] == 0 || labels[v] > m) continue;
+        for (const auto f : floors.in[labels[v]]) {
+            auto& fl = floors.floors[std::size_t(f)];
+            const auto p = mesh.position(v);
+            for (int k = 0; k < 3; ++k) fl.sum[std::size_t(k)] += p[std::size_t(k)];
+            ++fl.count;
+            fl.lowest = std::min(fl.lowest, vertex_height(mesh, dem, v));
+            if (fl.first_col < 0)
+                fl.first_col = int(std::size_t(mesh.vertex_pixel[v]) % std::size_t(dem.width));
+        }
+    }
+    for (auto& fl : floors.floors) {
         const double c = double(std::max<std::size_t>(fl.count, 1));
         fl.centre = {fl.sum[0] / c, fl.sum[1] / c, fl.sum[2] / c};
         const V3 up = mesh.frame == MeshFrame::body ? unit(fl.centre) : V3{0, 0, 1};
@@ -184,7 +229,12 @@ CraterTable find_craters(const TriangleMesh& mesh, const Dem& dem,
         fl.e2 = cross(up, fl.e1);
         fl.h.fill(-kInf);
     }
-    // Pass 2: the affine maps to pixels over each floor; the highest rim vertex by direction.
+}
+
+// Pass 2: the affine maps to pixels over each floor; the highest rim vertex by direction.
+void find_crests(const TriangleMesh& mesh, const Dem& dem, const std::vector<std::uint32_t>& labels,
+                 const CraterOptions& options, Floors& floors) {
+    const std::size_t m = floors.in.size() - 1;
     const double width = dem.width;
     const auto unwrapped = [&](const Floor& fl, double col) {
         if (!mesh.seam_closed) return col;
@@ -192,27 +242,28 @@ CraterTable find_craters(const TriangleMesh& mesh, const Dem& dem,
         if (fl.first_col - col > width / 2) return col + width;
         return col;
     };
-    for (std::size_t v = 0; v < n; ++v) {
+    for (std::size_t v = 0; v < mesh.vertex_count(); ++v) {
         const auto label = labels[v];
         if (label == 0 || label > m) continue;
-        const auto f = floor_of[label];
-        if (f < 0 && rim_of[label].empty()) continue;
+        const auto& in = floors.in[label];
+        const auto& rim = floors.rim[label];
+        if (in.empty() && rim.empty()) continue;
         const auto p = mesh.position(v);
-        if (f >= 0) {
-            auto& fl = floors[std::size_t(f)];
+        const auto pixel = std::size_t(mesh.vertex_pixel[v]);
+        for (const auto f : in) {
+            auto& fl = floors.floors[std::size_t(f)];
             const V3 d = sub(p, fl.centre);
             const double x = dot(d, fl.e1), y = dot(d, fl.e2);
-            const auto pixel = std::size_t(mesh.vertex_pixel[v]);
             fl.col.add({1, x, y}, unwrapped(fl, double(pixel % std::size_t(dem.width)) + 0.5));
             fl.row.add({1, x, y}, double(pixel / std::size_t(dem.width)) + 0.5);
-            continue;
         }
-        const double h = height(v);
-        for (const auto fi : rim_of[label]) {
-            auto& fl = floors[std::size_t(fi)];
+        if (rim.empty()) continue;
+        const double h = vertex_height(mesh, dem, v);
+        for (const auto f : rim) {
+            auto& fl = floors.floors[std::size_t(f)];
             const V3 d = sub(p, fl.centre);
             const double x = dot(d, fl.e1), y = dot(d, fl.e2), r = std::hypot(x, y);
-            if (r < crest_from * fl.radius || r > crest_to * fl.radius) continue;
+            if (r < options.crest_from * fl.radius || r > options.crest_to * fl.radius) continue;
             const double turn = (std::atan2(y, x) + std::numbers::pi) / (2 * std::numbers::pi);
             const auto s = std::size_t(std::min(kSectors - 1, int(turn * kSectors)));
             if (h > fl.h[s]) {
@@ -223,7 +274,12 @@ CraterTable find_craters(const TriangleMesh& mesh, const Dem& dem,
             }
         }
     }
-    // The circles.
+}
+
+// The rim circles: fitted twice, the second time without the points a quarter radius off.
+// The floors whose circle holds (enough directions, a radius the floor allows, a positive
+// depth), in floor order.
+std::vector<std::size_t> fit_rims(const CraterOptions& options, std::vector<Floor>& floors) {
     std::vector<std::size_t> found;
     for (std::size_t f = 0; f < floors.size(); ++f) {
         auto& fl = floors[f];
@@ -242,93 +298,100 @@ CraterTable find_craters(const TriangleMesh& mesh, const Dem& dem,
             if (fl.kept[std::size_t(s)]) crest += fl.h[std::size_t(s)];
         fl.crest = crest / c.points;
         const double fraction = double(c.points) / kSectors;
-        if (fraction < options.min_rim_fraction || c.r < 0.8 * crest_from * fl.radius ||
-            c.r > crest_to * fl.radius || !(fl.crest > fl.lowest))
+        if (fraction < options.min_rim_fraction || c.r < 0.8 * options.crest_from * fl.radius ||
+            c.r > options.crest_to * fl.radius || !(fl.crest > fl.lowest))
             continue;
         found.push_back(f);
     }
-    // The table, with the ring of surroundings from the grid around each centre.
-    CraterTable table;
-    std::vector<double> cx, cy;
-    for (const auto f : found) {
-        const auto& fl = floors[f];
-        const auto& c = fl.circle;
-        const double quality = std::max(0.0, 1 - 4 * c.rms / c.r);
-        Crater k;
-        k.floor_region = fl.region;
-        k.diameter_m = 2 * c.r;
-        k.depth_m = fl.crest - fl.lowest;
-        k.rim_fraction = double(c.points) / kSectors;
-        k.fit_rms_m = c.rms;
-        const auto& region = regions[fl.region - 1];
-        k.field_scale_m = region.field_scale_m;
-        k.circularity = std::min(1.0, 4 * std::numbers::pi * region.area_m2 /
-                                          (perimeter[fl.region] * perimeter[fl.region]));
-        const double roundness =
-            options.round_floor > 0 ? std::min(1.0, k.circularity / options.round_floor) : 1.0;
-        k.confidence = k.rim_fraction * quality * roundness;
-        if (k.confidence < options.min_confidence) continue;
-        for (int s = 0; s < kSectors; ++s)
-            if (fl.kept[std::size_t(s)]) k.rim_regions.push_back(fl.from[std::size_t(s)]);
-        std::sort(k.rim_regions.begin(), k.rim_regions.end());
-        k.rim_regions.erase(std::unique(k.rim_regions.begin(), k.rim_regions.end()),
-                            k.rim_regions.end());
-        V3 ac, ar;
-        if (!fl.col.solve(ac) || !fl.row.solve(ar)) continue;
-        const auto to_pixel = [&](double x, double y) {
-            return std::array<double, 2>{ac[0] + ac[1] * x + ac[2] * y,
-                                         ar[0] + ar[1] * x + ar[2] * y};
-        };
-        const auto centre = to_pixel(c.x, c.y);
-        k.col = centre[0];
-        k.row = centre[1];
-        for (int i = 0; i <= kRimPoints; ++i) {
-            const double t = 2 * std::numbers::pi * (i % kRimPoints) / kRimPoints;
-            const auto q = to_pixel(c.x + c.r * std::cos(t), c.y + c.r * std::sin(t));
-            k.rim.push_back(dem.map_xy(q[0], q[1]));
+    return found;
+}
+
+// The mean height of the surroundings of a crater: the pixels 1.5 to 2 radii from its centre
+// (NaN when there are none).
+double surroundings_height(const TriangleMesh& mesh, const Dem& dem, const Floor& fl,
+                           const std::function<std::array<double, 2>(double, double)>& to_pixel) {
+    const auto& c = fl.circle;
+    double lo_c = kInf, hi_c = -kInf, lo_r = kInf, hi_r = -kInf;
+    for (const double sx : {-2.0, 2.0})
+        for (const double sy : {-2.0, 2.0}) {
+            const auto q = to_pixel(c.x + sx * c.r, c.y + sy * c.r);
+            lo_c = std::min(lo_c, q[0]);
+            hi_c = std::max(hi_c, q[0]);
+            lo_r = std::min(lo_r, q[1]);
+            hi_r = std::max(hi_r, q[1]);
         }
-        // The surroundings: pixels 1.5 to 2 radii from the centre.
-        double lo_c = kInf, hi_c = -kInf, lo_r = kInf, hi_r = -kInf;
-        for (const double sx : {-2.0, 2.0})
-            for (const double sy : {-2.0, 2.0}) {
-                const auto q = to_pixel(c.x + sx * c.r, c.y + sy * c.r);
-                lo_c = std::min(lo_c, q[0]);
-                hi_c = std::max(hi_c, q[0]);
-                lo_r = std::min(lo_r, q[1]);
-                hi_r = std::max(hi_r, q[1]);
-            }
-        double ring = 0;
-        std::size_t ring_n = 0;
-        const int r0 = std::max(0, int(std::floor(lo_r))),
-                  r1 = std::min(dem.height - 1, int(std::ceil(hi_r)));
-        const int c0 = std::max(0, int(std::floor(lo_c))),
-                  c1 = std::min(dem.width - 1, int(std::ceil(hi_c)));
-        for (int row = r0; row <= r1; ++row)
-            for (int col = c0; col <= c1; ++col) {
-                const auto v =
-                    mesh.pixel_vertex[std::size_t(row) * std::size_t(dem.width) + std::size_t(col)];
-                if (v < 0) continue;
-                const V3 d = sub(mesh.position(std::size_t(v)), fl.centre);
-                const double r = std::hypot(dot(d, fl.e1) - c.x, dot(d, fl.e2) - c.y);
-                if (r < 1.5 * c.r || r > 2 * c.r) continue;
-                ring += dem.height_at(col, row);
-                ++ring_n;
-            }
-        k.rim_height_m = ring_n > 0 ? fl.crest - ring / double(ring_n)
-                                    : std::numeric_limits<double>::quiet_NaN();
-        const auto xy = dem.map_xy(centre[0], centre[1]);
-        cx.push_back(xy[0]);
-        cy.push_back(xy[1]);
-        table.craters.push_back(std::move(k));
+    double ring = 0;
+    std::size_t ring_n = 0;
+    const int r0 = std::max(0, int(std::floor(lo_r))),
+              r1 = std::min(dem.height - 1, int(std::ceil(hi_r)));
+    const int c0 = std::max(0, int(std::floor(lo_c))),
+              c1 = std::min(dem.width - 1, int(std::ceil(hi_c)));
+    for (int row = r0; row <= r1; ++row)
+        for (int col = c0; col <= c1; ++col) {
+            const auto v =
+                mesh.pixel_vertex[std::size_t(row) * std::size_t(dem.width) + std::size_t(col)];
+            if (v < 0) continue;
+            const V3 d = sub(mesh.position(std::size_t(v)), fl.centre);
+            const double r = std::hypot(dot(d, fl.e1) - c.x, dot(d, fl.e2) - c.y);
+            if (r < 1.5 * c.r || r > 2 * c.r) continue;
+            ring += dem.height_at(col, row);
+            ++ring_n;
+        }
+    return ring_n > 0 ? ring / double(ring_n) : std::numeric_limits<double>::quiet_NaN();
+}
+
+// A crater of a floor whose rim circle holds; false when its confidence is too low or its
+// frame has no map to the grid. `xy`: its centre in the DEM's map coordinates.
+bool make_crater(const TriangleMesh& mesh, const Dem& dem, const RegionGraph& graph,
+                 const CraterOptions& options, const Floor& fl, Crater& k,
+                 std::array<double, 2>& xy) {
+    const auto& c = fl.circle;
+    const double quality = std::max(0.0, 1 - 4 * c.rms / c.r);
+    k.floor_region = fl.members[0];
+    k.diameter_m = 2 * c.r;
+    k.depth_m = fl.crest - fl.lowest;
+    k.rim_fraction = double(c.points) / kSectors;
+    k.fit_rms_m = c.rms;
+    k.field_scale_m = graph.regions[fl.members[0] - 1].field_scale_m;
+    k.circularity = std::min(1.0, 4 * std::numbers::pi * fl.area / (fl.perimeter * fl.perimeter));
+    const double roundness =
+        options.round_floor > 0 ? std::min(1.0, k.circularity / options.round_floor) : 1.0;
+    k.confidence = k.rim_fraction * quality * roundness;
+    if (k.confidence < options.min_confidence) return false;
+    for (int s = 0; s < kSectors; ++s)
+        if (fl.kept[std::size_t(s)]) k.rim_regions.push_back(fl.from[std::size_t(s)]);
+    std::sort(k.rim_regions.begin(), k.rim_regions.end());
+    k.rim_regions.erase(std::unique(k.rim_regions.begin(), k.rim_regions.end()),
+                        k.rim_regions.end());
+    V3 ac, ar;
+    if (!fl.col.solve(ac) || !fl.row.solve(ar)) return false;
+    const auto to_pixel = [&](double x, double y) {
+        return std::array<double, 2>{ac[0] + ac[1] * x + ac[2] * y, ar[0] + ar[1] * x + ar[2] * y};
+    };
+    const auto centre = to_pixel(c.x, c.y);
+    k.col = centre[0];
+    k.row = centre[1];
+    for (int i = 0; i <= kRimPoints; ++i) {
+        const double t = 2 * std::numbers::pi * (i % kRimPoints) / kRimPoints;
+        const auto q = to_pixel(c.x + c.r * std::cos(t), c.y + c.r * std::sin(t));
+        k.rim.push_back(dem.map_xy(q[0], q[1]));
     }
-    // Of two craters at one place and size, the more confident (ties: the lower floor id).
+    k.rim_height_m = fl.crest - surroundings_height(mesh, dem, fl, to_pixel);
+    xy = dem.map_xy(centre[0], centre[1]);
+    return true;
+}
+
+// Of two craters at one place and size, the more confident (ties: the lower floor region,
+// then the floor made of fewer regions, then the lower floor index); the others are marked.
+std::vector<std::uint8_t> duplicates(const CraterTable& table, const std::vector<Floor>& floors,
+                                     const std::vector<std::size_t>& floor_of) {
     std::vector<V3> at;
     std::vector<double> radius;
-    for (const auto& k : table.craters) {
-        const auto& fl = floors[std::size_t(floor_of[k.floor_region])];
+    for (std::size_t i = 0; i < table.craters.size(); ++i) {
+        const auto& fl = floors[floor_of[i]];
         const auto& c = fl.circle;
         V3 p = fl.centre;
-        for (std::size_t i = 0; i < 3; ++i) p[i] += c.x * fl.e1[i] + c.y * fl.e2[i];
+        for (std::size_t j = 0; j < 3; ++j) p[j] += c.x * fl.e1[j] + c.y * fl.e2[j];
         at.push_back(p);
         radius.push_back(c.r);
     }
@@ -340,8 +403,9 @@ CraterTable find_craters(const TriangleMesh& mesh, const Dem& dem,
     std::vector<std::uint8_t> gone(at.size(), 0);
     const auto better = [&](std::size_t a, std::size_t b) {
         const auto &ka = table.craters[a], &kb = table.craters[b];
-        return ka.confidence > kb.confidence ||
-               (ka.confidence == kb.confidence && ka.floor_region < kb.floor_region);
+        if (ka.confidence != kb.confidence) return ka.confidence > kb.confidence;
+        if (ka.floor_region != kb.floor_region) return ka.floor_region < kb.floor_region;
+        return floor_of[a] < floor_of[b];
     };
     for (std::size_t i = 0; i < by_x.size(); ++i)
         for (std::size_t j = i + 1; j < by_x.size(); ++j) {
@@ -355,37 +419,78 @@ CraterTable find_craters(const TriangleMesh& mesh, const Dem& dem,
                 continue;
             gone[better(a, b) ? b : a] = 1;
         }
-    std::size_t kept = 0;
-    for (std::size_t i = 0; i < table.craters.size(); ++i) {
-        if (gone[i]) continue;
-        if (kept != i) table.craters[kept] = std::move(table.craters[i]);
-        cx[kept] = cx[i];
-        cy[kept] = cy[i];
-        ++kept;
-    }
-    table.craters.resize(kept);
-    cx.resize(kept);
-    cy.resize(kept);
+    return gone;
+}
+
+// The centres and rims in lon/lat where the DEM has a frame for them.
+void to_lonlat(const Dem& dem, CraterTable& table, std::vector<double>& cx,
+               std::vector<double>& cy) {
     table.lonlat = false;
-    if (!dem.crs_wkt.empty() && dem.georef_current() && dem.georef.output_lonlat) {
-        const LonLatMapping& frame = *dem.georef.output_lonlat;
-        if (!frame.to_lonlat(cx.size(), cx.data(), cy.data()))
-            throw Error("craters", "a crater's centre has no longitude/latitude on the body");
-        for (std::size_t i = 0; i < table.craters.size(); ++i) {
-            auto& ring = table.craters[i].rim;
-            std::vector<double> x, y;
-            for (const auto& p : ring) {
-                x.push_back(p[0]);
-                y.push_back(p[1]);
-            }
-            if (!frame.to_lonlat(x.size(), x.data(), y.data()))
-                throw Error("craters", "a crater's rim has no longitude/latitude on the body");
-            for (std::size_t j = 0; j < ring.size(); ++j)
-                ring[j] = {x[j] + 360 * std::round((cx[i] - x[j]) / 360), y[j]};
+    if (dem.crs_wkt.empty() || !dem.georef_current() || !dem.georef.output_lonlat) return;
+    const LonLatMapping& frame = *dem.georef.output_lonlat;
+    if (!frame.to_lonlat(cx.size(), cx.data(), cy.data()))
+        throw Error("craters", "a crater's centre has no longitude/latitude on the body");
+    for (std::size_t i = 0; i < table.craters.size(); ++i) {
+        auto& ring = table.craters[i].rim;
+        std::vector<double> x, y;
+        for (const auto& p : ring) {
+            x.push_back(p[0]);
+            y.push_back(p[1]);
         }
-        table.lonlat = true;
-        table.lonlat_crs_wkt = frame.lonlat_crs_wkt();
+        if (!frame.to_lonlat(x.size(), x.data(), y.data()))
+            throw Error("craters", "a crater's rim has no longitude/latitude on the body");
+        for (std::size_t j = 0; j < ring.size(); ++j)
+            ring[j] = {x[j] + 360 * std::round((cx[i] - x[j]) / 360), y[j]};
     }
+    table.lonlat = true;
+    table.lonlat_crs_wkt = frame.lonlat_crs_wkt();
+}
+
+}  // namespace
+
+CraterTable find_craters(const TriangleMesh& mesh, const Dem& dem,
+                         const std::vector<std::uint32_t>& labels, const RegionGraph& graph,
+                         const CraterOptions& options) {
+    const std::size_t n = mesh.vertex_count();
+    if (labels.size() != n || mesh.vertex_pixel.size() != n ||
+        mesh.pixel_vertex.size() != std::size_t(dem.width) * std::size_t(dem.height))
+        throw Error("craters", "the labels, the mesh and the DEM do not match");
+    auto floors = select_floors(graph, options);
+    find_centres(mesh, dem, labels, floors);
+    find_crests(mesh, dem, labels, options, floors);
+    const auto found = fit_rims(options, floors.floors);
+    CraterTable table;
+    std::vector<double> cx, cy;
+    std::vector<std::size_t> floor_of;  // by crater
+    for (const auto f : found) {
+        Crater k;
+        std::array<double, 2> xy{};
+        if (!make_crater(mesh, dem, graph, options, floors.floors[f], k, xy)) continue;
+        table.craters.push_back(std::move(k));
+        cx.push_back(xy[0]);
+        cy.push_back(xy[1]);
+        floor_of.push_back(f);
+    }
+    const auto gone = duplicates(table, floors.floors, floor_of);
+    // The craters kept, by floor region (then by floor: a region alone before its pairs).
+    std::vector<std::size_t> order;
+    for (std::size_t i = 0; i < table.craters.size(); ++i)
+        if (!gone[i]) order.push_back(i);
+    std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+        const auto ra = table.craters[a].floor_region, rb = table.craters[b].floor_region;
+        return ra < rb || (ra == rb && floor_of[a] < floor_of[b]);
+    });
+    CraterTable sorted;
+    std::vector<double> sx, sy;
+    for (const auto i : order) {
+        sorted.craters.push_back(std::move(table.craters[i]));
+        sx.push_back(cx[i]);
+        sy.push_back(cy[i]);
+    }
+    table = std::move(sorted);
+    cx = std::move(sx);
+    cy = std::move(sy);
+    to_lonlat(dem, table, cx, cy);
     for (std::size_t i = 0; i < table.craters.size(); ++i) {
         table.craters[i].id = std::uint32_t(i + 1);
         table.craters[i].lon = cx[i];
