@@ -97,23 +97,32 @@ std::vector<double> default_radii(const TriangleMesh& mesh) {
     return radii;
 }
 
-ScaleSelectedField scale_selected_shape_index(const TriangleMesh& mesh,
-                                              const ShapeIndexOptions& options,
-                                              const ProgressFn& progress) {
-    ScaleSelectedField out;
-    out.radii = options.radii.empty() ? default_radii(mesh) : options.radii;
+namespace {
+
+// The ladder of a scale-selected field (options.radii, or the mesh's default_radii), checked
+// with the options that choose along it.
+std::vector<double> checked_ladder(const TriangleMesh& mesh, const ShapeIndexOptions& options) {
+    auto radii = options.radii.empty() ? default_radii(mesh) : options.radii;
     check_dem_mesh(mesh);
-    if (out.radii.empty() || out.radii.size() > kMaxRadii)
+    if (radii.empty() || radii.size() > kMaxRadii)
         throw Error("field", "--radii takes 1 to " + std::to_string(kMaxRadii) + " radii");
-    for (std::size_t i = 0; i < out.radii.size(); ++i)
-        if (!(out.radii[i] > 0) || !std::isfinite(out.radii[i]) ||
-            (i > 0 && !(out.radii[i] > out.radii[i - 1])))
+    for (std::size_t i = 0; i < radii.size(); ++i)
+        if (!(radii[i] > 0) || !std::isfinite(radii[i]) || (i > 0 && !(radii[i] > radii[i - 1])))
             throw Error("field", "--radii must be positive metres in increasing order");
     if (!(options.contrast_curvedness >= 0) || !std::isfinite(options.contrast_curvedness))
         throw Error("field", "the contrast curvedness must be a number >= 0");
     if (!(options.peak_dominance >= 1) || !std::isfinite(options.peak_dominance))
         throw Error("field", "the peak dominance must be a number >= 1");
+    return radii;
+}
 
+}  // namespace
+
+ScaleSelectedField scale_selected_shape_index(const TriangleMesh& mesh,
+                                              const ShapeIndexOptions& options,
+                                              const ProgressFn& progress) {
+    ScaleSelectedField out;
+    out.radii = checked_ladder(mesh, options);
     const std::size_t n = mesh.vertex_count();
     const double tau2 = options.contrast_curvedness * options.contrast_curvedness;
     const double beta = options.peak_dominance;
