@@ -271,24 +271,83 @@ ScaleResult segment_scale(const Input& input, const std::vector<float>& field,
                       scaled_progress(progress, 0.3, 1));
 }
 
-SegmentResult segment(Input input, const SegmentOptions& requested, const ProgressFn& progress) {
-    check_options(requested);
-    const SegmentOptions options = resolve_options(requested, input.dem.has_value());
-    // A polygon format that cannot hold the DEM's coordinates is refused before any work.
-    if (input.dem) io::check_polygon_format(*input.dem, options.format);
-    SegmentResult result;
-    result.input = std::move(input);
-    result.timings.push_back({"read", result.input.read_seconds});
-    if (result.input.dem) result.timings.push_back({"mesh", result.input.mesh_seconds});
-    // Slices of the progress by the stages' measured cost on global grids of 1 to 66 M
-    // pixels (docs/performance.md): field 0.2, Reeb graph 0.2, simplification 0.2, growing
-    // and dividing 0.3, region graph 0.1.
+namespace {
+
+// One run of pipeline::segment: the result as it is made, and the arrays that wait unread
+// through the stages that do not read them: the DEM's values (as floats when they all are
+// floats), then the field and the mesh's pixel maps, parked on disk (parked_arrays.hpp;
+// docs/performance.md, "Arrays parked on disk") when large. The DEM waits from before the
+// field (only the height field reads it) to the placing of the positions, and again through
+// the growing. Whether to park at all is decided the first time, on what all the arrays
+// parked through the run hold (the field is a float a vertex).
+class SegmentRun {
+  public:
+    SegmentRun(SegmentResult& result, const SegmentOptions& options, const ProgressFn& progress)
+        : result_(result),
+          options_(options),
+          progress_(progress),
+          mesh_(result.input.mesh),
+          parked_(options.park_directory, options.park_min_bytes) {}
+
+    // The field, the DEM held from before it unless it reads it; progress 0 to 0.2. Returns
+    // whether the Reeb graph is known to be a tree.
+    bool field();
+    // The Reeb graph, the arrays it does not read waiting; progress 0.2 to 0.4.
+    reeb::ReebGraph reeb(bool tree);
+    // The simplification, the arrays it does not read waiting; progress 0.41 to 0.6.
+    reeb::SimplifyResult simplify(reeb::ReebGraph graph, const reeb::SimplifyOptions& thresholds);
+    // The arrays back, the positions placed again, the DEM waiting again; progress 0.6 to
+    // 0.62. Returns its time.
+    double restore_for_growing();
+    // The region graph, its scales and area ranges, the craters; progress 0.905 to 1. Returns
+    // its time.
+    double regions(const std::vector<double>& ranges);
+
+    internal::ParkedArrays& parked() { return parked_; }
+
+  private:
+    void hold_dem(const ProgressFn& held);
+    void restore_dem(const ProgressFn& back);
+
+    SegmentResult& result_;
+    const SegmentOptions& options_;
+    const ProgressFn& progress_;
+    TriangleMesh& mesh_;
+    PackedHeights packed_;
+    internal::ParkedArrays parked_;
+    bool placed_again_ = false;  // the positions freed through the Reeb graph
+};
+
+void SegmentRun::hold_dem(const ProgressFn& held) {
+    Dem& dem = *result_.input.dem;
+    packed_.pack(dem, scaled_progress(held, 0, 0.5));
+    if (!parked_.decided())
+        parked_.decide(packed_.bytes(dem) +
+                       sizeof(float) * (mesh_.vertex_count() + mesh_.vertex_areas.size()) +
+                       sizeof(std::int32_t) *
+                           (mesh_.pixel_vertex.size() + mesh_.vertex_pixel.size()) +
+                       mesh_.neighbor_directions.size());
+    if (!packed_.park(parked_, scaled_progress(held, 0.5, 1)))
+        parked_.park(dem.values, held, 0.5, 1);
+}
+
+// The DEM back as doubles.
+void SegmentRun::restore_dem(const ProgressFn& back) {
+    parked_.restore(result_.input.dem->values, back, 0, 0.2);
+    packed_.restore(parked_, scaled_progress(back, 0, 0.2));
+    packed_.unpack(*result_.input.dem, scaled_progress(back, 0.2, 1));
+}
+
+bool SegmentRun::field() {
+    auto& result = result_;
+    auto& mesh = mesh_;
+    const auto& options = options_;
+    const auto& progress = progress_;
     // A DEM mesh whose Reeb graph is a tree (every component a disk or a sphere) frees its
     // triangles (24 bytes a pixel) before the field: no stage reads them at random, the
     // shape index's normals and the later stages walk them again from the grid in order.
     // The SDF casts rays through them: it keeps them. (The loop check is counted with the
     // field, which it precedes.)
-    auto& mesh = result.input.mesh;
     const auto tf = clock::now();
     const auto kind = field::parse_field_kind(options.field);
     const bool tree = kind != field::FieldKind::sdf &&
@@ -299,45 +358,32 @@ SegmentResult segment(Input input, const SegmentOptions& requested, const Progre
     else
         mesh.restore_triangles();  // (released by load_input: the Reeb graph reads them)
     result.add_time("field", since(tf));
-    // The DEM's values (as floats when they all are floats), then the field and the mesh's
-    // pixel maps, wait unread through the stages that do not read them: parked on disk
-    // (parked_arrays.hpp; docs/performance.md, "Arrays parked on disk") when large. The DEM
-    // waits from before the field (only the height field reads it) to the placing of the
-    // positions, and again through the growing.
-    // Whether to park at all is decided the first time, on what all the arrays parked through
-    // the run hold (the field is a float a vertex).
-    PackedHeights packed;
-    internal::ParkedArrays parked(options.park_directory, options.park_min_bytes);
-    const auto hold_dem = [&](const ProgressFn& held) {
-        Dem& dem = *result.input.dem;
-        packed.pack(dem, scaled_progress(held, 0, 0.5));
-        if (!parked.decided())
-            parked.decide(packed.bytes(dem) +
-                          sizeof(float) * (mesh.vertex_count() + mesh.vertex_areas.size()) +
-                          sizeof(std::int32_t) *
-                              (mesh.pixel_vertex.size() + mesh.vertex_pixel.size()) +
-                          mesh.neighbor_directions.size());
-        if (!packed.park(parked, scaled_progress(held, 0.5, 1)))
-            parked.park(dem.values, held, 0.5, 1);
-    };
     const bool field_reads_dem = kind == field::FieldKind::height;
     if (result.input.dem && !field_reads_dem) hold_dem(scaled_progress(progress, 0.02, 0.03));
-    result.parked_field = parked.parked_bytes();
+    result.parked_field = parked_.parked_bytes();
     compute_field(
         result, options,
         scaled_progress(progress, field_reads_dem ? 0.02 : 0.03, field_reads_dem ? 0.19 : 0.2));
     // A DEM mesh frees its positions (12 bytes a vertex) while the Reeb graph and the
     // simplification run, which do not read them, and places them again before the growing:
     // the same floats (docs/mesh.md, "Positions freed and placed again").
-    const bool placed_again = result.input.dem && mesh.release_positions();
+    placed_again_ = result.input.dem && mesh.release_positions();
     const auto tp = clock::now();
     if (result.input.dem) {
         if (field_reads_dem) hold_dem(scaled_progress(progress, 0.19, 0.2));
         // The vertices' areas wait through the Reeb graph, which does not read them (the
         // simplification does).
-        parked.park(mesh.vertex_areas, progress, 0.2, 0.21);
+        parked_.park(mesh.vertex_areas, progress, 0.2, 0.21);
     }
     result.add_time("reeb", since(tp));  // (which it precedes: the times stay in run order)
+    return tree;
+}
+
+reeb::ReebGraph SegmentRun::reeb(bool tree) {
+    auto& result = result_;
+    auto& mesh = mesh_;
+    auto& parked = parked_;
+    const auto& progress = progress_;
     // The field waits on disk too once the Reeb graph's events are ordered (the contour tree
     // does not read it): the Reeb graph's peak of memory is in the contour tree.
     // The graph's vertex lists, vertices' nodes and node values wait too through the contour
@@ -362,19 +408,15 @@ SegmentResult segment(Input input, const SegmentOptions& requested, const Progre
     const auto ta = clock::now();
     parked.restore(mesh.vertex_areas, progress, 0.4, 0.4);
     result.add_time("reeb", since(ta));
-    // One scale only: the simplification takes the graph and frees what it no longer needs,
-    // which lowers the peak memory.
-    const auto t0 = clock::now();
-    if (parked.on()) {
-        if (!result.field.empty()) parked.park(result.field, progress, 0.4, 0.403);
-        parked.park(mesh.pixel_vertex, progress, 0.403, 0.406);
-        parked.park(mesh.vertex_pixel, progress, 0.406, 0.409);
-        parked.park(mesh.neighbor_directions, progress, 0.409, 0.41);
-    }
-    result.parked_bytes = parked.parked_bytes();
-    const auto thresholds = simplify_options(options, result.input.mesh);
-    result.area_ratio_percent = thresholds.area_ratio;
-    result.min_area_m2 = min_area_m2(options, result.input.mesh);
+    return graph;
+}
+
+reeb::SimplifyResult SegmentRun::simplify(reeb::ReebGraph graph,
+                                          const reeb::SimplifyOptions& thresholds) {
+    auto& result = result_;
+    auto& mesh = mesh_;
+    auto& parked = parked_;
+    const auto& progress = progress_;
     // The areas wait on disk again once the simplification has read them, and the graph's
     // vertices' nodes until its output reads them (both before its peak of memory, the end
     // of its copy of the arcs). (Parked without progress: the simplification reports around
@@ -391,8 +433,14 @@ SegmentResult segment(Input input, const SegmentOptions& requested, const Progre
                 result.parked_bytes = parked.parked_bytes();
         },
         vertex_nodes);
-    const double seconds = since(t0);
-    // (Counted with the growing, which it precedes: the stages' times stay in run order.)
+    return simplified;
+}
+
+double SegmentRun::restore_for_growing() {
+    auto& result = result_;
+    auto& mesh = mesh_;
+    auto& parked = parked_;
+    const auto& progress = progress_;
     const auto t2 = clock::now();
     parked.restore(mesh.vertex_areas, progress, 0.6, 0.6);
     parked.restore(mesh.neighbor_directions, progress, 0.6, 0.601);
@@ -401,17 +449,69 @@ SegmentResult segment(Input input, const SegmentOptions& requested, const Progre
     parked.restore(result.field, progress, 0.603, 0.604);
     // The DEM back as doubles for the placing of the positions, then waiting again through
     // the growing, which does not read it; back for the region graph's points.
-    const auto restore_dem = [&](const ProgressFn& back) {
-        parked.restore(result.input.dem->values, back, 0, 0.2);
-        packed.restore(parked, scaled_progress(back, 0, 0.2));
-        packed.unpack(*result.input.dem, scaled_progress(back, 0.2, 1));
-    };
     if (result.input.dem) restore_dem(scaled_progress(progress, 0.604, 0.61));
-    if (placed_again)
+    if (placed_again_)
         mesh::restore_positions(*result.input.dem, mesh, scaled_progress(progress, 0.61, 0.615));
     if (result.input.dem && parked.on()) hold_dem(scaled_progress(progress, 0.615, 0.62));
     result.parked_growing = parked.parked_bytes();
-    const double placing = since(t2);
+    return since(t2);
+}
+
+double SegmentRun::regions(const std::vector<double>& ranges) {
+    auto& result = result_;
+    auto& mesh = mesh_;
+    const auto& options = options_;
+    const auto& progress = progress_;
+    const auto t1 = clock::now();
+    if (result.input.dem) restore_dem(scaled_progress(progress, 0.9, 0.905));
+    result.regions = segment::region_graph(
+        result.input.mesh, result.field, result.segmentation.labels,
+        result.segmentation.region_count, result.dem(), scaled_progress(progress, 0.905, 1));
+    // On a DEM, with the regions of valid pixels in no triangle (segment::label_pixels).
+    result.segmentation.region_count = static_cast<std::uint32_t>(result.regions.regions.size());
+    internal::set_region_scales(result);
+    if (options.min_area == "auto") internal::set_area_ranges(result, ranges);
+    if (options.craters && result.input.dem)
+        result.craters = segment::find_craters(mesh, *result.input.dem, result.segmentation.labels,
+                                               result.regions);
+    return since(t1);
+}
+
+}  // namespace
+
+SegmentResult segment(Input input, const SegmentOptions& requested, const ProgressFn& progress) {
+    check_options(requested);
+    const SegmentOptions options = resolve_options(requested, input.dem.has_value());
+    // A polygon format that cannot hold the DEM's coordinates is refused before any work.
+    if (input.dem) io::check_polygon_format(*input.dem, options.format);
+    SegmentResult result;
+    result.input = std::move(input);
+    result.timings.push_back({"read", result.input.read_seconds});
+    if (result.input.dem) result.timings.push_back({"mesh", result.input.mesh_seconds});
+    // Slices of the progress by the stages' measured cost on global grids of 1 to 66 M
+    // pixels (docs/performance.md): field 0.2, Reeb graph 0.2, simplification 0.2, growing
+    // and dividing 0.3, region graph 0.1.
+    SegmentRun run(result, options, progress);
+    auto& mesh = result.input.mesh;
+    const bool tree = run.field();
+    auto graph = run.reeb(tree);
+    // One scale only: the simplification takes the graph and frees what it no longer needs,
+    // which lowers the peak memory.
+    const auto t0 = clock::now();
+    if (run.parked().on()) {
+        if (!result.field.empty()) run.parked().park(result.field, progress, 0.4, 0.403);
+        run.parked().park(mesh.pixel_vertex, progress, 0.403, 0.406);
+        run.parked().park(mesh.vertex_pixel, progress, 0.406, 0.409);
+        run.parked().park(mesh.neighbor_directions, progress, 0.409, 0.41);
+    }
+    result.parked_bytes = run.parked().parked_bytes();
+    const auto thresholds = simplify_options(options, result.input.mesh);
+    result.area_ratio_percent = thresholds.area_ratio;
+    result.min_area_m2 = min_area_m2(options, result.input.mesh);
+    auto simplified = run.simplify(std::move(graph), thresholds);
+    const double seconds = since(t0);
+    // (Counted with the growing, which it precedes: the stages' times stay in run order.)
+    const double placing = run.restore_for_growing();
     auto scale = grow_scale(result.input, result.field, options, simplified, seconds,
                             scaled_progress(progress, 0.62, 0.86));
     result.segmentation = std::move(scale.segmentation);
@@ -434,21 +534,10 @@ SegmentResult segment(Input input, const SegmentOptions& requested, const Progre
     // The simplified graph, its rewritten field and its absorbed flags are read no more: they
     // go before the DEM comes back as doubles for the region graph (the growing's peak).
     simplified = reeb::SimplifyResult{};
-    const auto t1 = clock::now();
-    if (result.input.dem) restore_dem(scaled_progress(progress, 0.9, 0.905));
-    result.regions = segment::region_graph(
-        result.input.mesh, result.field, result.segmentation.labels,
-        result.segmentation.region_count, result.dem(), scaled_progress(progress, 0.905, 1));
-    // On a DEM, with the regions of valid pixels in no triangle (segment::label_pixels).
-    result.segmentation.region_count = static_cast<std::uint32_t>(result.regions.regions.size());
-    internal::set_region_scales(result);
-    if (options.min_area == "auto") internal::set_area_ranges(result, ranges);
-    if (options.craters && result.input.dem)
-        result.craters = segment::find_craters(mesh, *result.input.dem, result.segmentation.labels,
-                                               result.regions);
-    result.add_time("grow", placing + scale.grow_seconds + since(t1));
-    result.parked_file = parked.file_peak();
-    result.parked_most = parked.most_parked();
+    const double region_seconds = run.regions(ranges);
+    result.add_time("grow", placing + scale.grow_seconds + region_seconds);
+    result.parked_file = run.parked().file_peak();
+    result.parked_most = run.parked().most_parked();
     return result;
 }
 
