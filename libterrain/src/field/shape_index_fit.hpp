@@ -1,7 +1,8 @@
 #pragma once
 // Internals shared by the shape index's methods, not installed: shape_index.cpp (the mesh
-// method, and the grid method of the ball window) and shape_index_disk.cpp (the disk
-// window). docs/field.md describes them.
+// method and the dispatch), shape_index_normals.cpp, shape_index_lanes.cpp (four vertices at
+// a time), shape_index_grid.cpp (the grid method of the ball window) and shape_index_disk.cpp
+// (the disk window); the fit itself is curvature_fit.hpp's. docs/field.md describes them.
 
 #include <algorithm>
 #include <array>
@@ -11,25 +12,10 @@
 #include <limits>
 #include <vector>
 
+#include "curvature_fit.hpp"
 #include "terrain/field/shape_index.hpp"
 
 namespace terrain::field::detail {
-
-using Vec3 = std::array<double, 3>;
-
-inline Vec3 sub(const std::array<float, 3>& a, const std::array<float, 3>& b) {
-    return {double(a[0]) - b[0], double(a[1]) - b[1], double(a[2]) - b[2]};
-}
-inline Vec3 cross(const Vec3& a, const Vec3& b) {
-    return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
-inline double dot(const Vec3& a, const Vec3& b) {
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-inline Vec3 normalized(const Vec3& a) {
-    const double n = std::sqrt(dot(a, a));
-    return n > 0 ? Vec3{a[0] / n, a[1] / n, a[2] / n} : Vec3{0, 0, 1};
-}
 
 struct Scratch {
     std::vector<std::uint32_t> stamp;
@@ -155,23 +141,8 @@ struct DiskWindow {
     }
 };
 
-// The normal equations of the fit h = a u^2 + b uv + c v^2 (+ d u + e v) in raw tangent
-// coordinates (lower triangles of ata), the neighbour count m and their mean distance.
-struct NormalEquations {
-    std::array<std::array<double, 5>, 5> ata{};
-    std::array<double, 5> atb{};
-    std::size_t m = 0;
-    double scale = 0;
-};
-
-// Solves the fit (coordinates divided by e.scale) and returns the principal curvatures in
-// units of 1/scale; false when the neighbourhood is too small.
-bool solve_curvatures(NormalEquations e, PrincipalCurvatures& out);
-
-// The tangent frame (t1, t2) of a vertex normal.
-std::array<Vec3, 2> tangent_frame(const Vec3& normal);
-
-// Area-weighted unit vertex normals, each vertex's sum taken in triangle order (shape_index.cpp).
+// Area-weighted unit vertex normals, each vertex's sum taken in triangle order
+// (shape_index_normals.cpp).
 std::vector<Vec3> vertex_normals(const TriangleMesh& mesh, const ProgressFn& progress = {});
 
 // Unit vertex normals of the vertices [first, first + values.size()): all of a mesh's, or
@@ -187,23 +158,16 @@ struct Normals {
 bool normals_by_bands(const TriangleMesh& mesh);
 
 // The normals of the vertices of pixel rows [r0, r1), as vertex_normals gives them: the same
-// sums in the same order, so the same bits (shape_index.cpp). `out` spans the ids of the
+// sums in the same order, so the same bits (shape_index_normals.cpp). `out` spans the ids of the
 // vertices the rows' pixels own; where it holds a vertex of another row, that entry is no
 // normal.
 void band_normals(const TriangleMesh& mesh, int r0, int r1, Normals& out);
 
-// Fits h = a u^2 + b uv + c v^2 (+ d u + e v) to the m neighbours of v in the tangent frame of
-// `normal` (shape_index.cpp): the normal equations, then solve_curvatures. False when the
-// neighbourhood is too small.
-bool fit_curvatures(const TriangleMesh& mesh, std::int32_t v, const Vec3& normal,
-                    const std::int32_t* neighbour_ids, std::size_t m, PrincipalCurvatures& out,
-                    double& scale);
-
-// fit_curvatures for kFitLanes vertices at once, in the lanes of vectors: every lane does the
-// same operations in the same order as fit_curvatures (no operation is fused or reordered; a
-// lane past its last neighbour keeps its sums as they are), so each vertex gets the same bits.
-// A lane the vectors cannot finish (fewer than 5 neighbours, a zero scale, a singular system)
-// is fitted by fit_curvatures.
+// fit_curvatures for kFitLanes vertices at once, in the lanes of vectors (shape_index_lanes.cpp):
+// every lane does the same operations in the same order as fit_curvatures (no operation is fused or
+// reordered; a lane past its last neighbour keeps its sums as they are), so each vertex gets the
+// same bits. A lane the vectors cannot finish (fewer than 5 neighbours, a zero scale, a singular
+// system) is fitted by fit_curvatures.
 constexpr int kFitLanes = 4;
 struct FitBatch {
     std::array<std::int32_t, kFitLanes> vertex{};
@@ -390,6 +354,15 @@ void disk_tile(const TriangleMesh& mesh, const GridLayout& g, const Normals& nor
 using CurvatureBody = std::function<void(std::int32_t, bool, const PrincipalCurvatures&, double)>;
 void for_each_curvature(const TriangleMesh& mesh, const ShapeIndexOptions& options,
                         const ProgressFn& progress, const CurvatureBody& body);
+// Whether the disk window applies (a radius, the disk window, a mesh made from a DEM) and
+// whether the grid method does (shape_index_grid.cpp); the grid method refuses a mesh not made
+// from a DEM when asked for.
 bool disk_applies(const TriangleMesh& mesh, const ShapeIndexOptions& options);
+bool grid_applies(const TriangleMesh& mesh, const ShapeIndexOptions& options);
+
+// The grid method's fits of every vertex through `body`, normals 0 to 0.05 of the progress,
+// the grid's layout to 0.06, the vertices to 1 (shape_index_grid.cpp).
+void grid_method_for_each_vertex(const TriangleMesh& mesh, const ShapeIndexOptions& options,
+                                 const ProgressFn& progress, const VertexFn& body);
 
 }  // namespace terrain::field::detail

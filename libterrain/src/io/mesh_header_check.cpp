@@ -109,12 +109,21 @@ bool read_length(const unsigned char* p, const PlyType& t, bool big_endian, std:
     return true;
 }
 
-MeshFileCounts check_ply(std::string_view bytes, const std::string& name) {
+// A PLY header: its format (0 ascii, 1 little endian, 2 big endian), its elements and where
+// its data begin.
+struct PlyHeader {
+    int format = -1;
+    std::vector<PlyElement> elements;
+    std::size_t body = 0;
+};
+
+PlyHeader read_ply_header(std::string_view bytes, const std::string& name) {
     LineReader lines{bytes};
     const auto first = lines.next();
     if (!first || *first != "ply") refuse(name, "not a PLY file (the first line is not 'ply')");
-    int format = -1;  // 0 ascii, 1 little endian, 2 big endian
-    std::vector<PlyElement> elements;
+    PlyHeader header;
+    int& format = header.format;  // 0 ascii, 1 little endian, 2 big endian
+    std::vector<PlyElement>& elements = header.elements;
     bool ended = false;
     std::size_t line_number = 1;
     while (auto line = lines.next()) {
@@ -180,54 +189,58 @@ MeshFileCounts check_ply(std::string_view bytes, const std::string& name) {
     if (!ended) refuse(name, "PLY header has no end_header line");
     if (format < 0) refuse(name, "PLY header has no format line (the second line)");
 
-    MeshFileCounts counts;
-    for (const auto& e : elements) {
-        if (e.name == "vertex") counts.vertices = e.count;
-        if (e.name == "face") counts.faces = e.count;
-    }
-    const std::size_t body = lines.pos;
+    header.body = lines.pos;
+    return header;
+}
+
+// The ascii data after the header (whitespace-separated tokens), walked as CGAL reads them;
+// adds the faces' indices to `counts`.
+void check_ply_ascii(std::string_view bytes, const std::string& name, const PlyHeader& header,
+                     MeshFileCounts& counts) {
     auto truncated = [&](const PlyElement& e, std::uint64_t i) {
         refuse(name, "PLY data end inside " + e.name + " " + str(i) + " of " + str(e.count) +
                          " declared; the file is truncated or its header lies");
     };
+    std::size_t pos = header.body;
+    auto token = [&]() -> std::optional<std::string_view> {
+        while (pos < bytes.size() && std::isspace(static_cast<unsigned char>(bytes[pos]))) ++pos;
+        const std::size_t start = pos;
+        while (pos < bytes.size() && !std::isspace(static_cast<unsigned char>(bytes[pos]))) ++pos;
+        if (pos == start) return std::nullopt;
+        return bytes.substr(start, pos - start);
+    };
+    for (const auto& e : header.elements)
+        for (std::uint64_t i = 0; i < e.count; ++i)
+            for (const auto& p : e.properties) {
+                const auto t = token();
+                if (!t) truncated(e, i);
+                if (!p.size_type) continue;
+                const auto n = parse_count(*t);
+                if (!n)
+                    refuse(name, "PLY list length '" + std::string(*t) + "' in " + e.name + " " +
+                                     str(i) + " is not a non-negative integer");
+                // Each entry takes at least one character and one separator.
+                if (*n > (bytes.size() - pos + 1) / 2)
+                    refuse(name, "PLY " + e.name + " " + str(i) + " declares a list of " + str(*n) +
+                                     " entries; the rest of the file cannot hold them");
+                if (e.name == "face") counts.indices += *n;
+                for (std::uint64_t k = 0; k < *n; ++k)
+                    if (!token()) truncated(e, i);
+            }
+}
 
-    if (format == 0) {  // ascii: whitespace-separated tokens
-        std::size_t pos = body;
-        auto token = [&]() -> std::optional<std::string_view> {
-            while (pos < bytes.size() && std::isspace(static_cast<unsigned char>(bytes[pos])))
-                ++pos;
-            const std::size_t start = pos;
-            while (pos < bytes.size() && !std::isspace(static_cast<unsigned char>(bytes[pos])))
-                ++pos;
-            if (pos == start) return std::nullopt;
-            return bytes.substr(start, pos - start);
-        };
-        for (const auto& e : elements)
-            for (std::uint64_t i = 0; i < e.count; ++i)
-                for (const auto& p : e.properties) {
-                    const auto t = token();
-                    if (!t) truncated(e, i);
-                    if (!p.size_type) continue;
-                    const auto n = parse_count(*t);
-                    if (!n)
-                        refuse(name, "PLY list length '" + std::string(*t) + "' in " + e.name +
-                                         " " + str(i) + " is not a non-negative integer");
-                    // Each entry takes at least one character and one separator.
-                    if (*n > (bytes.size() - pos + 1) / 2)
-                        refuse(name, "PLY " + e.name + " " + str(i) + " declares a list of " +
-                                         str(*n) +
-                                         " entries; the rest of the file cannot hold them");
-                    if (e.name == "face") counts.indices += *n;
-                    for (std::uint64_t k = 0; k < *n; ++k)
-                        if (!token()) truncated(e, i);
-                }
-        return counts;
-    }
-
-    const bool big_endian = format == 2;
+// The binary data after the header, walked as CGAL reads them; adds the faces' indices to
+// `counts`.
+void check_ply_binary(std::string_view bytes, const std::string& name, const PlyHeader& header,
+                      MeshFileCounts& counts) {
+    auto truncated = [&](const PlyElement& e, std::uint64_t i) {
+        refuse(name, "PLY data end inside " + e.name + " " + str(i) + " of " + str(e.count) +
+                         " declared; the file is truncated or its header lies");
+    };
+    const bool big_endian = header.format == 2;
     const auto* data = reinterpret_cast<const unsigned char*>(bytes.data());
-    std::uint64_t pos = body;
-    for (const auto& e : elements) {
+    std::uint64_t pos = header.body;
+    for (const auto& e : header.elements) {
         const bool fixed = std::none_of(e.properties.begin(), e.properties.end(),
                                         [](const PlyProperty& p) { return p.size_type; });
         if (fixed) {
@@ -257,6 +270,19 @@ MeshFileCounts check_ply(std::string_view bytes, const std::string& name) {
                 pos += n * p.type->size;
             }
     }
+}
+
+MeshFileCounts check_ply(std::string_view bytes, const std::string& name) {
+    const PlyHeader header = read_ply_header(bytes, name);
+    MeshFileCounts counts;
+    for (const auto& e : header.elements) {
+        if (e.name == "vertex") counts.vertices = e.count;
+        if (e.name == "face") counts.faces = e.count;
+    }
+    if (header.format == 0)  // ascii: whitespace-separated tokens
+        check_ply_ascii(bytes, name, header, counts);
+    else
+        check_ply_binary(bytes, name, header, counts);
     return counts;
 }
 
@@ -335,23 +361,18 @@ std::uint32_t big_endian32(const unsigned char* p) {
            std::uint32_t(p[3]);
 }
 
-MeshFileCounts check_off(std::string_view bytes, const std::string& name) {
-    OffLines lines{LineReader{bytes}};
-    const auto header = lines.next();
-    if (!header) refuse(name, "empty OFF file");
-    auto tokens = split(*header);
-    std::string_view keyword = tokens[0];
-    // A '#' right after the keyword starts a comment here, not to CGAL's scanner, which reads
-    // the counts from what follows it: the two readings would differ.
-    if (const char* end = keyword.data() + keyword.size();
-        end < bytes.data() + bytes.size() && *end == '#')
-        refuse(name, "a comment glued to the OFF keyword ('" + std::string(keyword) +
-                         "#...'); put a space or a line break before '#'");
+// What an OFF keyword ([ST][C][N][4][n]OFF) says the data hold.
+struct OffKeyword {
+    bool n_dimensional = false, homogeneous = false, normals = false, colours = false;
+};
+
+OffKeyword parse_off_keyword(std::string_view keyword, const std::string& name) {
     // [ST][C][N][4][n]OFF
     std::string_view prefix = keyword;
     if (prefix.size() < 3 || prefix.substr(prefix.size() - 3) != "OFF")
         refuse(name, "not an OFF file (no OFF keyword on its first line)");
     prefix.remove_suffix(3);
+    OffKeyword k;
     const bool n_dimensional = !prefix.empty() && prefix.back() == 'n';
     if (n_dimensional) prefix.remove_suffix(1);
     const bool homogeneous = !prefix.empty() && prefix.back() == '4';
@@ -364,79 +385,50 @@ MeshFileCounts check_off(std::string_view bytes, const std::string& name) {
         refuse(name, "OFF texture coordinates (" + std::string(keyword) +
                          ") are not read; remove them (OFF, COFF, NOFF, 4OFF)");
     if (!prefix.empty()) refuse(name, "unknown OFF keyword '" + std::string(keyword) + "'");
-    const bool binary = tokens.size() > 1 && tokens[1] == "BINARY";
-    std::vector<std::string_view> numbers(tokens.begin() + 1 + (binary ? 1 : 0), tokens.end());
+    k.n_dimensional = n_dimensional, k.homogeneous = homogeneous, k.normals = normals;
+    k.colours = colours;
+    return k;
+}
+
+// A binary OFF file's data from `pos`: the counts and the faces' lists walked.
+MeshFileCounts check_off_binary(std::string_view bytes, const std::string& name,
+                                std::uint64_t pos) {
     MeshFileCounts counts;
-
-    if (binary) {
-        if (keyword != "OFF")
-            refuse(name, "binary " + std::string(keyword) +
-                             " files are not read; convert to ASCII OFF or PLY");
-        std::uint64_t pos = lines.reader.pos;
-        const auto* data = reinterpret_cast<const unsigned char*>(bytes.data());
-        if (bytes.size() - pos < 12) refuse(name, "binary OFF header is truncated");
-        const std::uint32_t nv = big_endian32(data + pos), nf = big_endian32(data + pos + 4);
-        if ((nv >> 31) || (nf >> 31)) refuse(name, "binary OFF header declares a negative count");
-        pos += 12;
-        counts.vertices = nv;
-        counts.faces = nf;
-        if (nv > (bytes.size() - pos) / 12)
-            refuse(name, "binary OFF header declares " + str(nv) +
-                             " vertices; the file cannot hold them");
-        pos += std::uint64_t(nv) * 12;
-        for (std::uint64_t f = 0; f < nf; ++f) {
-            for (int part = 0; part < 2; ++part) {  // the corner indices, then the colour
-                if (bytes.size() - pos < 4)
-                    refuse(name, "binary OFF data end inside face " + str(f));
-                const std::uint32_t n = big_endian32(data + pos);
-                pos += 4;
-                if ((n >> 31) || n > (bytes.size() - pos) / 4)
-                    refuse(name, "binary OFF face " + str(f) + " declares " + str(n) +
-                                     " entries; the file cannot hold them");
-                if (part == 0) counts.indices += n;
-                pos += std::uint64_t(n) * 4;
-            }
+    const auto* data = reinterpret_cast<const unsigned char*>(bytes.data());
+    if (bytes.size() - pos < 12) refuse(name, "binary OFF header is truncated");
+    const std::uint32_t nv = big_endian32(data + pos), nf = big_endian32(data + pos + 4);
+    if ((nv >> 31) || (nf >> 31)) refuse(name, "binary OFF header declares a negative count");
+    pos += 12;
+    counts.vertices = nv;
+    counts.faces = nf;
+    if (nv > (bytes.size() - pos) / 12)
+        refuse(name,
+               "binary OFF header declares " + str(nv) + " vertices; the file cannot hold them");
+    pos += std::uint64_t(nv) * 12;
+    for (std::uint64_t f = 0; f < nf; ++f) {
+        for (int part = 0; part < 2; ++part) {  // the corner indices, then the colour
+            if (bytes.size() - pos < 4) refuse(name, "binary OFF data end inside face " + str(f));
+            const std::uint32_t n = big_endian32(data + pos);
+            pos += 4;
+            if ((n >> 31) || n > (bytes.size() - pos) / 4)
+                refuse(name, "binary OFF face " + str(f) + " declares " + str(n) +
+                                 " entries; the file cannot hold them");
+            if (part == 0) counts.indices += n;
+            pos += std::uint64_t(n) * 4;
         }
-        return counts;
     }
+    return counts;
+}
 
-    auto next_number = [&]() -> std::optional<std::uint64_t> {
-        if (numbers.empty()) {
-            const auto line = lines.next();
-            if (!line) return std::nullopt;
-            numbers = split(*line);
-        }
-        const auto token = numbers.front();
-        numbers.erase(numbers.begin());
-        const auto n = parse_count(token);
-        if (!n)
-            refuse(name,
-                   "OFF header count '" + std::string(token) + "' is not a non-negative integer");
-        return n;
-    };
-    if (n_dimensional && !next_number()) refuse(name, "OFF header has no dimension");
-    const auto nv = next_number();
-    const auto nf = next_number();
-    if (!nv || !nf) refuse(name, "OFF header has no vertex and face counts");
-    // CGAL reads the edge count too, from the next line if need be: without it, the first
-    // number of the data would be taken for it and the data read shifted.
-    if (!next_number()) refuse(name, "OFF header has no edge count (the third number)");
-    // CGAL reads the first vertex from the rest of that line.
-    if (!numbers.empty()) refuse(name, "OFF header has numbers after its three counts");
-    counts.vertices = *nv;
-    counts.faces = *nf;
-    const std::uint64_t rest = bytes.size() - lines.reader.pos + 1;
-    // A vertex takes at least 6 characters ("0 0 0\n"), a face at least 2 ("0\n").
-    if (*nv > rest / 6 || *nf > rest / 2 || *nv * 6 + *nf * 2 > rest)
-        refuse(name, "OFF header declares " + str(*nv) + " vertices and " + str(*nf) +
-                         " faces; the file (" + str(bytes.size()) + " bytes) cannot hold them");
-    // Coordinates (and normals) a vertex line starts with; CGAL reads past a short line.
-    const std::size_t coordinates = (homogeneous ? 4 : 3) * (normals ? 2 : 1);
-    bool vertex_colours = false, face_colours = false;
-    for (std::uint64_t v = 0; v < *nv; ++v) {
+// The vertex lines of an ASCII OFF file: `coordinates` numbers or more each, and their
+// colours when the keyword has C.
+void check_off_vertices(OffLines& lines, const std::string& name, std::uint64_t nv,
+                        std::size_t coordinates, bool colours) {
+    bool vertex_colours = false;
+    for (std::uint64_t v = 0; v < nv; ++v) {
         const auto line = lines.next();
         if (!line)
-            refuse(name, "OFF data end at vertex " + str(v) + " of " + str(*nv) + " declared");
+            refuse(name, "OFF data end at vertex " + str(v) + " of " + str(nv) + " declared");
         const auto values = off_numbers(split(*line));
         if (!values || values->size() < coordinates)
             refuse(name, "OFF vertex " + str(v) + " is not a line of " + str(coordinates) +
@@ -444,9 +436,16 @@ MeshFileCounts check_off(std::string_view bytes, const std::string& name) {
         if (colours)
             check_off_colour(*values, coordinates, name, "vertex " + str(v), vertex_colours);
     }
-    for (std::uint64_t f = 0; f < *nf; ++f) {
+}
+
+// The face lines of an ASCII OFF file: each index a vertex of the file, and their colours
+// when the keyword has C; adds the faces' indices to `counts`.
+void check_off_faces(std::string_view bytes, OffLines& lines, const std::string& name,
+                     std::uint64_t nv, std::uint64_t nf, bool colours, MeshFileCounts& counts) {
+    bool face_colours = false;
+    for (std::uint64_t f = 0; f < nf; ++f) {
         const auto line = lines.next();
-        if (!line) refuse(name, "OFF data end at face " + str(f) + " of " + str(*nf) + " declared");
+        if (!line) refuse(name, "OFF data end at face " + str(f) + " of " + str(nf) + " declared");
         const auto face = split(*line);
         const auto n = parse_count(face[0]);
         if (!n)
@@ -463,9 +462,9 @@ MeshFileCounts check_off(std::string_view bytes, const std::string& name) {
                              str(*n) + " vertices");
         for (std::uint64_t k = 1; k <= *n; ++k) {
             const auto index = parse_count(face[k]);
-            if (!index || *index >= *nv)
+            if (!index || *index >= nv)
                 refuse(name, "OFF face " + str(f) + " refers to vertex '" + std::string(face[k]) +
-                                 "'; the file has " + str(*nv) + " vertices");
+                                 "'; the file has " + str(nv) + " vertices");
         }
         if (colours) {
             const auto values = off_numbers(face);
@@ -473,6 +472,64 @@ MeshFileCounts check_off(std::string_view bytes, const std::string& name) {
             check_off_colour(*values, *n + 1, name, "face " + str(f), face_colours);
         }
     }
+}
+
+MeshFileCounts check_off(std::string_view bytes, const std::string& name) {
+    OffLines lines{LineReader{bytes}};
+    const auto header = lines.next();
+    if (!header) refuse(name, "empty OFF file");
+    auto tokens = split(*header);
+    std::string_view keyword = tokens[0];
+    // A '#' right after the keyword starts a comment here, not to CGAL's scanner, which reads
+    // the counts from what follows it: the two readings would differ.
+    if (const char* end = keyword.data() + keyword.size();
+        end < bytes.data() + bytes.size() && *end == '#')
+        refuse(name, "a comment glued to the OFF keyword ('" + std::string(keyword) +
+                         "#...'); put a space or a line break before '#'");
+    const OffKeyword k = parse_off_keyword(keyword, name);
+    const bool binary = tokens.size() > 1 && tokens[1] == "BINARY";
+    std::vector<std::string_view> numbers(tokens.begin() + 1 + (binary ? 1 : 0), tokens.end());
+    if (binary) {
+        if (keyword != "OFF")
+            refuse(name, "binary " + std::string(keyword) +
+                             " files are not read; convert to ASCII OFF or PLY");
+        return check_off_binary(bytes, name, lines.reader.pos);
+    }
+    MeshFileCounts counts;
+    auto next_number = [&]() -> std::optional<std::uint64_t> {
+        if (numbers.empty()) {
+            const auto line = lines.next();
+            if (!line) return std::nullopt;
+            numbers = split(*line);
+        }
+        const auto token = numbers.front();
+        numbers.erase(numbers.begin());
+        const auto n = parse_count(token);
+        if (!n)
+            refuse(name,
+                   "OFF header count '" + std::string(token) + "' is not a non-negative integer");
+        return n;
+    };
+    if (k.n_dimensional && !next_number()) refuse(name, "OFF header has no dimension");
+    const auto nv = next_number();
+    const auto nf = next_number();
+    if (!nv || !nf) refuse(name, "OFF header has no vertex and face counts");
+    // CGAL reads the edge count too, from the next line if need be: without it, the first
+    // number of the data would be taken for it and the data read shifted.
+    if (!next_number()) refuse(name, "OFF header has no edge count (the third number)");
+    // CGAL reads the first vertex from the rest of that line.
+    if (!numbers.empty()) refuse(name, "OFF header has numbers after its three counts");
+    counts.vertices = *nv;
+    counts.faces = *nf;
+    const std::uint64_t rest = bytes.size() - lines.reader.pos + 1;
+    // A vertex takes at least 6 characters ("0 0 0\n"), a face at least 2 ("0\n").
+    if (*nv > rest / 6 || *nf > rest / 2 || *nv * 6 + *nf * 2 > rest)
+        refuse(name, "OFF header declares " + str(*nv) + " vertices and " + str(*nf) +
+                         " faces; the file (" + str(bytes.size()) + " bytes) cannot hold them");
+    // Coordinates (and normals) a vertex line starts with; CGAL reads past a short line.
+    const std::size_t coordinates = (k.homogeneous ? 4 : 3) * (k.normals ? 2 : 1);
+    check_off_vertices(lines, name, *nv, coordinates, k.colours);
+    check_off_faces(bytes, lines, name, *nv, *nf, k.colours, counts);
     return counts;
 }
 

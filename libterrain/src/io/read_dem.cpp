@@ -29,11 +29,9 @@ ElevationKind detect_elevation_kind(const Body& body, double min_value, double m
 
 namespace {
 
-// `summary`: statistics only, the values are not kept (Dem::values stays empty).
-Dem read_dem(const std::string& path, const ReadDemOptions& options, const ProgressFn& progress,
-             DemValueSummary* summary) {
-    ensure_gdal_registered();
-    const GdalErrorCapture errors;
+// The raster at `path` opened, with the band asked for.
+std::unique_ptr<GDALDataset> open_dem(const std::string& path, const ReadDemOptions& options,
+                                      const GdalErrorCapture& errors) {
     if (!std::filesystem::exists(path) && path.rfind("/vsi", 0) != 0)
         throw Error("read", "'" + path + "' does not exist; check the path");
     std::unique_ptr<GDALDataset> dataset(
@@ -47,17 +45,23 @@ Dem read_dem(const std::string& path, const ReadDemOptions& options, const Progr
         throw Error("read", "band " + std::to_string(options.band) + " does not exist in '" + path +
                                 "', which has " + std::to_string(band_count) +
                                 " band(s); choose --band 1.." + std::to_string(band_count));
+    return dataset;
+}
+
+// The grid of the dataset: its size, geotransform, CRS, body and georeference, checked
+// before anything reads its values.
+Dem dem_grid(const std::string& path, const ReadDemOptions& options, GDALDataset& dataset) {
     Dem dem;
     dem.source = path;
     dem.band = options.band;
-    dem.width = dataset->GetRasterXSize();
-    dem.height = dataset->GetRasterYSize();
+    dem.width = dataset.GetRasterXSize();
+    dem.height = dataset.GetRasterYSize();
     if (dem.width < 2 || dem.height < 2)
         throw Error("read", "'" + path + "' is " + std::to_string(dem.width) + "x" +
                                 std::to_string(dem.height) +
                                 " pixels; a surface needs at least 2x2 pixels");
 
-    dem.has_transform = dataset->GetGeoTransform(dem.transform.data()) == CE_None;
+    dem.has_transform = dataset.GetGeoTransform(dem.transform.data()) == CE_None;
     if (!dem.has_transform) {
         const double size = options.pixel_size.value_or(1.0);
         dem.transform = {0, size, 0, 0, 0, -size};
@@ -66,7 +70,7 @@ Dem read_dem(const std::string& path, const ReadDemOptions& options, const Progr
                                 "' is georeferenced; --pixel-size is only for rasters without a "
                                 "geotransform");
     }
-    if (const OGRSpatialReference* srs = dataset->GetSpatialRef()) {
+    if (const OGRSpatialReference* srs = dataset.GetSpatialRef()) {
         char* wkt = nullptr;
         const char* wkt_options[] = {"FORMAT=WKT2_2019", nullptr};
         if (srs->exportToWkt(&wkt, wkt_options) == OGRERR_NONE && wkt) dem.crs_wkt = wkt;
@@ -75,31 +79,38 @@ Dem read_dem(const std::string& path, const ReadDemOptions& options, const Progr
     // The grid is checked before anything reads it (a hostile geotransform or pixel size
     // would make the georeference loop or the arrays absurd).
     dem.body = geo::body_from_crs(dem.crs_wkt);
-    validate_dem_grid(path, dem, dataset->GetSpatialRef());
-    geo::georeference(dem);                          // the body, and where the pixels lie on it
-    validate_dem_on_body(path, dem, dataset.get());  // ... which must be on it
+    validate_dem_grid(path, dem, dataset.GetSpatialRef());
+    geo::georeference(dem);                     // the body, and where the pixels lie on it
+    validate_dem_on_body(path, dem, &dataset);  // ... which must be on it
 
-    GDALRasterBand* band = dataset->GetRasterBand(options.band);
-    int has_scale = 0, has_offset = 0;
-    const double scale = band->GetScale(&has_scale);
-    const double offset = band->GetOffset(&has_offset);
-    const double a = has_scale ? scale : 1.0;
-    const double b = has_offset ? offset : 0.0;
-    validate_scale(path, a, b);
-    GDALRasterBand* mask = band->GetMaskBand();
-    const bool all_valid = band->GetMaskFlags() == GMF_ALL_VALID;
+    return dem;
+}
 
-    const std::size_t width = static_cast<std::size_t>(dem.width);
-    check_dem_size(path, dem, *band, summary ? nullptr : &options.memory, all_valid);
-    // Each row of the grid's values is added as it is read, and the whole grid is reserved
-    // (address space only) once the first row has been read: the memory used follows what
-    // the file gives, not what its header claims. An 826-byte GeoTIFF declaring 18464 x 65504
-    // pixels used to fill 9.7 GB with NaN before its first row failed to read.
-    std::vector<double> row_values(summary ? width : 0);
-    std::vector<unsigned char> mask_row(all_valid ? 0 : width);
+// What reading the values found: the valid pixels and their range, the values neither valid
+// nor NoData (NaN or infinite) and the first of them.
+struct ValuesRead {
     std::size_t valid = 0, not_finite = 0;
     double lo = std::numeric_limits<double>::infinity(), hi = -lo;
     int first_bad_col = -1, first_bad_row = -1;
+};
+
+// The band's values, row by row, scaled by a x + b, into dem.values (or, with `summary`,
+// only counted).
+ValuesRead read_values(const std::string& path, GDALDataset& dataset, GDALRasterBand& band_ref,
+                       Dem& dem, double a, double b, bool all_valid, bool summary,
+                       const GdalErrorCapture& errors, const ProgressFn& progress) {
+    GDALRasterBand* band = &band_ref;
+    GDALRasterBand* mask = band->GetMaskBand();
+    const std::size_t width = static_cast<std::size_t>(dem.width);
+    ValuesRead read;
+    std::size_t& valid = read.valid;
+    std::size_t& not_finite = read.not_finite;
+    double& lo = read.lo;
+    double& hi = read.hi;
+    int& first_bad_col = read.first_bad_col;
+    int& first_bad_row = read.first_bad_row;
+    std::vector<double> row_values(summary ? width : 0);
+    std::vector<unsigned char> mask_row(all_valid ? 0 : width);
     // A summary reads one row of blocks at a time, drops GDAL's cached blocks after each, and
     // skips the blocks a sparse file does not hold (all NoData, or all zero without NoData).
     int block_width = 0, block_height = 0;
@@ -108,7 +119,7 @@ Dem read_dem(const std::string& path, const ReadDemOptions& options, const Progr
     const bool known_fill = all_valid || band->GetMaskFlags() == GMF_NODATA;
     for (int row = 0; row < dem.height; ++row) {
         if (summary && row % block_height == 0) {
-            if (row > 0) dataset->FlushCache(false);
+            if (row > 0) dataset.FlushCache(false);
             const int rows = std::min(block_height, dem.height - row);
             if (known_fill && band->GetDataCoverageStatus(0, row, dem.width, rows, 0, nullptr) ==
                                   GDAL_DATA_COVERAGE_STATUS_EMPTY) {
@@ -156,6 +167,34 @@ Dem read_dem(const std::string& path, const ReadDemOptions& options, const Progr
         }
         if ((row & 63) == 0) report_progress(progress, double(row) / dem.height, "read");
     }
+    return read;
+}
+
+// `summary`: statistics only, the values are not kept (Dem::values stays empty).
+Dem read_dem(const std::string& path, const ReadDemOptions& options, const ProgressFn& progress,
+             DemValueSummary* summary) {
+    ensure_gdal_registered();
+    const GdalErrorCapture errors;
+    const std::unique_ptr<GDALDataset> dataset = open_dem(path, options, errors);
+    Dem dem = dem_grid(path, options, *dataset);
+    GDALRasterBand* band = dataset->GetRasterBand(options.band);
+    int has_scale = 0, has_offset = 0;
+    const double scale = band->GetScale(&has_scale);
+    const double offset = band->GetOffset(&has_offset);
+    const double a = has_scale ? scale : 1.0;
+    const double b = has_offset ? offset : 0.0;
+    validate_scale(path, a, b);
+    const bool all_valid = band->GetMaskFlags() == GMF_ALL_VALID;
+    check_dem_size(path, dem, *band, summary ? nullptr : &options.memory, all_valid);
+    // Each row of the grid's values is added as it is read, and the whole grid is reserved
+    // (address space only) once the first row has been read: the memory used follows what
+    // the file gives, not what its header claims. An 826-byte GeoTIFF declaring 18464 x 65504
+    // pixels used to fill 9.7 GB with NaN before its first row failed to read.
+    const ValuesRead read = read_values(path, *dataset, *band, dem, a, b, all_valid,
+                                        summary != nullptr, errors, progress);
+    const std::size_t valid = read.valid, not_finite = read.not_finite;
+    const double lo = read.lo, hi = read.hi;
+    const int first_bad_col = read.first_bad_col, first_bad_row = read.first_bad_row;
     if (not_finite > 0 && !options.nan_as_nodata)
         throw Error("read", "'" + path + "' has " + std::to_string(not_finite) +
                                 " NaN or infinite value(s) not declared NoData (first at col " +

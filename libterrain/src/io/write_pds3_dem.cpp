@@ -211,44 +211,32 @@ std::string pds3_image_path(const std::string& label_path) {
     return path.string();
 }
 
-void write_pds3_dem(const Dem& dem, const std::string& label_path, const Pds3DemOptions& options) {
-    ensure_gdal_registered();
-    const GdalErrorCapture quiet;
-    const fs::path label(label_path);
-    if (upper(label.extension().string()) != ".LBL")
-        fail("'" + label_path +
-             "' does not end in .lbl; name the PDS3 label *.lbl (the image "
-             "is written beside it as *.img)");
-    const fs::path image(pds3_image_path(label_path));
-    if (dem.width < 1 || dem.height < 1 ||
-        dem.values.size() != static_cast<std::size_t>(dem.width) * dem.height)
-        fail("the DEM is empty or its values do not match its size");
+namespace {
 
-    // Everything is checked and encoded before any file is touched.
-    const Projection p = read_projection(dem);
-    const std::string target = target_name(dem, options);
-    if (!std::isfinite(options.scaling_factor) || !(options.scaling_factor > 0))
-        fail("the scaling factor must be a positive number of metres per DN");
-    const bool radius = dem.elevation == ElevationKind::radius;
-    if (radius && !options.offset && !(dem.body.semi_major_axis > 0))
-        fail("the DEM holds radii but its body has no radius; give the offset");
-    const double offset = options.offset.value_or(radius ? dem.body.semi_major_axis : 0.0);
-    if (!std::isfinite(offset)) fail("the offset must be a finite number of metres");
+// The DEM's values as 16-bit DNs, MSB first, and the least and greatest DN written.
+struct EncodedDem {
+    std::vector<unsigned char> bytes;
+    int dn_min = 0, dn_max = 0;
+};
 
-    std::vector<unsigned char> bytes(dem.values.size() * 2);
-    int dn_min = std::numeric_limits<int>::max(), dn_max = std::numeric_limits<int>::min();
+EncodedDem encode_dns(const Dem& dem, double offset, double scaling_factor) {
+    EncodedDem out;
+    std::vector<unsigned char>& bytes = out.bytes;
+    int& dn_min = out.dn_min;
+    int& dn_max = out.dn_max;
+    bytes.resize(dem.values.size() * 2);
+    dn_min = std::numeric_limits<int>::max(), dn_max = std::numeric_limits<int>::min();
     for (int row = 0; row < dem.height; ++row)
         for (int col = 0; col < dem.width; ++col) {
             const std::size_t i = dem.index(col, row);
             const double v = dem.values[i];
             int dn = kMissing;
             if (!std::isnan(v)) {
-                const double q = std::round((v - offset) / options.scaling_factor);
+                const double q = std::round((v - offset) / scaling_factor);
                 if (!std::isfinite(v) || q < kValidMin || q > kValidMax)
                     fail("the value " + real(v) + " m at column " + std::to_string(col) + ", row " +
                          std::to_string(row) + " does not fit a 16-bit DN with " +
-                         "SCALING_FACTOR " + real(options.scaling_factor) + " and OFFSET " +
-                         real(offset) +
+                         "SCALING_FACTOR " + real(scaling_factor) + " and OFFSET " + real(offset) +
                          "; choose a larger scaling factor or an offset nearer "
                          "the values");
                 dn = static_cast<int>(q);
@@ -260,6 +248,15 @@ void write_pds3_dem(const Dem& dem, const std::string& label_path, const Pds3Dem
             bytes[2 * i + 1] = static_cast<unsigned char>(u & 0xff);
         }
 
+    return out;
+}
+
+// The DEM's extent on its body, in degrees.
+struct MapExtent {
+    double lat_min = 0, lat_max = 0, lon_west = 0, lon_east = 0;
+};
+
+MapExtent map_extent(const Dem& dem, const Projection& p) {
     // Map extent. Sample s (1-based) has its centre at x = (s - SAMPLE_PROJECTION_OFFSET - 1) *
     // MAP_SCALE and line l at y = (LINE_PROJECTION_OFFSET - l + 1) * MAP_SCALE, as GDAL's PDS
     // driver reads them.
@@ -273,34 +270,14 @@ void write_pds3_dem(const Dem& dem, const std::string& label_path, const Pds3Dem
         fail("the DEM's extent (latitude " + real(lat_min) + " to " + real(lat_max) +
              ") does not lie on its body; check the geotransform and CRS");
 
-    const std::string stem = label.stem().string();
-    const std::string product_id = options.product_id.empty() ? stem : options.product_id;
+    return {lat_min, lat_max, lon_west, lon_east};
+}
+
+// The label's IMAGE object: the DNs and how they give metres.
+void label_image(Label& l, const Dem& dem, const Pds3DemOptions& options, bool radius,
+                 double offset, const EncodedDem& dns) {
     const std::string quantity = radius ? "RADIUS" : "HEIGHT";
-    Label l;
-    l.field("PDS_VERSION_ID", "PDS3");
-    l.line();
-    l.comment("FILE CHARACTERISTICS");
-    l.field("RECORD_TYPE", "FIXED_LENGTH");
-    l.field("RECORD_BYTES", std::to_string(2 * dem.width));
-    l.field("FILE_RECORDS", std::to_string(dem.height));
-    l.line();
-    l.comment("POINTER TO THE DATA OBJECT");
-    l.field("^IMAGE", "\"" + image.filename().string() + "\"");
-    l.line();
-    l.comment("IDENTIFICATION");
-    l.field("PRODUCT_ID", "\"" + product_id + "\"");
-    l.field("PRODUCT_TYPE", "DTM");
-    l.field("TARGET_NAME", target);
-    l.field("SOFTWARE_NAME", "\"terrain\"");
-    l.field("SOFTWARE_VERSION_ID", "\"" + version() + "\"");
-    l.text("DESCRIPTION", options.description.empty()
-                              ? "Digital terrain model of " + upper(dem.body.name) + ": " +
-                                    (radius ? "planetary radius" : "height") + " in metres, " +
-                                    quantity +
-                                    " = DN * SCALING_FACTOR + OFFSET, in an equirectangular map "
-                                    "projection."
-                              : options.description);
-    l.line();
+    const int dn_min = dns.dn_min, dn_max = dns.dn_max;
     l.begin("IMAGE");
     l.field("NAME", quantity);
     l.text("DESCRIPTION", quantity + " in metres = DN * SCALING_FACTOR + OFFSET" +
@@ -323,7 +300,12 @@ void write_pds3_dem(const Dem& dem, const std::string& label_path, const Pds3Dem
         l.field("MAXIMUM", std::to_string(dn_max));
     }
     l.end("IMAGE");
-    l.line();
+}
+
+// The label's IMAGE_MAP_PROJECTION object: the equirectangular projection of the grid.
+void label_projection(Label& l, const Dem& dem, const Projection& p, const MapExtent& e) {
+    const double lat_min = e.lat_min, lat_max = e.lat_max, lon_west = e.lon_west,
+                 lon_east = e.lon_east;
     l.begin("IMAGE_MAP_PROJECTION");
     l.field("MAP_PROJECTION_TYPE", "\"EQUIRECTANGULAR\"");
     l.field("PROJECTION_LATITUDE_TYPE", "PLANETOCENTRIC");
@@ -353,6 +335,67 @@ void write_pds3_dem(const Dem& dem, const std::string& label_path, const Pds3Dem
     l.field("COORDINATE_SYSTEM_TYPE", "\"BODY-FIXED ROTATING\"");
     l.field("COORDINATE_SYSTEM_NAME", "PLANETOCENTRIC");
     l.end("IMAGE_MAP_PROJECTION");
+}
+
+}  // namespace
+
+void write_pds3_dem(const Dem& dem, const std::string& label_path, const Pds3DemOptions& options) {
+    ensure_gdal_registered();
+    const GdalErrorCapture quiet;
+    const fs::path label(label_path);
+    if (upper(label.extension().string()) != ".LBL")
+        fail("'" + label_path +
+             "' does not end in .lbl; name the PDS3 label *.lbl (the image "
+             "is written beside it as *.img)");
+    const fs::path image(pds3_image_path(label_path));
+    if (dem.width < 1 || dem.height < 1 ||
+        dem.values.size() != static_cast<std::size_t>(dem.width) * dem.height)
+        fail("the DEM is empty or its values do not match its size");
+
+    // Everything is checked and encoded before any file is touched.
+    const Projection p = read_projection(dem);
+    const std::string target = target_name(dem, options);
+    if (!std::isfinite(options.scaling_factor) || !(options.scaling_factor > 0))
+        fail("the scaling factor must be a positive number of metres per DN");
+    const bool radius = dem.elevation == ElevationKind::radius;
+    if (radius && !options.offset && !(dem.body.semi_major_axis > 0))
+        fail("the DEM holds radii but its body has no radius; give the offset");
+    const double offset = options.offset.value_or(radius ? dem.body.semi_major_axis : 0.0);
+    if (!std::isfinite(offset)) fail("the offset must be a finite number of metres");
+
+    const EncodedDem dns = encode_dns(dem, offset, options.scaling_factor);
+    const MapExtent extent = map_extent(dem, p);
+    const std::string stem = label.stem().string();
+    const std::string product_id = options.product_id.empty() ? stem : options.product_id;
+    const std::string quantity = radius ? "RADIUS" : "HEIGHT";
+    Label l;
+    l.field("PDS_VERSION_ID", "PDS3");
+    l.line();
+    l.comment("FILE CHARACTERISTICS");
+    l.field("RECORD_TYPE", "FIXED_LENGTH");
+    l.field("RECORD_BYTES", std::to_string(2 * dem.width));
+    l.field("FILE_RECORDS", std::to_string(dem.height));
+    l.line();
+    l.comment("POINTER TO THE DATA OBJECT");
+    l.field("^IMAGE", "\"" + image.filename().string() + "\"");
+    l.line();
+    l.comment("IDENTIFICATION");
+    l.field("PRODUCT_ID", "\"" + product_id + "\"");
+    l.field("PRODUCT_TYPE", "DTM");
+    l.field("TARGET_NAME", target);
+    l.field("SOFTWARE_NAME", "\"terrain\"");
+    l.field("SOFTWARE_VERSION_ID", "\"" + version() + "\"");
+    l.text("DESCRIPTION", options.description.empty()
+                              ? "Digital terrain model of " + upper(dem.body.name) + ": " +
+                                    (radius ? "planetary radius" : "height") + " in metres, " +
+                                    quantity +
+                                    " = DN * SCALING_FACTOR + OFFSET, in an equirectangular map "
+                                    "projection."
+                              : options.description);
+    l.line();
+    label_image(l, dem, options, radius, offset, dns);
+    l.line();
+    label_projection(l, dem, p, extent);
     l.line();
     l.line("END");
 
@@ -360,7 +403,7 @@ void write_pds3_dem(const Dem& dem, const std::string& label_path, const Pds3Dem
     // first, so that a label never points at a missing or older image.
     AtomicOutput image_out(image.string(), options.overwrite);
     AtomicOutput label_out(label.string(), options.overwrite);
-    write_file(image_out.temp_path(), bytes.data(), bytes.size());
+    write_file(image_out.temp_path(), dns.bytes.data(), dns.bytes.size());
     write_file(label_out.temp_path(), l.str().data(), l.str().size());
     image_out.commit();
     label_out.commit();

@@ -12,8 +12,10 @@
 #include "../core/pass_progress.hpp"
 #include "../core/release.hpp"
 #include "../core/significant.hpp"
+#include "packed_heights.hpp"
 #include "parked_arrays.hpp"
 #include "region_scales.hpp"
+#include "stage_clock.hpp"
 #include "terrain/core/error.hpp"
 #include "terrain/core/huge_pages.hpp"
 #include "terrain/core/json_writer.hpp"
@@ -34,63 +36,9 @@ namespace terrain::pipeline {
 
 namespace fs = std::filesystem;
 
-namespace {
-
-using clock = std::chrono::steady_clock;
-double since(clock::time_point t0) {
-    return std::chrono::duration<double>(clock::now() - t0).count();
-}
-
-}  // namespace
-
-std::optional<MeshFrame> parse_frame(const std::string& name) {
-    if (name == "body") return MeshFrame::body;
-    if (name == "map") return MeshFrame::map;
-    if (name == "auto") return std::nullopt;
-    throw Error("mesh", "the frame must be body, map or auto, not '" + name + "'");
-}
-
-Input load_input(const std::string& path, const InputOptions& options, const ProgressFn& progress) {
-    const auto t0 = clock::now();
-    const MemoryPlan plan =
-        memory_plan(options.planned_field, options.max_memory, options.planned_segment);
-    if (io::is_mesh_file(path)) {
-        io::ReadMeshOptions read_options;
-        read_options.repair = options.repair;
-        Input input;
-        input.mesh = io::read_mesh(path, read_options, progress, plan);
-        input.read_seconds = since(t0);
-        return input;
-    }
-    const auto frame = parse_frame(options.frame);
-    io::ReadDemOptions dem_options = options.dem;
-    dem_options.memory = plan;
-    Dem dem = io::read_dem(path, dem_options, scaled_progress(progress, 0, 0.3));
-    const double read_seconds = since(t0);
-    mesh::DemToMeshOptions mesh_options;
-    mesh_options.frame = frame;
-    // pipeline::segment frees the triangles of a tree before the field (below): they may go
-    // before the mesh's areas and adjacency, unless the SDF is to cast rays through them.
-    mesh_options.release_triangles = options.planned_segment && options.planned_field != "sdf";
-    const auto t1 = clock::now();
-    Input input;
-    input.mesh = mesh::dem_to_mesh(dem, mesh_options, scaled_progress(progress, 0.3, 1));
-    input.mesh_seconds = since(t1);
-    input.read_seconds = read_seconds;
-    input.dem = std::move(dem);
-    return input;
-}
-
-Input input_from_dem(Dem dem, const std::string& frame, const ProgressFn& progress) {
-    mesh::DemToMeshOptions mesh_options;
-    mesh_options.frame = parse_frame(frame);
-    const auto t0 = clock::now();
-    Input input;
-    input.mesh = mesh::dem_to_mesh(dem, mesh_options, progress);
-    input.mesh_seconds = since(t0);
-    input.dem = std::move(dem);
-    return input;
-}
+using internal::clock;
+using internal::PackedHeights;
+using internal::since;
 
 void check_options(const SegmentOptions& o) {
     field::parse_field_kind(o.field);
@@ -305,63 +253,6 @@ ScaleResult grow_scale(const Input& input, const std::vector<float>& field,
     return out;
 }
 
-// The DEM's values held as floats while the stages that do not read them run, when every
-// value is one exactly (16- and 32-bit samples, and integers times a power of two below 2^24
-// of them): 4 bytes a pixel less. They are doubles again, the same numbers, where they are
-// read (the placing of the positions, the region graph's points); a DEM with a value no float
-// holds keeps its doubles. Packed again later, the values are not checked again.
-class PackedHeights {
-  public:
-    void pack(Dem& dem, const ProgressFn& progress) {
-        const std::size_t n = dem.values.size();
-        const detail::PassProgress checked(progress, 0, 0.4, "mesh"),
-            packed(progress, 0.4, 1, "mesh");
-        if (!exact_) {
-            for (std::size_t i = 0; i < n; ++i) {
-                checked.at(i, n);
-                const double v = dem.values[i];
-                if (!std::isnan(v) && static_cast<double>(static_cast<float>(v)) != v) return;
-            }
-            exact_ = true;
-        }
-        values_.reserve(n);
-        for (std::size_t i = 0; i < n; ++i) {
-            packed.at(i, n);
-            values_.push_back(static_cast<float>(dem.values[i]));
-        }
-        detail::release(dem.values);
-        packed_ = true;
-    }
-    // The bytes of the DEM's values as held now.
-    std::size_t bytes(const Dem& dem) const {
-        return packed_ ? values_.size() * sizeof(float) : dem.values.size() * sizeof(double);
-    }
-    // The floats parked (parked_arrays.hpp) and read back.
-    bool park(internal::ParkedArrays& parked, const ProgressFn& progress) {
-        return packed_ && parked.park(values_, progress, 0, 1);
-    }
-    void restore(internal::ParkedArrays& parked, const ProgressFn& progress) {
-        if (packed_) parked.restore(values_, progress, 0, 1);
-    }
-    void unpack(Dem& dem, const ProgressFn& progress) {
-        if (!packed_) return;
-        const std::size_t n = values_.size();
-        const detail::PassProgress unpacked(progress, 0, 1, "mesh");
-        dem.values.reserve(n);
-        for (std::size_t i = 0; i < n; ++i) {
-            unpacked.at(i, n);
-            dem.values.push_back(static_cast<double>(values_[i]));
-        }
-        detail::release(values_);
-        packed_ = false;
-    }
-
-  private:
-    std::vector<float> values_;
-    bool packed_ = false;
-    bool exact_ = false;  // every value is a float
-};
-
 }  // namespace
 
 ScaleResult grow_simplified(const Input& input, const std::vector<float>& field,
@@ -380,24 +271,83 @@ ScaleResult segment_scale(const Input& input, const std::vector<float>& field,
                       scaled_progress(progress, 0.3, 1));
 }
 
-SegmentResult segment(Input input, const SegmentOptions& requested, const ProgressFn& progress) {
-    check_options(requested);
-    const SegmentOptions options = resolve_options(requested, input.dem.has_value());
-    // A polygon format that cannot hold the DEM's coordinates is refused before any work.
-    if (input.dem) io::check_polygon_format(*input.dem, options.format);
-    SegmentResult result;
-    result.input = std::move(input);
-    result.timings.push_back({"read", result.input.read_seconds});
-    if (result.input.dem) result.timings.push_back({"mesh", result.input.mesh_seconds});
-    // Slices of the progress by the stages' measured cost on global grids of 1 to 66 M
-    // pixels (docs/performance.md): field 0.2, Reeb graph 0.2, simplification 0.2, growing
-    // and dividing 0.3, region graph 0.1.
+namespace {
+
+// One run of pipeline::segment: the result as it is made, and the arrays that wait unread
+// through the stages that do not read them: the DEM's values (as floats when they all are
+// floats), then the field and the mesh's pixel maps, parked on disk (parked_arrays.hpp;
+// docs/performance.md, "Arrays parked on disk") when large. The DEM waits from before the
+// field (only the height field reads it) to the placing of the positions, and again through
+// the growing. Whether to park at all is decided the first time, on what all the arrays
+// parked through the run hold (the field is a float a vertex).
+class SegmentRun {
+  public:
+    SegmentRun(SegmentResult& result, const SegmentOptions& options, const ProgressFn& progress)
+        : result_(result),
+          options_(options),
+          progress_(progress),
+          mesh_(result.input.mesh),
+          parked_(options.park_directory, options.park_min_bytes) {}
+
+    // The field, the DEM held from before it unless it reads it; progress 0 to 0.2. Returns
+    // whether the Reeb graph is known to be a tree.
+    bool field();
+    // The Reeb graph, the arrays it does not read waiting; progress 0.2 to 0.4.
+    reeb::ReebGraph reeb(bool tree);
+    // The simplification, the arrays it does not read waiting; progress 0.41 to 0.6.
+    reeb::SimplifyResult simplify(reeb::ReebGraph graph, const reeb::SimplifyOptions& thresholds);
+    // The arrays back, the positions placed again, the DEM waiting again; progress 0.6 to
+    // 0.62. Returns its time.
+    double restore_for_growing();
+    // The region graph, its scales and area ranges, the craters; progress 0.905 to 1. Returns
+    // its time.
+    double regions(const std::vector<double>& ranges);
+
+    internal::ParkedArrays& parked() { return parked_; }
+
+  private:
+    void hold_dem(const ProgressFn& held);
+    void restore_dem(const ProgressFn& back);
+
+    SegmentResult& result_;
+    const SegmentOptions& options_;
+    const ProgressFn& progress_;
+    TriangleMesh& mesh_;
+    PackedHeights packed_;
+    internal::ParkedArrays parked_;
+    bool placed_again_ = false;  // the positions freed through the Reeb graph
+};
+
+void SegmentRun::hold_dem(const ProgressFn& held) {
+    Dem& dem = *result_.input.dem;
+    packed_.pack(dem, scaled_progress(held, 0, 0.5));
+    if (!parked_.decided())
+        parked_.decide(packed_.bytes(dem) +
+                       sizeof(float) * (mesh_.vertex_count() + mesh_.vertex_areas.size()) +
+                       sizeof(std::int32_t) *
+                           (mesh_.pixel_vertex.size() + mesh_.vertex_pixel.size()) +
+                       mesh_.neighbor_directions.size());
+    if (!packed_.park(parked_, scaled_progress(held, 0.5, 1)))
+        parked_.park(dem.values, held, 0.5, 1);
+}
+
+// The DEM back as doubles.
+void SegmentRun::restore_dem(const ProgressFn& back) {
+    parked_.restore(result_.input.dem->values, back, 0, 0.2);
+    packed_.restore(parked_, scaled_progress(back, 0, 0.2));
+    packed_.unpack(*result_.input.dem, scaled_progress(back, 0.2, 1));
+}
+
+bool SegmentRun::field() {
+    auto& result = result_;
+    auto& mesh = mesh_;
+    const auto& options = options_;
+    const auto& progress = progress_;
     // A DEM mesh whose Reeb graph is a tree (every component a disk or a sphere) frees its
     // triangles (24 bytes a pixel) before the field: no stage reads them at random, the
     // shape index's normals and the later stages walk them again from the grid in order.
     // The SDF casts rays through them: it keeps them. (The loop check is counted with the
     // field, which it precedes.)
-    auto& mesh = result.input.mesh;
     const auto tf = clock::now();
     const auto kind = field::parse_field_kind(options.field);
     const bool tree = kind != field::FieldKind::sdf &&
@@ -408,45 +358,32 @@ SegmentResult segment(Input input, const SegmentOptions& requested, const Progre
     else
         mesh.restore_triangles();  // (released by load_input: the Reeb graph reads them)
     result.add_time("field", since(tf));
-    // The DEM's values (as floats when they all are floats), then the field and the mesh's
-    // pixel maps, wait unread through the stages that do not read them: parked on disk
-    // (parked_arrays.hpp; docs/performance.md, "Arrays parked on disk") when large. The DEM
-    // waits from before the field (only the height field reads it) to the placing of the
-    // positions, and again through the growing.
-    // Whether to park at all is decided the first time, on what all the arrays parked through
-    // the run hold (the field is a float a vertex).
-    PackedHeights packed;
-    internal::ParkedArrays parked(options.park_directory, options.park_min_bytes);
-    const auto hold_dem = [&](const ProgressFn& held) {
-        Dem& dem = *result.input.dem;
-        packed.pack(dem, scaled_progress(held, 0, 0.5));
-        if (!parked.decided())
-            parked.decide(packed.bytes(dem) +
-                          sizeof(float) * (mesh.vertex_count() + mesh.vertex_areas.size()) +
-                          sizeof(std::int32_t) *
-                              (mesh.pixel_vertex.size() + mesh.vertex_pixel.size()) +
-                          mesh.neighbor_directions.size());
-        if (!packed.park(parked, scaled_progress(held, 0.5, 1)))
-            parked.park(dem.values, held, 0.5, 1);
-    };
     const bool field_reads_dem = kind == field::FieldKind::height;
     if (result.input.dem && !field_reads_dem) hold_dem(scaled_progress(progress, 0.02, 0.03));
-    result.parked_field = parked.parked_bytes();
+    result.parked_field = parked_.parked_bytes();
     compute_field(
         result, options,
         scaled_progress(progress, field_reads_dem ? 0.02 : 0.03, field_reads_dem ? 0.19 : 0.2));
     // A DEM mesh frees its positions (12 bytes a vertex) while the Reeb graph and the
     // simplification run, which do not read them, and places them again before the growing:
     // the same floats (docs/mesh.md, "Positions freed and placed again").
-    const bool placed_again = result.input.dem && mesh.release_positions();
+    placed_again_ = result.input.dem && mesh.release_positions();
     const auto tp = clock::now();
     if (result.input.dem) {
         if (field_reads_dem) hold_dem(scaled_progress(progress, 0.19, 0.2));
         // The vertices' areas wait through the Reeb graph, which does not read them (the
         // simplification does).
-        parked.park(mesh.vertex_areas, progress, 0.2, 0.21);
+        parked_.park(mesh.vertex_areas, progress, 0.2, 0.21);
     }
     result.add_time("reeb", since(tp));  // (which it precedes: the times stay in run order)
+    return tree;
+}
+
+reeb::ReebGraph SegmentRun::reeb(bool tree) {
+    auto& result = result_;
+    auto& mesh = mesh_;
+    auto& parked = parked_;
+    const auto& progress = progress_;
     // The field waits on disk too once the Reeb graph's events are ordered (the contour tree
     // does not read it): the Reeb graph's peak of memory is in the contour tree.
     // The graph's vertex lists, vertices' nodes and node values wait too through the contour
@@ -471,19 +408,15 @@ SegmentResult segment(Input input, const SegmentOptions& requested, const Progre
     const auto ta = clock::now();
     parked.restore(mesh.vertex_areas, progress, 0.4, 0.4);
     result.add_time("reeb", since(ta));
-    // One scale only: the simplification takes the graph and frees what it no longer needs,
-    // which lowers the peak memory.
-    const auto t0 = clock::now();
-    if (parked.on()) {
-        if (!result.field.empty()) parked.park(result.field, progress, 0.4, 0.403);
-        parked.park(mesh.pixel_vertex, progress, 0.403, 0.406);
-        parked.park(mesh.vertex_pixel, progress, 0.406, 0.409);
-        parked.park(mesh.neighbor_directions, progress, 0.409, 0.41);
-    }
-    result.parked_bytes = parked.parked_bytes();
-    const auto thresholds = simplify_options(options, result.input.mesh);
-    result.area_ratio_percent = thresholds.area_ratio;
-    result.min_area_m2 = min_area_m2(options, result.input.mesh);
+    return graph;
+}
+
+reeb::SimplifyResult SegmentRun::simplify(reeb::ReebGraph graph,
+                                          const reeb::SimplifyOptions& thresholds) {
+    auto& result = result_;
+    auto& mesh = mesh_;
+    auto& parked = parked_;
+    const auto& progress = progress_;
     // The areas wait on disk again once the simplification has read them, and the graph's
     // vertices' nodes until its output reads them (both before its peak of memory, the end
     // of its copy of the arcs). (Parked without progress: the simplification reports around
@@ -500,8 +433,14 @@ SegmentResult segment(Input input, const SegmentOptions& requested, const Progre
                 result.parked_bytes = parked.parked_bytes();
         },
         vertex_nodes);
-    const double seconds = since(t0);
-    // (Counted with the growing, which it precedes: the stages' times stay in run order.)
+    return simplified;
+}
+
+double SegmentRun::restore_for_growing() {
+    auto& result = result_;
+    auto& mesh = mesh_;
+    auto& parked = parked_;
+    const auto& progress = progress_;
     const auto t2 = clock::now();
     parked.restore(mesh.vertex_areas, progress, 0.6, 0.6);
     parked.restore(mesh.neighbor_directions, progress, 0.6, 0.601);
@@ -510,17 +449,69 @@ SegmentResult segment(Input input, const SegmentOptions& requested, const Progre
     parked.restore(result.field, progress, 0.603, 0.604);
     // The DEM back as doubles for the placing of the positions, then waiting again through
     // the growing, which does not read it; back for the region graph's points.
-    const auto restore_dem = [&](const ProgressFn& back) {
-        parked.restore(result.input.dem->values, back, 0, 0.2);
-        packed.restore(parked, scaled_progress(back, 0, 0.2));
-        packed.unpack(*result.input.dem, scaled_progress(back, 0.2, 1));
-    };
     if (result.input.dem) restore_dem(scaled_progress(progress, 0.604, 0.61));
-    if (placed_again)
+    if (placed_again_)
         mesh::restore_positions(*result.input.dem, mesh, scaled_progress(progress, 0.61, 0.615));
     if (result.input.dem && parked.on()) hold_dem(scaled_progress(progress, 0.615, 0.62));
     result.parked_growing = parked.parked_bytes();
-    const double placing = since(t2);
+    return since(t2);
+}
+
+double SegmentRun::regions(const std::vector<double>& ranges) {
+    auto& result = result_;
+    auto& mesh = mesh_;
+    const auto& options = options_;
+    const auto& progress = progress_;
+    const auto t1 = clock::now();
+    if (result.input.dem) restore_dem(scaled_progress(progress, 0.9, 0.905));
+    result.regions = segment::region_graph(
+        result.input.mesh, result.field, result.segmentation.labels,
+        result.segmentation.region_count, result.dem(), scaled_progress(progress, 0.905, 1));
+    // On a DEM, with the regions of valid pixels in no triangle (segment::label_pixels).
+    result.segmentation.region_count = static_cast<std::uint32_t>(result.regions.regions.size());
+    internal::set_region_scales(result);
+    if (options.min_area == "auto") internal::set_area_ranges(result, ranges);
+    if (options.craters && result.input.dem)
+        result.craters = segment::find_craters(mesh, *result.input.dem, result.segmentation.labels,
+                                               result.regions);
+    return since(t1);
+}
+
+}  // namespace
+
+SegmentResult segment(Input input, const SegmentOptions& requested, const ProgressFn& progress) {
+    check_options(requested);
+    const SegmentOptions options = resolve_options(requested, input.dem.has_value());
+    // A polygon format that cannot hold the DEM's coordinates is refused before any work.
+    if (input.dem) io::check_polygon_format(*input.dem, options.format);
+    SegmentResult result;
+    result.input = std::move(input);
+    result.timings.push_back({"read", result.input.read_seconds});
+    if (result.input.dem) result.timings.push_back({"mesh", result.input.mesh_seconds});
+    // Slices of the progress by the stages' measured cost on global grids of 1 to 66 M
+    // pixels (docs/performance.md): field 0.2, Reeb graph 0.2, simplification 0.2, growing
+    // and dividing 0.3, region graph 0.1.
+    SegmentRun run(result, options, progress);
+    auto& mesh = result.input.mesh;
+    const bool tree = run.field();
+    auto graph = run.reeb(tree);
+    // One scale only: the simplification takes the graph and frees what it no longer needs,
+    // which lowers the peak memory.
+    const auto t0 = clock::now();
+    if (run.parked().on()) {
+        if (!result.field.empty()) run.parked().park(result.field, progress, 0.4, 0.403);
+        run.parked().park(mesh.pixel_vertex, progress, 0.403, 0.406);
+        run.parked().park(mesh.vertex_pixel, progress, 0.406, 0.409);
+        run.parked().park(mesh.neighbor_directions, progress, 0.409, 0.41);
+    }
+    result.parked_bytes = run.parked().parked_bytes();
+    const auto thresholds = simplify_options(options, result.input.mesh);
+    result.area_ratio_percent = thresholds.area_ratio;
+    result.min_area_m2 = min_area_m2(options, result.input.mesh);
+    auto simplified = run.simplify(std::move(graph), thresholds);
+    const double seconds = since(t0);
+    // (Counted with the growing, which it precedes: the stages' times stay in run order.)
+    const double placing = run.restore_for_growing();
     auto scale = grow_scale(result.input, result.field, options, simplified, seconds,
                             scaled_progress(progress, 0.62, 0.86));
     result.segmentation = std::move(scale.segmentation);
@@ -543,264 +534,10 @@ SegmentResult segment(Input input, const SegmentOptions& requested, const Progre
     // The simplified graph, its rewritten field and its absorbed flags are read no more: they
     // go before the DEM comes back as doubles for the region graph (the growing's peak).
     simplified = reeb::SimplifyResult{};
-    const auto t1 = clock::now();
-    if (result.input.dem) restore_dem(scaled_progress(progress, 0.9, 0.905));
-    result.regions = segment::region_graph(
-        result.input.mesh, result.field, result.segmentation.labels,
-        result.segmentation.region_count, result.dem(), scaled_progress(progress, 0.905, 1));
-    // On a DEM, with the regions of valid pixels in no triangle (segment::label_pixels).
-    result.segmentation.region_count = static_cast<std::uint32_t>(result.regions.regions.size());
-    internal::set_region_scales(result);
-    if (options.min_area == "auto") internal::set_area_ranges(result, ranges);
-    if (options.craters && result.input.dem)
-        result.craters = segment::find_craters(mesh, *result.input.dem, result.segmentation.labels,
-                                               result.regions);
-    result.add_time("grow", placing + scale.grow_seconds + since(t1));
-    result.parked_file = parked.file_peak();
-    result.parked_most = parked.most_parked();
-    return result;
-}
-
-// A DEM mesh's geometry, which its files do not read (the counts for run.json kept first).
-static void release_mesh_geometry(SegmentResult& result) {
-    if (!result.mesh_counts) result.mesh_counts = mesh_counts(result.input.mesh);
-    auto& m = result.input.mesh;
-    m.release_positions();  // (the vertex count stays; a mesh that cannot keeps them)
-    m.release_triangles();
-    detail::release(m.vertex_areas);
-    m.release_adjacency();
-    release_free_memory();
-}
-
-void release_large_data(SegmentResult& result) {
-    if (!result.mesh_counts) result.mesh_counts = mesh_counts(result.input.mesh);
-    // (`v = {}` would keep a vector's capacity: it is the initializer-list assignment.)
-    auto drop = [](auto& v) { std::decay_t<decltype(v)>().swap(v); };
-    auto& m = result.input.mesh;
-    drop(m.positions);
-    drop(m.triangles);
-    drop(m.vertex_areas);
-    m.release_adjacency();
-    drop(m.pixel_vertex);
-    drop(m.vertex_pixel);
-    drop(result.field);
-    drop(result.segmentation.labels);
-    drop(result.segmentation.seeds);
-    release_free_memory();
-}
-
-// A length and an area for the preview's caption, in m or km, three significant digits.
-std::string caption_length(double m) {
-    return m >= 1000 ? terrain::detail::significant(m / 1000, 3) + " km"
-                     : terrain::detail::significant(m, 3) + " m";
-}
-std::string caption_area(double m2) {
-    return m2 >= 1e5 ? terrain::detail::significant(m2 / 1e6, 3) + " km^2"
-                     : terrain::detail::significant(m2, 3) + " m^2";
-}
-
-// The preview's words for a scale chosen per vertex: the ladder's ends.
-std::string scale_caption(const std::vector<double>& radii) {
-    if (radii.empty()) return "radius auto";
-    return "radius auto (" + std::to_string(radii.size()) + " radii, " +
-           caption_length(radii.front()) + " to " + caption_length(radii.back()) + ")";
-}
-
-std::vector<std::string> write_segment_directory(SegmentResult& result, const SegmentOptions& given,
-                                                 const std::string& input_path,
-                                                 const std::string& dir, const WriteOptions& write,
-                                                 const ProgressFn& progress) {
-    const SegmentOptions options = resolve_options(given, result.input.dem.has_value());
-    const auto t0 = clock::now();
-    release_free_memory();  // (freed blocks a program keeps: GDAL's block cache comes next)
-    io::SegmentOutputOptions out;
-    out.polygons.driver = options.format;
-    out.preview_caption.input = fs::path(input_path).filename().string();
-    out.preview_caption.field = options.field;
-    auto& caption = out.preview_caption.parameters;
-    if (options.field == "shape-index" && options.shape_index.auto_scale)
-        caption.push_back(scale_caption(result.field_radii));
-    else if (options.field == "shape-index")
-        caption.push_back(
-            options.shape_index.radius > 0
-                ? "radius " + JsonWriter::number(options.shape_index.radius) + " m (" +
-                      field::shape_index_window(result.input.mesh, options.shape_index) + ")"
-                : std::to_string(options.shape_index.rings) + " rings");
-    caption.push_back("persistence " + JsonWriter::number(options.simplify.persistence));
-    if (options.min_area == "auto")
-        caption.push_back("min area auto (" + caption_area(result.min_area_m2) + ")");
-    else
-        caption.push_back(
-            "area ratio " + JsonWriter::number(result.area_ratio_percent) + " %" +
-            (options.min_area.empty() ? std::string() : " (min area " + options.min_area + ")"));
-    caption.push_back("cost " +
-                      std::string(options.cost == "auto" ? (result.input.dem ? "graph" : "standard")
-                                                         : options.cost) +
-                      ", saddle penalty " + JsonWriter::number(options.saddle_penalty));
-    caption.push_back("absorbed " + options.absorbed);
-    // The preview is written last, once the large data is freed.
-    io::PreviewImage preview;
-    const bool deferred = write.release_memory && result.input.dem;
-    // The files of a DEM read the labels, the field and the pixel maps, not the mesh's
-    // positions, areas, triangles or adjacency (about 17 bytes a pixel): they go first.
-    if (deferred) {
-        release_mesh_geometry(result);
-        out.deferred_preview = &preview;
-    }
-    const auto paths =
-        io::write_segment_outputs(dir, result.input.mesh, result.field, result.segmentation.labels,
-                                  result.regions, result.dem(), out, progress);
-    std::vector<std::string> names;
-    for (const auto& p : paths) {
-        names.push_back(fs::path(p).filename().string());
-        // The QGIS style written with the label raster.
-        if (result.dem() && p == paths.front())
-            names.push_back(fs::path(io::label_style_path(p)).filename().string());
-    }
-    if (result.craters) {
-        io::write_craters_csv(*result.craters, (fs::path(dir) / "craters.csv").string(), false);
-        io::write_craters_geojson(*result.craters, (fs::path(dir) / "craters.geojson").string(),
-                                  false);
-        names.push_back("craters.csv");
-        names.push_back("craters.geojson");
-        const auto gpkg = fs::path(dir) / "regions.gpkg";
-        if (options.format == "GPKG" && fs::exists(gpkg))
-            io::add_crater_layers(*result.craters, gpkg.string());
-        double area = 0;
-        for (const auto& r : result.regions.regions) area += r.area_m2;
-        if (area > 0) {
-            io::write_craters_plot(*result.craters, area, (fs::path(dir) / "craters.png").string(),
-                                   false);
-            names.push_back("craters.png");
-        }
-        if (result.craters->lonlat) {
-            io::write_craters_scc(*result.craters, result.dem()->body, area,
-                                  (fs::path(dir) / "craters.scc").string(), false);
-            names.push_back("craters.scc");
-        }
-    }
-    result.add_time("write", since(t0));
-    if (write.release_memory) release_large_data(result);
-    if (deferred) {
-        const auto t1 = clock::now();
-        io::write_preview_image(preview, (fs::path(dir) / "preview.png").string(), false);
-        result.add_time("write", since(t1));
-    }
-    write_run_json(result, input_path, options, names, (fs::path(dir) / "run.json").string());
-    names.push_back("run.json");
-    return names;
-}
-
-void write_run_json(const SegmentResult& result, const std::string& input_path,
-                    const SegmentOptions& given, const std::vector<std::string>& files,
-                    const std::string& path,
-                    const std::vector<std::pair<std::string, std::string>>& extra) {
-    const SegmentOptions options = resolve_options(given, result.input.dem.has_value());
-    std::ofstream os(path, std::ios::binary);
-    if (!os) throw Error("write", "cannot write " + path);
-    JsonWriter j(os);
-    const auto topo = result.mesh_counts ? *result.mesh_counts : mesh_counts(result.input.mesh);
-    const auto& after = result.after;
-    const bool dem = result.input.dem.has_value();
-    j.begin_object();
-    j.field("input", fs::absolute(input_path).lexically_normal().string());
-    j.key("parameters")
-        .begin_object()
-        .field("field", options.field)
-        .field("rings", options.shape_index.rings);
-    if (options.shape_index.auto_scale) {
-        j.field("radius", "auto").key("radii_m").begin_array();
-        for (const double r : result.field_radii) j.value(r);
-        j.end_array()
-            .field("contrast_curvedness", options.shape_index.contrast_curvedness)
-            .field("pixel_noise_m", result.pixel_noise_m);
-    } else {
-        j.field("radius", options.shape_index.radius);
-    }
-    j.field("persistence", options.simplify.persistence)
-        .field("area_ratio_percent",
-               options.min_area.empty() ? options.simplify.area_ratio : result.area_ratio_percent);
-    if (!options.min_area.empty())
-        j.field("min_area", options.min_area).field("min_area_m2", result.min_area_m2);
-    if (result.regions.has_area_range) internal::write_area_range(j, result);
-    j.field("cost", options.cost == "auto" ? (dem ? "graph" : "standard") : options.cost.c_str())
-        .field("saddle_penalty", options.saddle_penalty)
-        .field("absorbed", options.absorbed)
-        .field("format", options.format)
-        .field("frame", to_string(result.input.mesh.frame));
-    if (options.field == "shape-index") {
-        const auto& mesh = result.input.mesh;
-        j.field("shape_index_method",
-                !result.shape_index_method.empty()
-                    ? result.shape_index_method
-                    : std::string(field::shape_index_method(mesh, options.shape_index)))
-            .field("shape_index_window",
-                   !result.shape_index_window.empty()
-                       ? result.shape_index_window
-                       : std::string(field::shape_index_window(mesh, options.shape_index)));
-    }
-    if (options.field == "sdf")
-        j.field("rays", options.rays)
-            .field("cone_angle_degrees", options.cone_angle_degrees)
-            .field("postprocess", options.postprocess)
-            .field("allow_open", options.allow_open);
-    j.end_object();
-    j.key("counts")
-        .begin_object()
-        .field("vertices", topo.vertices)
-        .field("faces", topo.faces)
-        .field("boundary_edges", topo.boundary_edges)
-        .field("euler_characteristic", topo.euler_characteristic)
-        .field("critical_nodes_before", result.critical_before)
-        .field("critical_nodes_after", after.critical)
-        .field("loops", after.loops)
-        .field("regions", static_cast<std::size_t>(result.segmentation.region_count))
-        .field("relaxed_nodes", result.segmentation.relaxed_nodes)
-        .field("absorbed_vertices", result.divided.absorbed)
-        .field("absorbed_relabelled", result.divided.relabelled)
-        .field("parked_bytes", result.parked_bytes)
-        .field("parked_bytes_field", result.parked_field)
-        .field("parked_bytes_growing", result.parked_growing)
-        .field("parked_bytes_most", result.parked_most)
-        .field("parked_file_bytes", result.parked_file);
-    if (result.craters) j.field("craters", result.craters->craters.size());
-    j.end_object();
-    j.key("timings_seconds").begin_object();
-    double total = 0;
-    for (const auto& t : result.timings) {
-        j.field(t.name, t.seconds);
-        total += t.seconds;
-    }
-    j.field("total", total).end_object();
-    j.key("outputs").begin_array();
-    for (const auto& f : files) j.value(f);
-    j.end_array();
-    for (const auto& [k, v] : extra) j.key(k).raw(v);
-    j.field("pages", huge_page_use());  // huge or normal pages for the arrays (speed only)
-    j.key("versions").begin_object().field("terrain", version());
-    for (const auto& [name, v] : dependency_versions()) j.field(name, v);
-    j.end_object();
-    j.end_object();
-    os.flush();
-    if (!os) throw Error("write", "writing " + path + " failed (disk full?)");
-}
-
-SegmentResult segment_to_directory(const std::string& input_path, const std::string& output_dir,
-                                   bool overwrite, const InputOptions& input_options,
-                                   const SegmentOptions& options, const ProgressFn& progress) {
-    check_options(options);
-    OutputDirectory dir(output_dir, overwrite);
-    InputOptions planned = input_options;
-    planned.planned_field = options.field;  // the plan of the field segmented
-    planned.planned_segment = true;
-    auto input = load_input(input_path, planned, scaled_progress(progress, 0, 0.15));
-    auto result = segment(std::move(input), options, scaled_progress(progress, 0.15, 0.7));
-    WriteOptions write;
-    write.release_memory = true;
-    write_segment_directory(result, options, input_path, dir.temp_path(), write,
-                            scaled_progress(progress, 0.7, 0.95));
-    dir.commit();
-    report_progress(progress, 1.0);
+    const double region_seconds = run.regions(ranges);
+    result.add_time("grow", placing + scale.grow_seconds + region_seconds);
+    result.parked_file = run.parked().file_peak();
+    result.parked_most = run.parked().most_parked();
     return result;
 }
 

@@ -218,114 +218,105 @@ SweepResult run_sweep(Input input, const std::vector<ScaleSpec>& specs,
 
 }  // namespace
 
-std::vector<std::string> write_sweep_directory(SweepResult& result, const SegmentOptions& options,
-                                               const std::string& input_path,
-                                               const std::string& dir_path,
-                                               const ProgressFn& progress) {
-    auto& base = result.base;
+namespace {
+
+// A DEM's sweep: every scale's labels in one raster of bands, and its polygons (a layer each
+// in the GeoPackage, a GeoJSON file each); progress 0.2 after the labels.
+void write_scale_maps(const SweepResult& result, const Dem& dem, const std::string& dir_path,
+                      std::vector<std::string>& files, const ProgressFn& progress) {
+    const auto& base = result.base;
     const auto& scales = result.scales;
     const std::string d = dir_path + "/";
-    const auto w0 = clock::now();
-    release_free_memory();  // (freed blocks a program keeps: GDAL's block cache comes next)
-    std::vector<std::string> files;
-    const Dem* dem = base.dem();
-    const bool by_area = !scales.empty() && scales.front().min_area_m2 > 0;
-    if (dem) {
-        std::vector<std::vector<std::uint32_t>> bands;
-        std::vector<std::string> descriptions;
-        std::vector<const segment::RegionGraph*> graphs;
-        for (const auto& s : scales) {
-            graphs.push_back(&s.regions);
-            bands.push_back(segment::label_pixels(base.input.mesh, *dem, s.segmentation.labels));
-            descriptions.push_back((s.min_area_m2 > 0 ? "min_area=" : "area_ratio=") + s.name);
-        }
-        io::write_label_stack(*dem, bands, descriptions, graphs, d + "labels.tif", false);
-        files.push_back("labels.tif");
-        files.push_back("labels.qml");
-        report_progress(progress, 0.2);
-        // Each scale polygonized once; then the GeoPackage's layers one after the other,
-        // the GeoJSON files beside them.
-        std::vector<io::RegionPolygons> polygons(scales.size());
-        tbb::parallel_for(std::size_t{0}, scales.size(), [&](std::size_t i) {
-            polygons[i] =
-                io::polygonize_regions(*dem, bands[i], scales[i].regions.regions.size(), dir_path);
-        });
-        tbb::parallel_invoke(
-            [&] {
-                for (std::size_t i = 0; i < scales.size(); ++i) {
-                    io::RegionPolygonOptions gpkg;
-                    gpkg.driver = "GPKG";
-                    gpkg.layer = "regions_" + scales[i].name;
-                    gpkg.append_layer = true;
-                    io::write_region_polygons(*dem, polygons[i], scales[i].regions,
-                                              d + "regions.gpkg", false, gpkg);
-                }
-            },
-            [&] {
-                tbb::parallel_for(std::size_t{0}, scales.size(), [&](std::size_t i) {
-                    io::write_region_polygons(*dem, polygons[i], scales[i].regions,
-                                              d + "regions_" + scales[i].name + ".geojson", false);
-                });
-            });
-        files.push_back("regions.gpkg");
-        for (const auto& s : scales) files.push_back("regions_" + s.name + ".geojson");
-    } else {
-        for (const auto& s : scales) {
-            io::write_faces_seg(base.input.mesh, s.segmentation.labels,
-                                d + "faces_" + s.name + ".seg", false);
-            files.push_back("faces_" + s.name + ".seg");
-        }
-    }
-    report_progress(progress, 0.7);
+    std::vector<std::vector<std::uint32_t>> bands;
+    std::vector<std::string> descriptions;
+    std::vector<const segment::RegionGraph*> graphs;
     for (const auto& s : scales) {
-        io::write_adjacency_json(s.regions, d + "adjacency_" + s.name + ".json", false);
-        files.push_back("adjacency_" + s.name + ".json");
+        graphs.push_back(&s.regions);
+        bands.push_back(segment::label_pixels(base.input.mesh, dem, s.segmentation.labels));
+        descriptions.push_back((s.min_area_m2 > 0 ? "min_area=" : "area_ratio=") + s.name);
     }
-    {
-        std::ofstream os(d + "lineage.json", std::ios::binary);
-        JsonWriter j(os);
-        j.begin_object();
-        j.key("scales").begin_array();
-        for (const auto& s : scales) j.value(s.ratio);
-        j.end_array();
-        if (by_area) {
-            j.key("min_areas_m2").begin_array();
-            for (const auto& s : scales) j.value(s.min_area_m2);
-            j.end_array();
-        }
-        j.field("area_unit", dem ? "m^2 of pixel footprints on the body" : "m^2 of mesh surface");
-        j.key("links").begin_array();
-        for (std::size_t i = 0; i < result.lineage.size(); ++i) {
-            const auto& a = scales[i];
-            const auto& b = scales[i + 1];
-            j.begin_object()
-                .field("from_area_ratio", a.ratio)
-                .field("to_area_ratio", b.ratio)
-                .field("mean_parent_share", segment::mean_parent_share(result.lineage[i]));
-            j.key("regions").begin_array();
-            for (const auto& r : result.lineage[i]) {
-                j.begin_object()
-                    .field("region", static_cast<std::int64_t>(r.region))
-                    .field("area_m2", r.area_m2)
-                    .field("parent", static_cast<std::int64_t>(r.parent))
-                    .field("parent_share", r.parent_share);
-                j.key("overlaps").begin_array();
-                for (const auto& o : r.overlaps)
-                    j.begin_object()
-                        .field("region", static_cast<std::int64_t>(o.region))
-                        .field("area_m2", o.area_m2)
-                        .field("fraction", o.fraction)
-                        .end_object();
-                j.end_array().end_object();
+    io::write_label_stack(dem, bands, descriptions, graphs, d + "labels.tif", false);
+    files.push_back("labels.tif");
+    files.push_back("labels.qml");
+    report_progress(progress, 0.2);
+    // Each scale polygonized once; then the GeoPackage's layers one after the other,
+    // the GeoJSON files beside them.
+    std::vector<io::RegionPolygons> polygons(scales.size());
+    tbb::parallel_for(std::size_t{0}, scales.size(), [&](std::size_t i) {
+        polygons[i] =
+            io::polygonize_regions(dem, bands[i], scales[i].regions.regions.size(), dir_path);
+    });
+    tbb::parallel_invoke(
+        [&] {
+            for (std::size_t i = 0; i < scales.size(); ++i) {
+                io::RegionPolygonOptions gpkg;
+                gpkg.driver = "GPKG";
+                gpkg.layer = "regions_" + scales[i].name;
+                gpkg.append_layer = true;
+                io::write_region_polygons(dem, polygons[i], scales[i].regions, d + "regions.gpkg",
+                                          false, gpkg);
             }
+        },
+        [&] {
+            tbb::parallel_for(std::size_t{0}, scales.size(), [&](std::size_t i) {
+                io::write_region_polygons(dem, polygons[i], scales[i].regions,
+                                          d + "regions_" + scales[i].name + ".geojson", false);
+            });
+        });
+    files.push_back("regions.gpkg");
+    for (const auto& s : scales) files.push_back("regions_" + s.name + ".geojson");
+}
+
+// lineage.json: each scale's region in the next scale's, with their overlaps.
+void write_lineage_json(const SweepResult& result, const std::string& path, bool by_area,
+                        bool dem) {
+    const auto& scales = result.scales;
+    std::ofstream os(path, std::ios::binary);
+    JsonWriter j(os);
+    j.begin_object();
+    j.key("scales").begin_array();
+    for (const auto& s : scales) j.value(s.ratio);
+    j.end_array();
+    if (by_area) {
+        j.key("min_areas_m2").begin_array();
+        for (const auto& s : scales) j.value(s.min_area_m2);
+        j.end_array();
+    }
+    j.field("area_unit", dem ? "m^2 of pixel footprints on the body" : "m^2 of mesh surface");
+    j.key("links").begin_array();
+    for (std::size_t i = 0; i < result.lineage.size(); ++i) {
+        const auto& a = scales[i];
+        const auto& b = scales[i + 1];
+        j.begin_object()
+            .field("from_area_ratio", a.ratio)
+            .field("to_area_ratio", b.ratio)
+            .field("mean_parent_share", segment::mean_parent_share(result.lineage[i]));
+        j.key("regions").begin_array();
+        for (const auto& r : result.lineage[i]) {
+            j.begin_object()
+                .field("region", static_cast<std::int64_t>(r.region))
+                .field("area_m2", r.area_m2)
+                .field("parent", static_cast<std::int64_t>(r.parent))
+                .field("parent_share", r.parent_share);
+            j.key("overlaps").begin_array();
+            for (const auto& o : r.overlaps)
+                j.begin_object()
+                    .field("region", static_cast<std::int64_t>(o.region))
+                    .field("area_m2", o.area_m2)
+                    .field("fraction", o.fraction)
+                    .end_object();
             j.end_array().end_object();
         }
         j.end_array().end_object();
-        os.flush();
-        if (!os) throw Error("write", "cannot write lineage.json");
-        files.push_back("lineage.json");
     }
-    // sweep.csv and sweep.png.
+    j.end_array().end_object();
+    os.flush();
+    if (!os) throw Error("write", "cannot write lineage.json");
+}
+
+// sweep.csv and sweep.png: each scale's regions, critical nodes and mean region area.
+void write_sweep_table(const std::vector<SweepScale>& scales, const std::string& d, bool by_area,
+                       std::vector<std::string>& files) {
     std::vector<double> xs, counts, means;
     std::string csv = std::string(
                           "area_ratio_percent,regions,critical_nodes,mean_region_area_m2,"
@@ -348,14 +339,10 @@ std::vector<std::string> write_sweep_directory(SweepResult& result, const Segmen
     files.push_back("sweep.csv");
     io::write_sweep_plot(xs, counts, means, d + "sweep.png", false);
     files.push_back("sweep.png");
-    base.add_time("write", since(w0));
+}
 
-    // run.json: the last scale stands in for the one-segmentation fields; every scale listed.
-    if (!scales.empty()) {
-        base.segmentation.region_count = scales.back().segmentation.region_count;
-        base.segmentation.relaxed_nodes = scales.back().segmentation.relaxed_nodes;
-        base.after = scales.back().after;
-    }
+// run.json's "scales": each scale's ratio (and minimum area), regions, nodes and time.
+std::string per_scale_json(const std::vector<SweepScale>& scales, bool by_area) {
     std::string per_scale = "[";
     for (std::size_t i = 0; i < scales.size(); ++i) {
         const auto& s = scales[i];
@@ -370,6 +357,49 @@ std::vector<std::string> write_sweep_directory(SweepResult& result, const Segmen
                      ",\"seconds\":" + JsonWriter::number(s.seconds) + "}";
     }
     per_scale += "]";
+    return per_scale;
+}
+
+}  // namespace
+
+std::vector<std::string> write_sweep_directory(SweepResult& result, const SegmentOptions& options,
+                                               const std::string& input_path,
+                                               const std::string& dir_path,
+                                               const ProgressFn& progress) {
+    auto& base = result.base;
+    const auto& scales = result.scales;
+    const std::string d = dir_path + "/";
+    const auto w0 = clock::now();
+    release_free_memory();  // (freed blocks a program keeps: GDAL's block cache comes next)
+    std::vector<std::string> files;
+    const Dem* dem = base.dem();
+    const bool by_area = !scales.empty() && scales.front().min_area_m2 > 0;
+    if (dem) {
+        write_scale_maps(result, *dem, dir_path, files, progress);
+    } else {
+        for (const auto& s : scales) {
+            io::write_faces_seg(base.input.mesh, s.segmentation.labels,
+                                d + "faces_" + s.name + ".seg", false);
+            files.push_back("faces_" + s.name + ".seg");
+        }
+    }
+    report_progress(progress, 0.7);
+    for (const auto& s : scales) {
+        io::write_adjacency_json(s.regions, d + "adjacency_" + s.name + ".json", false);
+        files.push_back("adjacency_" + s.name + ".json");
+    }
+    write_lineage_json(result, d + "lineage.json", by_area, dem != nullptr);
+    files.push_back("lineage.json");
+    write_sweep_table(scales, d, by_area, files);
+    base.add_time("write", since(w0));
+
+    // run.json: the last scale stands in for the one-segmentation fields; every scale listed.
+    if (!scales.empty()) {
+        base.segmentation.region_count = scales.back().segmentation.region_count;
+        base.segmentation.relaxed_nodes = scales.back().segmentation.relaxed_nodes;
+        base.after = scales.back().after;
+    }
+    const std::string per_scale = per_scale_json(scales, by_area);
     SegmentOptions recorded = options;
     recorded.min_area.clear();
     if (!scales.empty()) {

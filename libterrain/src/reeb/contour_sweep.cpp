@@ -70,7 +70,20 @@ class Sweep {
 
     void process_event(i32 e, i32 begin, i32 end);
     bool try_regular(i32 e, i32 v);
+    // An event general_event handles in six steps: the event's star (every triangle with a
+    // corner in it, once, sorted), the contours entering it and their boundary ends inside the
+    // star (and the node's links), the segments of the star's new mixed triangles and their
+    // ends, every end settled (walked in lockstep), the groups of segments joined through
+    // paired ends, and the new contours.
     void general_event(i32 e, i32 begin, i32 end);
+    void event_star(i32 e, i32 begin, i32 end);
+    void incoming_contours(i32 e);
+    void event_segments(i32 e);
+    void settle_ends(i32 e);
+    void join_groups(i32 e);
+    void new_contours(i32 e);
+    // A piece is walked when one of its ends completed it.
+    bool piece_done(const End& en) const;
 
     bool processed(i32 v, i32 e) const { return g_.vertex_nodes[idx(v)] <= e; }
     bool in_event(i32 t, i32 e) const {
@@ -283,7 +296,7 @@ void Sweep::deduce(i32 label) {
     }
 }
 
-void Sweep::general_event(i32 e, i32 begin, i32 end) {
+void Sweep::event_star(i32 e, i32 begin, i32 end) {
     // 1. The star of the event: every triangle with a corner in it, once.
     star_.clear();
     for (i32 i = begin; i < end; ++i) {
@@ -304,10 +317,9 @@ void Sweep::general_event(i32 e, i32 begin, i32 end) {
         }
     }
     std::sort(star_.begin(), star_.end());
-    auto star_index = [&](i32 t) {
-        return static_cast<i32>(std::lower_bound(star_.begin(), star_.end(), t) - star_.begin());
-    };
+}
 
+void Sweep::incoming_contours(i32 e) {
     // 2. Contours entering the event (before it is processed) and their boundary ends inside
     //    the star; the link components for the node's classification.
     d_in_.clear();
@@ -333,13 +345,17 @@ void Sweep::general_event(i32 e, i32 begin, i32 end) {
         }
     }
     set_links(g_, e, links_.count(mesh_, g_, e, star_));
+}
 
+void Sweep::event_segments(i32 e) {
+    auto star_index = [&](i32 t) {
+        return static_cast<i32>(std::lower_bound(star_.begin(), star_.end(), t) - star_.begin());
+    };
     // 3. The event is processed from here on. Segments: new mixed triangles of the star joined
     //    across active edges; their exits into the old contours are the ends.
     const std::size_t ns = star_.size();
     segments_.reset_empty(ns);
     seg_bnd_.assign(ns, 0);
-    auto seg_root = [&](i32 x) { return segments_.find(x); };
     auto in_segment = [&](std::size_t i) { return segments_.contains(static_cast<i32>(i)); };
     for (std::size_t i = 0; i < ns; ++i) {
         const auto& tri = mesh_.triangles[idx(star_[i])];
@@ -375,7 +391,9 @@ void Sweep::general_event(i32 e, i32 begin, i32 end) {
         }
     }
     std::sort(end_index_.begin(), end_index_.end());
+}
 
+void Sweep::settle_ends(i32 e) {
     // 4. Settle every end: walk all open ones in lockstep, deducing what counting allows.
     for (const auto& lc : label_counts_) deduce(lc.label);
     for (bool open = true; open;) {
@@ -407,7 +425,14 @@ void Sweep::general_event(i32 e, i32 begin, i32 end) {
             open = true;
         }
     }
+}
 
+bool Sweep::piece_done(const End& en) const {
+    return en.complete || (en.state == 1 && ends_[idx(en.partner)].complete);
+}
+
+void Sweep::join_groups(i32 e) {
+    auto seg_root = [&](i32 x) { return segments_.find(x); };
     // 5. Groups: segments joined through paired ends. Each group is one new contour.
     for (const auto& en : ends_) {
         if (en.state != 1) continue;
@@ -415,9 +440,6 @@ void Sweep::general_event(i32 e, i32 begin, i32 end) {
     }
     // A piece is walked when one of its ends completed it; a label whose unwalked pieces lie in
     // several groups has all but one group's pieces walked to the end (lockstep again).
-    auto piece_done = [&](const End& en) {
-        return en.complete || (en.state == 1 && ends_[idx(en.partner)].complete);
-    };
     for (const i32 label : d_in_) {
         for (;;) {
             i32 group = kNone;
@@ -443,7 +465,12 @@ void Sweep::general_event(i32 e, i32 begin, i32 end) {
             }
         }
     }
+}
 
+void Sweep::new_contours(i32 e) {
+    const std::size_t ns = star_.size();
+    auto seg_root = [&](i32 x) { return segments_.find(x); };
+    auto in_segment = [&](std::size_t i) { return segments_.contains(static_cast<i32>(i)); };
     // 6. New contours: a group keeps the ids of the old contours whose unwalked pieces it holds
     //    (merged by union), or gets a new id; walked pieces and new triangles are relabelled.
     const bool regular = d_in_.size() == 1 && [&] {
@@ -498,6 +525,15 @@ void Sweep::general_event(i32 e, i32 begin, i32 end) {
     g_.node_kinds[idx(e)] = d_down == 0   ? NodeKind::minimum
                             : groups == 0 ? NodeKind::maximum
                                           : NodeKind::saddle;
+}
+
+void Sweep::general_event(i32 e, i32 begin, i32 end) {
+    event_star(e, begin, end);
+    incoming_contours(e);
+    event_segments(e);
+    settle_ends(e);
+    join_groups(e);
+    new_contours(e);
 }
 
 void Sweep::finish_graph() {

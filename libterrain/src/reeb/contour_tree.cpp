@@ -100,201 +100,209 @@ bool loop_free_by_components(const TriangleMesh& mesh, const ProgressFn& progres
     return true;
 }
 
-bool contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& progress,
-                  const ArrayParking& parking) {
-    const std::size_t nn = g.node_count();
-    g.node_lower_links.assign(nn, 1);
-    g.node_upper_links.assign(nn, 1);
-    std::vector<char> general;
-    std::vector<LinkReps> reps = link_components(mesh, g, g.node_lower_links, g.node_upper_links,
-                                                 general, scaled_progress(progress, 0.2, 0.3));
-    // A node whose link a sweep reads vertex by vertex (kSeveral on a side: a plateau, more
-    // than two link components, a vertex of very high degree; few on a terrain) has the nodes
-    // around it listed here, in the order the sweep reads them (its vertices', each one's
-    // neighbours' in order), and their list's number in the second representative of such a
-    // side. The sweeps then read neither the graph's vertex lists, its vertices' nodes nor the
-    // mesh, and the caller may park the first two through them.
-    std::vector<std::size_t> around_offsets(1, 0);
-    std::vector<i32> around;
-    for (std::size_t e = 0; e < nn; ++e) {
+namespace {
+
+// The nodes around each node whose link a sweep reads vertex by vertex (kSeveral on a side:
+// a plateau, more than two link components, a vertex of very high degree; few on a
+// terrain), in the order the sweep reads them (its vertices', each one's neighbours' in
+// order); list l is nodes[offsets[l] .. offsets[l + 1]), and its number is in the second
+// representative of such a side. The sweeps then read neither the graph's vertex lists, its
+// vertices' nodes nor the mesh, and the caller may park the first two through them.
+struct NodesAround {
+    std::vector<std::size_t> offsets{0};
+    std::vector<i32> nodes;
+};
+
+NodesAround nodes_around(const TriangleMesh& mesh, const ReebGraph& g,
+                         std::vector<LinkReps>& reps) {
+    NodesAround out;
+    for (std::size_t e = 0; e < g.node_count(); ++e) {
         LinkReps& r = reps[e];
         if (r.lower[0] != kSeveral && r.upper[0] != kSeveral) continue;
-        const auto list = static_cast<i32>(around_offsets.size() - 1);
+        const auto list = static_cast<i32>(out.offsets.size() - 1);
         if (r.lower[0] == kSeveral) r.lower[1] = list;
         if (r.upper[0] == kSeveral) r.upper[1] = list;
         for (i32 i = g.node_vertex_offsets[e]; i < g.node_vertex_offsets[e + 1]; ++i)
             for (const i32 w : mesh.neighbors_of(idx(g.node_vertices[idx(i)])))
-                around.push_back(g.vertex_nodes[idx(w)]);
-        around_offsets.push_back(around.size());
+                out.nodes.push_back(g.vertex_nodes[idx(w)]);
+        out.offsets.push_back(out.nodes.size());
     }
-    const bool park_floats = parking.park_floats && parking.restore_floats,
-               park_own = parking.park_own && parking.restore_own;
-    if (parking.on()) {
-        parking.park(g.node_vertices);
-        parking.park(g.node_vertex_offsets);
-        parking.park(g.vertex_nodes);
-        if (park_floats) parking.park_floats(g.node_values);
-        if (park_own) parking.park_own();
-    }
+    return out;
+}
 
-    // Each event's parent in the join tree (below it) and in the split tree (above it).
+// The join tree and the split tree: each event's parent in the join tree (below it) and in
+// the split tree (above it), and its children in each.
+struct JoinSplitTrees {
+    std::vector<i32> join_parent, split_parent;
+    std::vector<std::array<i32, 2>> children;  // (join, split)
+};
+
+// One union-find sweep over the components of the part swept so far (the sublevel set for
+// the join tree, the superlevel set for the split tree). A node's entry holds its parent,
+// or (at a root) minus one minus its rank, and the last event added to its component (the
+// component's head, where the next event joining it hangs in the tree). Union by rank with
+// the head beside the link, in one record: not detail::DisjointSets, on the hottest path.
+// Most events have one link component below (above): one find, and the event hangs under
+// the root. The join (ascending) and split (descending) sweeps are independent: they run
+// side by side, each with its own records (8 bytes a node) and its own side of `children`
+// (side by side they take about the time of one). The 12 bytes a node this holds more
+// than one sweep at a time are the arrays parked through them (contour_tree).
+struct Entry {
+    i32 up, head;
+};
+
+// Progress: the events both sweeps have passed, counted together, reported (0.3 to 0.6)
+// only from the caller's thread (the callback may not be called from another). Either
+// sweep may run there, or both one after the other in either order: the count is what
+// keeps the fraction from going back.
+struct SweepProgress {
+    const ProgressFn& progress;
+    std::thread::id caller = std::this_thread::get_id();
+    std::atomic<std::size_t> swept_events{0};
+    std::size_t nn = 0;
+    double fraction(std::size_t events) const {
+        return 0.3 + 0.3 * double(events) / double(std::max<std::size_t>(1, 2 * nn));
+    }
+};
+
+void sweep(bool ascending, const std::vector<LinkReps>& reps, const NodesAround& around_lists,
+           SweepProgress& swept_progress, std::vector<i32>& tree_parent,
+           std::vector<std::array<i32, 2>>& children, std::vector<Entry>& swept) {
+    const std::size_t nn = reps.size();
+    const std::vector<std::size_t>& around_offsets = around_lists.offsets;
+    const std::vector<i32>& around = around_lists.nodes;
+    const ProgressFn& progress = swept_progress.progress;
+    const std::size_t side = ascending ? 0 : 1;
+    const bool reports = progress && std::this_thread::get_id() == swept_progress.caller;
+    const auto passed = [&](std::size_t k) {
+        constexpr std::size_t kStep = std::size_t{1} << 18;
+        if ((k & (kStep - 1)) != kStep - 1) return;
+        const std::size_t all = swept_progress.swept_events.fetch_add(kStep) + kStep;
+        if (reports)
+            report_progress(progress, swept_progress.fraction(all), "reeb: join and split trees");
+    };
+    auto find = [&](i32 x) {
+        i32 r = x;
+        while (swept[idx(r)].up >= 0) r = swept[idx(r)].up;
+        while (x != r) {
+            const i32 nx = swept[idx(x)].up;
+            swept[idx(x)].up = r;
+            x = nx;
+        }
+        return r;
+    };
+    auto reps_at = [&](std::size_t k) -> const std::array<i32, 2>& {
+        return ascending ? reps[k].lower : reps[nn - 1 - k].upper;
+    };
+    // Paths are short: two steps up without branching, then the rare longer path.
+    auto find_short = [&](i32 x) {
+        const i32 ux = swept[idx(x)].up;
+        const i32 b = ux >= 0 ? ux : x;
+        const i32 ub = swept[idx(b)].up;
+        i32 c = ub >= 0 ? ub : b;
+        if (swept[idx(c)].up >= 0) [[unlikely]]
+            c = find(c);
+        swept[idx(x)].up = ux >= 0 ? c : ux;
+        return c;
+    };
+    // The sweep waits on memory: the entries of the representatives a few events ahead
+    // are fetched early (and, from those, their parents').
+    constexpr std::size_t kAhead = 16;
+    auto prefetch = [&](i32 x) { __builtin_prefetch(&swept[idx(x >= 0 && idx(x) < nn ? x : 0)]); };
+    // Component c (a root) joins the component of event e whose root is cur, by rank (the
+    // higher rank has the lower `up`); returns the new root.
+    auto join = [&](i32 cur, i32 c, i32 e) {
+        tree_parent[idx(swept[idx(c)].head)] = e;
+        ++children[idx(e)][side];
+        const bool cur_higher = swept[idx(cur)].up <= swept[idx(c)].up;
+        const i32 hi = cur_higher ? cur : c, lo = cur_higher ? c : cur;
+        if (swept[idx(hi)].up == swept[idx(lo)].up) --swept[idx(hi)].up;
+        swept[idx(lo)].up = hi;
+        swept[idx(hi)].head = e;
+        return hi;
+    };
+    std::vector<i32> roots;
+    for (std::size_t k = 0; k < nn; ++k) {
+        passed(k);
+        if (k + kAhead < nn) {
+            const auto& r = reps_at(k + kAhead);
+            prefetch(r[0]);
+            prefetch(r[1]);
+        }
+        if (k + kAhead / 2 < nn) {
+            const auto& r = reps_at(k + kAhead / 2);
+            if (r[0] >= 0) prefetch(swept[idx(r[0])].up);
+            if (r[1] >= 0) prefetch(swept[idx(r[1])].up);
+        }
+        const i32 e = static_cast<i32>(ascending ? k : nn - 1 - k);
+        const auto& rep = reps_at(k);
+        if (rep[0] >= 0) {
+            // The event hangs under the component of its first link component.
+            const i32 c = find_short(rep[0]);
+            Entry& root = swept[idx(c)];
+            tree_parent[idx(root.head)] = e;
+            children[idx(e)][side] = 1;
+            swept[idx(e)].up = c;
+            root.head = e;
+            root.up -= root.up == -1;  // rank 0 -> 1
+            if (rep[1] < 0) continue;
+            const i32 o = find_short(rep[1]);
+            if (o != c) join(c, o, e);  // a second component joins here
+            continue;
+        }
+        swept[idx(e)] = {-1, e};
+        children[idx(e)][side] = 0;
+        if (rep[0] == kNone) continue;
+        roots.clear();
+        const std::size_t list = idx(rep[1]);  // (rep[0] is kSeveral)
+        for (std::size_t i = around_offsets[list]; i < around_offsets[list + 1]; ++i) {
+            const i32 n = around[i];
+            if (ascending ? n >= e : n <= e) continue;
+            const i32 c = find(n);
+            if (std::find(roots.begin(), roots.end(), c) == roots.end()) roots.push_back(c);
+        }
+        i32 cur = e;
+        for (const i32 c : roots) cur = join(cur, c, e);
+    }
+}
+
+// The join and split trees of the events in order, the two sweeps side by side; progress
+// 0.3 to 0.6.
+JoinSplitTrees join_and_split_trees(const std::vector<LinkReps>& reps, const NodesAround& around,
+                                    const ProgressFn& progress) {
+    const std::size_t nn = reps.size();
     // (Large blocks made a slice at a time, the sweeps' own too: their first touch is slow,
     // docs/performance.md. The sweeps' progress starts at 0.3.)
-    const auto made = [&](double from) {
-        return detail::PassProgress(progress, from, from, "reeb: join and split trees");
+    const auto made = [&] {
+        return detail::PassProgress(progress, 0.3, 0.3, "reeb: join and split trees");
     };
-    std::vector<i32> join_parent, split_parent;
-    detail::assign_in_slices(join_parent, nn, kNone, made(0.3));
-    detail::assign_in_slices(split_parent, nn, kNone, made(0.3));
+    JoinSplitTrees trees;
+    detail::assign_in_slices(trees.join_parent, nn, kNone, made());
+    detail::assign_in_slices(trees.split_parent, nn, kNone, made());
     // Children in the join and split trees. The sweeps run in opposite directions, so they
     // share cache lines only where they cross.
-    std::vector<std::array<i32, 2>> children;
-    detail::assign_in_slices(children, nn, std::array<i32, 2>{}, made(0.3));
-    // One union-find sweep over the components of the part swept so far (the sublevel set for
-    // the join tree, the superlevel set for the split tree). A node's entry holds its parent,
-    // or (at a root) minus one minus its rank, and the last event added to its component (the
-    // component's head, where the next event joining it hangs in the tree). Union by rank with
-    // the head beside the link, in one record: not detail::DisjointSets, on the hottest path.
-    // Most events have one link component below (above): one find, and the event hangs under
-    // the root. The join (ascending) and split (descending) sweeps are independent: they run
-    // side by side, each with its own records (8 bytes a node) and its own side of `children`
-    // (side by side they take about the time of one). The 12 bytes a node this holds more
-    // than one sweep at a time are the arrays parked through them (above).
-    struct Entry {
-        i32 up, head;
-    };
-    // Progress: the events both sweeps have passed, counted together, reported (0.3 to 0.6)
-    // only from the caller's thread (the callback may not be called from another). Either
-    // sweep may run there, or both one after the other in either order: the count is what
-    // keeps the fraction from going back.
-    const auto caller = std::this_thread::get_id();
-    std::atomic<std::size_t> swept_events{0};
-    const auto swept_fraction = [&](std::size_t events) {
-        return 0.3 + 0.3 * double(events) / double(std::max<std::size_t>(1, 2 * nn));
-    };
-    auto sweep = [&](bool ascending, std::vector<i32>& tree_parent, std::vector<Entry>& swept) {
-        const std::size_t side = ascending ? 0 : 1;
-        const bool reports = progress && std::this_thread::get_id() == caller;
-        const auto passed = [&](std::size_t k) {
-            constexpr std::size_t kStep = std::size_t{1} << 18;
-            if ((k & (kStep - 1)) != kStep - 1) return;
-            const std::size_t all = swept_events.fetch_add(kStep) + kStep;
-            if (reports)
-                report_progress(progress, swept_fraction(all), "reeb: join and split trees");
-        };
-        auto find = [&](i32 x) {
-            i32 r = x;
-            while (swept[idx(r)].up >= 0) r = swept[idx(r)].up;
-            while (x != r) {
-                const i32 nx = swept[idx(x)].up;
-                swept[idx(x)].up = r;
-                x = nx;
-            }
-            return r;
-        };
-        auto reps_at = [&](std::size_t k) -> const std::array<i32, 2>& {
-            return ascending ? reps[k].lower : reps[nn - 1 - k].upper;
-        };
-        // Paths are short: two steps up without branching, then the rare longer path.
-        auto find_short = [&](i32 x) {
-            const i32 ux = swept[idx(x)].up;
-            const i32 b = ux >= 0 ? ux : x;
-            const i32 ub = swept[idx(b)].up;
-            i32 c = ub >= 0 ? ub : b;
-            if (swept[idx(c)].up >= 0) [[unlikely]]
-                c = find(c);
-            swept[idx(x)].up = ux >= 0 ? c : ux;
-            return c;
-        };
-        // The sweep waits on memory: the entries of the representatives a few events ahead
-        // are fetched early (and, from those, their parents').
-        constexpr std::size_t kAhead = 16;
-        auto prefetch = [&](i32 x) {
-            __builtin_prefetch(&swept[idx(x >= 0 && idx(x) < nn ? x : 0)]);
-        };
-        // Component c (a root) joins the component of event e whose root is cur, by rank (the
-        // higher rank has the lower `up`); returns the new root.
-        auto join = [&](i32 cur, i32 c, i32 e) {
-            tree_parent[idx(swept[idx(c)].head)] = e;
-            ++children[idx(e)][side];
-            const bool cur_higher = swept[idx(cur)].up <= swept[idx(c)].up;
-            const i32 hi = cur_higher ? cur : c, lo = cur_higher ? c : cur;
-            if (swept[idx(hi)].up == swept[idx(lo)].up) --swept[idx(hi)].up;
-            swept[idx(lo)].up = hi;
-            swept[idx(hi)].head = e;
-            return hi;
-        };
-        std::vector<i32> roots;
-        for (std::size_t k = 0; k < nn; ++k) {
-            passed(k);
-            if (k + kAhead < nn) {
-                const auto& r = reps_at(k + kAhead);
-                prefetch(r[0]);
-                prefetch(r[1]);
-            }
-            if (k + kAhead / 2 < nn) {
-                const auto& r = reps_at(k + kAhead / 2);
-                if (r[0] >= 0) prefetch(swept[idx(r[0])].up);
-                if (r[1] >= 0) prefetch(swept[idx(r[1])].up);
-            }
-            const i32 e = static_cast<i32>(ascending ? k : nn - 1 - k);
-            const auto& rep = reps_at(k);
-            if (rep[0] >= 0) {
-                // The event hangs under the component of its first link component.
-                const i32 c = find_short(rep[0]);
-                Entry& root = swept[idx(c)];
-                tree_parent[idx(root.head)] = e;
-                children[idx(e)][side] = 1;
-                swept[idx(e)].up = c;
-                root.head = e;
-                root.up -= root.up == -1;  // rank 0 -> 1
-                if (rep[1] < 0) continue;
-                const i32 o = find_short(rep[1]);
-                if (o != c) join(c, o, e);  // a second component joins here
-                continue;
-            }
-            swept[idx(e)] = {-1, e};
-            children[idx(e)][side] = 0;
-            if (rep[0] == kNone) continue;
-            roots.clear();
-            const std::size_t list = idx(rep[1]);  // (rep[0] is kSeveral)
-            for (std::size_t i = around_offsets[list]; i < around_offsets[list + 1]; ++i) {
-                const i32 n = around[i];
-                if (ascending ? n >= e : n <= e) continue;
-                const i32 c = find(n);
-                if (std::find(roots.begin(), roots.end(), c) == roots.end()) roots.push_back(c);
-            }
-            i32 cur = e;
-            for (const i32 c : roots) cur = join(cur, c, e);
-        }
-    };
-    {
-        // (Whichever sweep runs on the caller's thread reports the progress of both.)
-        std::vector<Entry> joined, split;
-        detail::assign_in_slices(joined, nn, Entry{-1, 0}, made(0.3));
-        detail::assign_in_slices(split, nn, Entry{-1, 0}, made(0.3));
-        tbb::task_group both;
-        both.run([&] { sweep(false, split_parent, split); });
-        sweep(true, join_parent, joined);
-        both.wait();
-    }
-    detail::release(reps);  // (16 bytes a node: what the arcs below are made beside)
-    detail::release(around);
-    detail::release(around_offsets);
-    if (parking.on()) {
-        if (park_own) parking.restore_own();
-        if (park_floats) parking.restore_floats(g.node_values);
-        parking.restore(g.vertex_nodes);
-        parking.restore(g.node_vertex_offsets);
-        parking.restore(g.node_vertices);
-    }
-    const auto components = std::count(join_parent.begin(), join_parent.end(), kNone);
-    if (components == 1 ? !one_component_loop_free(mesh) : !loop_free_by_components(mesh))
-        return false;
-    report_progress(progress, 0.6, "reeb: join and split trees");
+    detail::assign_in_slices(trees.children, nn, std::array<i32, 2>{}, made());
+    SweepProgress swept{progress};
+    swept.nn = nn;
+    // (Whichever sweep runs on the caller's thread reports the progress of both.)
+    std::vector<Entry> joined, split;
+    detail::assign_in_slices(joined, nn, Entry{-1, 0}, made());
+    detail::assign_in_slices(split, nn, Entry{-1, 0}, made());
+    tbb::task_group both;
+    both.run([&] { sweep(false, reps, around, swept, trees.split_parent, trees.children, split); });
+    sweep(true, reps, around, swept, trees.join_parent, trees.children, joined);
+    both.wait();
+    return trees;
+}
 
-    // Merge: remove leaves one by one; each removal is one edge of the augmented tree. A
-    // removed node's join-children count is set to -1; attach[x] = 2 * y + (x was below y).
+// Merge: remove leaves one by one; each removal is one edge of the augmented tree. A
+// removed node's join-children count is set to -1. Returns attach: attach[x] = 2 * y + (x
+// was below y), kNone for the last node; progress 0.6 to 0.75.
+std::vector<i32> merge_trees(JoinSplitTrees& trees, const ProgressFn& progress) {
+    auto& children = trees.children;
+    auto& join_parent = trees.join_parent;
+    auto& split_parent = trees.split_parent;
+    const std::size_t nn = children.size();
     auto dead = [&](i32 x) { return children[idx(x)][0] < 0; };
     auto next_alive = [&](std::vector<i32>& parent, i32 x) {
         i32 p = parent[idx(x)];
@@ -348,9 +356,16 @@ bool contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& prog
     detail::release(join_parent);
     detail::release(split_parent);
     report_progress(progress, 0.75, "reeb: contour tree");
+    return attach;
+}
 
-    // Up-edges per node (CSR, in the order of the removed leaves' indices), and down degrees.
-    std::vector<i32> up_off, up_to, down_deg;
+// The tree's edges (x, attach[x] >> 1) as up-edges per node (CSR, in the order of the
+// removed leaves' indices, up_off and up_to) and the node kinds from the degrees; progress
+// 0.75 to 0.825.
+void tree_edges(ReebGraph& g, const std::vector<i32>& attach, std::vector<i32>& up_off,
+                std::vector<i32>& up_to, const ProgressFn& progress) {
+    const std::size_t nn = attach.size();
+    std::vector<i32> down_deg;
     const auto arcs_made = [&](double from) {
         return detail::PassProgress(progress, from, from, "reeb: arcs");
     };
@@ -398,13 +413,26 @@ bool contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& prog
             }
         });
     detail::release(down_deg);  // (the kinds are known: read no more)
+}
+
+// The arcs from the tree's edges: chains of regular nodes between critical nodes, each
+// node's arc and each arc's nodes; progress 0.825 to 0.9. `below` is attach, reused.
+void arcs_from_edges(ReebGraph& g, std::vector<i32>& below, std::vector<i32>& up_off,
+                     std::vector<i32>& up_to, const ProgressFn& progress) {
+    const std::size_t nn = below.size();
+    const auto arcs_made = [&](double from) {
+        return detail::PassProgress(progress, from, from, "reeb: arcs");
+    };
+    const auto span = [&](double from, double to) {
+        return detail::PassProgress(progress, from, to, "reeb: arcs");
+    };
+    constexpr std::size_t kGrain = std::size_t{1} << 14;  // the passes in parallel
     // Arcs in the order of their lower nodes, then of their up-edges: a critical node's first
     // arc is the number of up-edges of the critical nodes before it (held in node_arcs until
     // the regular nodes take their arcs there). A regular node takes the arc of the edge
     // below it; `below` holds that edge as the regular node under it, or as -2 - arc when the
     // edge leaves a critical node.
     auto critical = [&](i32 n) { return g.node_kinds[idx(n)] != NodeKind::regular; };
-    std::vector<i32>& below = attach;  // attach is no longer needed
     detail::assign_in_slices(g.node_arcs, nn, kNone, arcs_made(0.825));
     std::size_t arc_count = 0;
     const auto counted = span(0.825, 0.835);
@@ -467,7 +495,7 @@ bool contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& prog
                                 }
                             });
     // (The tree's edges are arcs now: 12 bytes a node less beside the arcs' lists.)
-    detail::release(attach);
+    detail::release(below);
     detail::release(up_off);
     detail::release(up_to);
     const auto arc_of = [&](std::size_t n) -> std::int64_t { return g.node_arcs[n]; };
@@ -477,6 +505,48 @@ bool contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& prog
     detail::place_by_key_parts(
         nn, g.arc_offsets, span(0.885, 0.9), arc_of,
         [&](std::size_t n, std::size_t slot) { g.arc_nodes[slot] = static_cast<i32>(n); });
+}
+
+}  // namespace
+
+bool contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& progress,
+                  const ArrayParking& parking) {
+    const std::size_t nn = g.node_count();
+    g.node_lower_links.assign(nn, 1);
+    g.node_upper_links.assign(nn, 1);
+    std::vector<char> general;
+    std::vector<LinkReps> reps = link_components(mesh, g, g.node_lower_links, g.node_upper_links,
+                                                 general, scaled_progress(progress, 0.2, 0.3));
+    NodesAround around = nodes_around(mesh, g, reps);
+    const bool park_floats = parking.park_floats && parking.restore_floats,
+               park_own = parking.park_own && parking.restore_own;
+    if (parking.on()) {
+        parking.park(g.node_vertices);
+        parking.park(g.node_vertex_offsets);
+        parking.park(g.vertex_nodes);
+        if (park_floats) parking.park_floats(g.node_values);
+        if (park_own) parking.park_own();
+    }
+
+    JoinSplitTrees trees = join_and_split_trees(reps, around, progress);
+    detail::release(reps);  // (16 bytes a node: what the arcs below are made beside)
+    detail::release(around.nodes);
+    detail::release(around.offsets);
+    if (parking.on()) {
+        if (park_own) parking.restore_own();
+        if (park_floats) parking.restore_floats(g.node_values);
+        parking.restore(g.vertex_nodes);
+        parking.restore(g.node_vertex_offsets);
+        parking.restore(g.node_vertices);
+    }
+    const auto components = std::count(trees.join_parent.begin(), trees.join_parent.end(), kNone);
+    if (components == 1 ? !one_component_loop_free(mesh) : !loop_free_by_components(mesh))
+        return false;
+    report_progress(progress, 0.6, "reeb: join and split trees");
+    std::vector<i32> attach = merge_trees(trees, progress);
+    std::vector<i32> up_off, up_to;
+    tree_edges(g, attach, up_off, up_to, progress);
+    arcs_from_edges(g, attach, up_off, up_to, progress);
     report_progress(progress, 0.9, "reeb: arcs");
     count_general_links(mesh, g, general, scaled_progress(progress, 0.9, 1));
     return true;

@@ -43,13 +43,38 @@ inline float key_float(std::uint32_t k) {
     return std::bit_cast<float>((k & 0x80000000u) ? (k & 0x7fffffffu) : ~k);
 }
 
-}  // namespace
+// The vertices' fixed chunks: f(chunk, first, end) for every chunk, kGroup chunks at a time
+// in parallel; the progress from `from` to `to` after each group (a pass over a global grid
+// takes seconds).
+struct Chunks {
+    std::size_t nv;
+    const ProgressFn& progress;
+    std::size_t begin(std::size_t c) const { return nv * c / kChunks; }
+    template <class F>
+    void each(double from, double to, F&& f) const {
+        for (std::size_t group = 0; group < kChunks; group += kGroup) {
+            tbb::parallel_for(tbb::blocked_range<std::size_t>(group, group + kGroup, 1),
+                              [&](const tbb::blocked_range<std::size_t>& r) {
+                                  for (std::size_t c = r.begin(); c < r.end(); ++c)
+                                      f(c, begin(c), begin(c + 1));
+                              });
+            report_progress(progress, from + (to - from) * double(group + kGroup) / kChunks,
+                            "reeb: order");
+        }
+    }
+};
 
-void order_events(const TriangleMesh& mesh, const std::vector<float>& field, ReebGraph& g,
-                  const ProgressFn& progress) {
+bool same_value(std::uint64_t a, std::uint64_t b) {
+    return (a >> 32) == (b >> 32);
+}
+i32 vertex(std::uint64_t k) {
+    return static_cast<i32>(k & 0xffffffffu);
+}
+
+// The sort keys (value bits << 32 | vertex) of the field in order; progress 0 to 0.6.
+std::vector<std::uint64_t> sorted_keys(const std::vector<float>& field, const Chunks& chunks) {
     const std::size_t nv = field.size();
-    // Its passes: the keys (0 to 0.15), three radix passes (to 0.6), the ties (to 0.65), the
-    // plateaus (to 0.75), the runs of equal values (to 0.8), the nodes (to 1).
+    const ProgressFn& progress = chunks.progress;
     using detail::PassProgress;
     // Stable LSD radix sort of (value bits << 32 | vertex) on the value bits, 11 bits per
     // pass: ties keep vertex order. Each pass in parallel over fixed chunks of the array: a
@@ -61,20 +86,7 @@ void order_events(const TriangleMesh& mesh, const std::vector<float>& field, Ree
                              PassProgress(progress, 0, 0.05, "reeb: order"));
     detail::assign_in_slices(tmp, nv, std::uint64_t{0},
                              PassProgress(progress, 0.05, 0.1, "reeb: order"));
-    const auto chunk_begin = [nv](std::size_t c) { return nv * c / kChunks; };
-    // f(chunk, first, end) for every chunk, kGroup chunks at a time in parallel; the progress
-    // from `from` to `to` after each group (a pass over a global grid takes seconds).
-    const auto each_chunk = [&](double from, double to, auto&& f) {
-        for (std::size_t group = 0; group < kChunks; group += kGroup) {
-            tbb::parallel_for(tbb::blocked_range<std::size_t>(group, group + kGroup, 1),
-                              [&](const tbb::blocked_range<std::size_t>& r) {
-                                  for (std::size_t c = r.begin(); c < r.end(); ++c)
-                                      f(c, chunk_begin(c), chunk_begin(c + 1));
-                              });
-            report_progress(progress, from + (to - from) * double(group + kGroup) / kChunks,
-                            "reeb: order");
-        }
-    };
+    const auto each_chunk = [&](double from, double to, auto&& f) { chunks.each(from, to, f); };
     each_chunk(0.1, 0.15, [&](std::size_t, std::size_t first, std::size_t end) {
         for (std::size_t v = first; v < end; ++v)
             keys[v] = (std::uint64_t{float_key(field[v])} << 32) | v;
@@ -111,8 +123,16 @@ void order_events(const TriangleMesh& mesh, const std::vector<float>& field, Ree
         keys.swap(tmp);
     }
     detail::release(tmp);
-    auto same_value = [](std::uint64_t a, std::uint64_t b) { return (a >> 32) == (b >> 32); };
-    auto vertex = [](std::uint64_t k) { return static_cast<i32>(k & 0xffffffffu); };
+    return keys;
+}
+
+// Each vertex's plateau (adjacent vertices of equal value), its representative (the root)
+// its lowest vertex; empty when there is none. Progress 0.6 to 0.74.
+detail::DisjointSets<i32> plateaus_of(const TriangleMesh& mesh, const std::vector<float>& field,
+                                      const std::vector<std::uint64_t>& keys,
+                                      const Chunks& chunks) {
+    const std::size_t nv = field.size();
+    const auto each_chunk = [&](double from, double to, auto&& f) { chunks.each(from, to, f); };
     // Plateaus: adjacent vertices of equal value. Only a vertex whose value another vertex
     // shares (next to it in the sorted order) can be in one. On a noisy grid of quantized
     // heights about half the vertices share their value (a few each): the passes run in
@@ -165,42 +185,59 @@ void order_events(const TriangleMesh& mesh, const std::vector<float>& field, Ree
         if (!joined) plateaus = {};
     }
     detail::release(tied);
-    const bool any_plateau = !plateaus.empty();
-    if (any_plateau) {
-        plateaus.flatten();
-        // Equal values: plateaus together, ordered by their lowest vertex, then by vertex. A
-        // run of equal values is sorted as (plateau << 32 | vertex), so that the sort reads
-        // nothing else. Half the vertices of a noisy grid are in such runs (a few vertices
-        // each): each chunk sorts the runs that start in it, from its first run's start.
-        std::vector<std::size_t> run_start(kChunks + 1, nv);
-        // (A chunk with no run starting in it gets the next chunk's first start: nothing.)
-        each_chunk(0.75, 0.77, [&](std::size_t c, std::size_t first, std::size_t) {
-            std::size_t i = first;
-            while (i < nv && i > 0 && same_value(keys[i - 1], keys[i])) ++i;
-            run_start[c] = i;
-        });
-        each_chunk(0.77, 0.8, [&](std::size_t c, std::size_t, std::size_t) {
-            std::vector<std::uint64_t> run;
-            const std::size_t stop = run_start[c + 1];
-            for (std::size_t i = run_start[c]; i < stop;) {
-                std::size_t j = i + 1;
-                while (j < nv && same_value(keys[i], keys[j])) ++j;
-                if (j - i > 1) {
-                    run.clear();
-                    for (std::size_t k = i; k < j; ++k) {
-                        const i32 v = vertex(keys[k]);
-                        run.push_back(std::uint64_t(std::uint32_t(plateaus.parent(v))) << 32 |
-                                      std::uint32_t(v));
-                    }
-                    std::sort(run.begin(), run.end());
-                    const std::uint64_t value_bits = keys[i] & ~std::uint64_t{0xffffffffu};
-                    for (std::size_t k = i; k < j; ++k)
-                        keys[k] = value_bits | (run[k - i] & 0xffffffffu);
+    return plateaus;
+}
+
+// Within each run of equal values, the plateaus together, ordered by their lowest vertex,
+// then by vertex; progress 0.75 to 0.8.
+void order_plateaus(std::vector<std::uint64_t>& keys, const detail::DisjointSets<i32>& plateaus,
+                    const Chunks& chunks) {
+    const std::size_t nv = keys.size();
+    const auto each_chunk = [&](double from, double to, auto&& f) { chunks.each(from, to, f); };
+    // Equal values: plateaus together, ordered by their lowest vertex, then by vertex. A
+    // run of equal values is sorted as (plateau << 32 | vertex), so that the sort reads
+    // nothing else. Half the vertices of a noisy grid are in such runs (a few vertices
+    // each): each chunk sorts the runs that start in it, from its first run's start.
+    std::vector<std::size_t> run_start(kChunks + 1, nv);
+    // (A chunk with no run starting in it gets the next chunk's first start: nothing.)
+    each_chunk(0.75, 0.77, [&](std::size_t c, std::size_t first, std::size_t) {
+        std::size_t i = first;
+        while (i < nv && i > 0 && same_value(keys[i - 1], keys[i])) ++i;
+        run_start[c] = i;
+    });
+    each_chunk(0.77, 0.8, [&](std::size_t c, std::size_t, std::size_t) {
+        std::vector<std::uint64_t> run;
+        const std::size_t stop = run_start[c + 1];
+        for (std::size_t i = run_start[c]; i < stop;) {
+            std::size_t j = i + 1;
+            while (j < nv && same_value(keys[i], keys[j])) ++j;
+            if (j - i > 1) {
+                run.clear();
+                for (std::size_t k = i; k < j; ++k) {
+                    const i32 v = vertex(keys[k]);
+                    run.push_back(std::uint64_t(std::uint32_t(plateaus.parent(v))) << 32 |
+                                  std::uint32_t(v));
                 }
-                i = j;
+                std::sort(run.begin(), run.end());
+                const std::uint64_t value_bits = keys[i] & ~std::uint64_t{0xffffffffu};
+                for (std::size_t k = i; k < j; ++k)
+                    keys[k] = value_bits | (run[k - i] & 0xffffffffu);
             }
-        });
-    }
+            i = j;
+        }
+    });
+}
+
+// The nodes from the sorted keys: each event (a vertex, or a plateau's vertices) a node, its
+// vertices and value; progress 0.8 to 1.
+void write_nodes(ReebGraph& g, const std::vector<std::uint64_t>& keys,
+                 const detail::DisjointSets<i32>& plateaus, const Chunks& chunks) {
+    const std::size_t nv = keys.size();
+    const ProgressFn& progress = chunks.progress;
+    using detail::PassProgress;
+    const bool any_plateau = !plateaus.empty();
+    const auto chunk_begin = [&](std::size_t c) { return chunks.begin(c); };
+    const auto each_chunk = [&](double from, double to, auto&& f) { chunks.each(from, to, f); };
     auto same_event = [&](std::uint64_t a, std::uint64_t b) {
         return any_plateau && same_value(a, b) &&
                plateaus.parent(vertex(a)) == plateaus.parent(vertex(b));
@@ -246,6 +283,22 @@ void order_events(const TriangleMesh& mesh, const std::vector<float>& field, Ree
         }
     });
     g.node_vertex_offsets[n_nodes] = static_cast<i32>(nv);
+}
+
+}  // namespace
+
+void order_events(const TriangleMesh& mesh, const std::vector<float>& field, ReebGraph& g,
+                  const ProgressFn& progress) {
+    // Its passes: the keys (0 to 0.15), three radix passes (to 0.6), the ties (to 0.65), the
+    // plateaus (to 0.75), the runs of equal values (to 0.8), the nodes (to 1).
+    const Chunks chunks{field.size(), progress};
+    std::vector<std::uint64_t> keys = sorted_keys(field, chunks);
+    detail::DisjointSets<i32> plateaus = plateaus_of(mesh, field, keys, chunks);
+    if (!plateaus.empty()) {
+        plateaus.flatten();
+        order_plateaus(keys, plateaus, chunks);
+    }
+    write_nodes(g, keys, plateaus, chunks);
     report_progress(progress, 1.0, "reeb: order");
 }
 

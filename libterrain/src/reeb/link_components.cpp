@@ -62,36 +62,37 @@ std::pair<int, int> LinkCounter::count_star(const ReebGraph& g, i32 e, std::size
     return {lower, upper};
 }
 
-std::vector<LinkReps> link_components(const TriangleMesh& mesh, const ReebGraph& g,
-                                      std::vector<std::uint8_t>& lower_links,
-                                      std::vector<std::uint8_t>& upper_links,
-                                      std::vector<char>& general, const ProgressFn& progress,
-                                      std::size_t parts) {
-    const std::size_t nv = mesh.vertex_count(), nn = g.node_count();
-    // Its passes, for each part of the vertices (below): the triangles, then the vertices.
-    const auto& node = g.vertex_nodes;
-    // starts[0..1]: lower runs' first vertices, starts[2..3]: upper runs'; runs[0], runs[1]:
-    // how many lower and upper runs were seen.
-    struct Star {
-        std::array<i32, 4> starts;
-        std::uint8_t triangles, lower_edges, upper_edges;
-        std::array<std::uint8_t, 2> runs;
-    };
-    // The stars are gathered for a part of the vertices at a time, each part in a pass over
-    // every triangle, and read for those vertices: their records (24 bytes a vertex) are then
-    // not whole beside the nodes' representatives (16 bytes a node), which set the Reeb graph's
-    // peak of memory. Three parts on large meshes: two more passes over the triangles, 16
-    // bytes a vertex less. (What a star gathers is the same in any part: its own triangles.)
-    // An empty mesh: one part of nothing.
-    if (parts == 0) parts = nv >= kPartedStars ? 3 : 1;
-    parts = std::max<std::size_t>(1, std::min(parts, nv));
+namespace {
+
+// starts[0..1]: lower runs' first vertices, starts[2..3]: upper runs'; runs[0], runs[1]:
+// how many lower and upper runs were seen.
+struct Star {
+    std::array<i32, 4> starts;
+    std::uint8_t triangles, lower_edges, upper_edges;
+    std::array<std::uint8_t, 2> runs;
+};
+
+// The stars of a part [lo, hi) of the vertices, gathered from every triangle (add), and each
+// of the part's vertices' node's link counts and representatives read from them (vertex).
+// The vertices in parallel: each writes its own entries and its node's, and a node of
+// several vertices (a plateau) is written from its first vertex only.
+struct PartStars {
+    const TriangleMesh& mesh;
+    const ReebGraph& g;
+    std::vector<std::uint8_t>& lower_links;
+    std::vector<std::uint8_t>& upper_links;
+    std::vector<char>& general;
+    std::vector<LinkReps>& reps;
+    const std::vector<i32>& node;  // g.vertex_nodes
     std::vector<Star> stars;
     std::size_t lo = 0, hi = 0;  // the part's vertices
-    const auto star = [&](i32 c) -> Star* {
+
+    Star* star(i32 c) {
         const std::size_t v = idx(c);
         return v >= lo && v < hi ? &stars[v - lo] : nullptr;
-    };
-    const auto add = [&](const std::array<i32, 3>& t) {
+    }
+
+    void add(const std::array<i32, 3>& t) {
         const std::array<i32, 3> n{node[idx(t[0])], node[idx(t[1])], node[idx(t[2])]};
         for (const i32 c : t)
             if (Star* s = star(c)) ++s->triangles;
@@ -121,12 +122,10 @@ std::vector<LinkReps> link_components(const TriangleMesh& mesh, const ReebGraph&
             s->lower_edges += (m > p) & (m > q);
             s->upper_edges += (m < p) & (m < q);
         }
-    };
-    std::vector<LinkReps> reps;
-    // The vertices in parallel: each writes its own entries and its node's, and a node of
-    // several vertices (a plateau) is written from its first vertex only.
-    constexpr std::size_t kAhead = 16;  // the nodes' entries are written in random order
-    const auto vertex = [&](std::size_t v, std::size_t end) {
+    }
+
+    void vertex(std::size_t v, std::size_t end) {
+        constexpr std::size_t kAhead = 16;  // the nodes' entries are written in random order
         if (v + kAhead < end) {
             const std::size_t ahead = idx(node[v + kAhead]);
             __builtin_prefetch(&reps[ahead], 1);
@@ -167,7 +166,34 @@ std::vector<LinkReps> link_components(const TriangleMesh& mesh, const ReebGraph&
         };
         reps[idx(n)] = {side(lower, some_below, s.runs[0], s.starts[0], s.starts[1]),
                         side(upper, some_above, s.runs[1], s.starts[2], s.starts[3])};
-    };
+    }
+};
+
+}  // namespace
+
+std::vector<LinkReps> link_components(const TriangleMesh& mesh, const ReebGraph& g,
+                                      std::vector<std::uint8_t>& lower_links,
+                                      std::vector<std::uint8_t>& upper_links,
+                                      std::vector<char>& general, const ProgressFn& progress,
+                                      std::size_t parts) {
+    const std::size_t nv = mesh.vertex_count(), nn = g.node_count();
+    // Its passes, for each part of the vertices (below): the triangles, then the vertices.
+    // The stars are gathered for a part of the vertices at a time, each part in a pass over
+    // every triangle, and read for those vertices: their records (24 bytes a vertex) are then
+    // not whole beside the nodes' representatives (16 bytes a node), which set the Reeb graph's
+    // peak of memory. Three parts on large meshes: two more passes over the triangles, 16
+    // bytes a vertex less. (What a star gathers is the same in any part: its own triangles.)
+    // An empty mesh: one part of nothing.
+    if (parts == 0) parts = nv >= kPartedStars ? 3 : 1;
+    parts = std::max<std::size_t>(1, std::min(parts, nv));
+    std::vector<LinkReps> reps;
+    PartStars part_stars{mesh, g, lower_links, upper_links, general, reps, g.vertex_nodes, {},
+                         0,    0};
+    std::vector<Star>& stars = part_stars.stars;
+    std::size_t& lo = part_stars.lo;
+    std::size_t& hi = part_stars.hi;
+    const auto add = [&](const std::array<i32, 3>& t) { part_stars.add(t); };
+    const auto vertex = [&](std::size_t v, std::size_t end) { part_stars.vertex(v, end); };
     // Each part's share of the progress: its stars made (a fifth), its triangles (three
     // fifths), its vertices (the rest); the representatives made before the first vertices.
     for (std::size_t part = 0; part < parts; ++part) {

@@ -25,14 +25,9 @@ namespace terrain::reeb::internal {
 
 using detail::find_root;
 
-void WorkingGraph::write_result(SimplifyResult& result, bool rewrite_field,
-                                const ProgressFn& progress) {
-    const std::size_t nn = input_nodes_, nl = regular_.size();
-    // Its passes: the fates (0 to 0.2), the arcs (to 0.3), the new numbers (to 0.4), the
-    // input's vertex lists made again (to 0.5), the vertices and their values (to 1).
+std::vector<i32> WorkingGraph::final_codes(const ProgressFn& progress) {
+    const std::size_t nl = regular_.size();
     using detail::PassProgress;
-    const PassProgress arcs(progress, 0.2, 0.3, "simplify"),
-        numbers(progress, 0.3, 0.4, "simplify");
     // code[i]: for an absorbed node, the critical node that finally took it (nodes are
     // only absorbed into critical nodes); for a remaining node, -2 - its new id.
     // A listed node's forward: the fate of its set's root (kNone for a list still there).
@@ -73,20 +68,16 @@ void WorkingGraph::write_result(SimplifyResult& result, bool rewrite_field,
                 regular_[p].forward = f == kNone || code[idx(f)] == kNone ? f : code[idx(f)];
             }
         });
+    return code;
+}
+
+WorkingGraph::Remains WorkingGraph::take_remains(const std::vector<i32>& code,
+                                                 const ProgressFn& progress) {
+    const std::size_t nc = idx(critical_count_), nl = regular_.size();
+    const detail::PassProgress arcs(progress, 0.2, 0.3, "simplify");
     const auto code_of = [&](std::size_t i) { return i < nc ? code[i] : regular_[i - nc].forward; };
-    // What the output reads of the working graph, taken out: the nodes that remain (by their
-    // index here, in order) and the arcs that live, with their lists (a few thousand nodes on
-    // a simplified grid). The working graph then goes, before the new numbers come back
-    // (parked through the cancellations) and the arrays of every node and vertex are made:
-    // the peak of the simplification's memory.
-    struct Remaining {
-        i32 index = kNone;  // here
-        float value = 0;
-        NodeKind kind = NodeKind::regular;
-        std::uint8_t lower = 1, upper = 1;  // link counts, for a critical node changed
-        bool changed = false;
-    };
-    std::vector<Remaining> remaining;
+    Remains out;
+    std::vector<Remaining>& remaining = out.nodes;
     for (std::size_t i = 0; i < nc + nl; ++i) {
         if (code_of(i) != kNone) continue;
         Remaining r;
@@ -101,8 +92,10 @@ void WorkingGraph::write_result(SimplifyResult& result, bool rewrite_field,
         }
         remaining.push_back(r);
     }
-    std::vector<std::array<i32, 2>> live_ends;  // the arcs that live, in order
-    std::vector<i32> live_offsets(1, 0), live_nodes;
+    auto& live_ends = out.live_ends;  // the arcs that live, in order
+    auto& live_offsets = out.live_offsets;
+    auto& live_nodes = out.live_nodes;
+    live_offsets.assign(1, 0);
     for (std::size_t a = 0; a < arcs_.size(); ++a) {
         arcs.at(a, arcs_.size());
         const Arc& arc = arcs_[a];
@@ -111,26 +104,20 @@ void WorkingGraph::write_result(SimplifyResult& result, bool rewrite_field,
         for (i32 r = arc.head; r != kNone; r = next(r)) live_nodes.push_back(r);
         live_offsets.push_back(static_cast<i32>(live_nodes.size()));
     }
-    release_working_graph();
-    // The regular nodes' codes join the array (in its room), and their records go, their
-    // pages given back behind the copy.
-    {
-        detail::PagesBehind behind(regular_.data());
-        for (std::size_t p = 0; p < nl; ++p) {
-            code.push_back(regular_[p].forward);
-            if ((p & 0xffff) == 0) behind.before(regular_.data() + p);
-        }
-    }
-    detail::release(regular_);
-    if (map_parked_.on()) {
-        map_parked_.restore(node_map_);
-        if (node_map_.size() != nn)
-            throw Error("simplify", "the new numbers came back with the wrong size");
-    }
+    return out;
+}
+
+std::vector<std::array<i32, 2>> WorkingGraph::renumber(std::vector<i32>& code,
+                                                       std::vector<std::uint8_t>& gone,
+                                                       const ProgressFn& progress) {
+    const std::size_t nn = input_nodes_;
+    using detail::PassProgress;
+    // (Large blocks made a slice at a time, with heartbeats: their first touch is slow.)
+    const auto made = [&](double at) { return PassProgress(progress, at, at, "simplify"); };
+    const PassProgress numbers(progress, 0.3, 0.4, "simplify");
     // The remaining nodes are numbered in the order of the old ones; node_map_ takes each old
     // node's new node (first -2 - the node that took it, for the absorbed ones).
     std::vector<std::array<i32, 2>> kept;  // {old node, internal index} by new id
-    std::vector<std::uint8_t> gone;        // old nodes absorbed by another
     detail::assign_in_slices(gone, nn, std::uint8_t{0}, made(0.3));
     for (std::size_t n = 0; n < nn; ++n) {
         numbers.at(n, nn);
@@ -145,12 +132,18 @@ void WorkingGraph::write_result(SimplifyResult& result, bool rewrite_field,
         kept.push_back({static_cast<i32>(n), node_map_[n]});
         node_map_[n] = -2 - c;
     }
-    const std::size_t count = kept.size();
-    if (count != remaining.size())
-        throw Error("simplify", "internal: the remaining nodes are not one an old node");
     for (std::size_t n = 0; n < nn; ++n)
         if (node_map_[n] < 0) node_map_[n] = -2 - code[idx(-2 - node_map_[n])];
-    ReebGraph& out = result.graph;
+    return kept;
+}
+
+void WorkingGraph::write_nodes_and_arcs(ReebGraph& out, const std::vector<std::array<i32, 2>>& kept,
+                                        const Remains& remains, const std::vector<i32>& code) {
+    const std::size_t count = kept.size();
+    const std::vector<Remaining>& remaining = remains.nodes;
+    const auto& live_ends = remains.live_ends;
+    const auto& live_offsets = remains.live_offsets;
+    const auto& live_nodes = remains.live_nodes;
     out.node_values.resize(count);
     out.node_kinds.assign(count, NodeKind::regular);
     out.node_lower_links.assign(count, 1);
@@ -184,18 +177,10 @@ void WorkingGraph::write_result(SimplifyResult& result, bool rewrite_field,
         }
         out.arc_offsets.push_back(static_cast<i32>(out.arc_nodes.size()));
     }
-    detail::release(code);
-    detail::release(kept);
-    detail::release(remaining);
-    detail::release(live_ends);
-    detail::release(live_offsets);
-    detail::release(live_nodes);
-    const std::size_t nv = input_vertices_;
-    if (parked_.restore) {
-        parked_.restore(owned_->vertex_nodes);
-        if (owned_->vertex_nodes.size() != nv)
-            throw Error("simplify", "the vertices' nodes came back with the wrong size");
-    }
+}
+
+std::vector<i32> WorkingGraph::vertex_counts(std::size_t count) {
+    const std::size_t nn = input_nodes_, nv = input_vertices_;
     // Each new node's vertex count.
     constexpr std::size_t kSmallCounts = std::size_t{1} << 16;
     std::vector<i32> size(count + 1, 0);
@@ -220,6 +205,14 @@ void WorkingGraph::write_result(SimplifyResult& result, bool rewrite_field,
             size[idx(node_map_[n]) + 1] +=
                 g_.node_vertex_offsets[n + 1] - g_.node_vertex_offsets[n];
     }
+    return size;
+}
+
+void WorkingGraph::remake_vertex_lists(const ProgressFn& progress) {
+    const std::size_t nn = input_nodes_, nv = input_vertices_;
+    using detail::PassProgress;
+    // (Large blocks made a slice at a time, with heartbeats: their first touch is slow.)
+    const auto made = [&](double at) { return PassProgress(progress, at, at, "simplify"); };
     if (lists_from_vertex_nodes_) {
         // The input's vertex lists again, each ascending (a counting sort of the vertices by
         // node): what the graph handed over held.
@@ -238,7 +231,16 @@ void WorkingGraph::write_result(SimplifyResult& result, bool rewrite_field,
             [&](std::size_t v, std::size_t slot) { listed_vertices[slot] = static_cast<i32>(v); });
         detail::release(owned_->vertex_nodes);
     }
-    report_progress(progress, 0.5, "simplify");
+}
+
+void WorkingGraph::write_vertices(SimplifyResult& result, bool rewrite_field,
+                                  std::vector<i32>& size, const std::vector<std::uint8_t>& gone,
+                                  const ProgressFn& progress) {
+    const std::size_t nn = input_nodes_, nv = input_vertices_;
+    ReebGraph& out = result.graph;
+    using detail::PassProgress;
+    // (Large blocks made a slice at a time, with heartbeats: their first touch is slow.)
+    const auto made = [&](double at) { return PassProgress(progress, at, at, "simplify"); };
     // Vertices: grouped by new node, in the order of their old nodes (one pass in order), and
     // each vertex's new node, whether it was absorbed and its value (in parallel over the old
     // nodes, each vertex in one: its own entries), both at once.
@@ -276,6 +278,53 @@ void WorkingGraph::write_result(SimplifyResult& result, bool rewrite_field,
             }
         });
     grouped.wait();
+}
+
+void WorkingGraph::write_result(SimplifyResult& result, bool rewrite_field,
+                                const ProgressFn& progress) {
+    const std::size_t nn = input_nodes_, nl = regular_.size();
+    // Its passes: the fates (0 to 0.2), the arcs (to 0.3), the new numbers (to 0.4), the
+    // input's vertex lists made again (to 0.5), the vertices and their values (to 1).
+    std::vector<i32> code = final_codes(progress);
+    Remains remains = take_remains(code, progress);
+    release_working_graph();
+    // The regular nodes' codes join the array (in its room), and their records go, their
+    // pages given back behind the copy.
+    {
+        detail::PagesBehind behind(regular_.data());
+        for (std::size_t p = 0; p < nl; ++p) {
+            code.push_back(regular_[p].forward);
+            if ((p & 0xffff) == 0) behind.before(regular_.data() + p);
+        }
+    }
+    detail::release(regular_);
+    if (map_parked_.on()) {
+        map_parked_.restore(node_map_);
+        if (node_map_.size() != nn)
+            throw Error("simplify", "the new numbers came back with the wrong size");
+    }
+    std::vector<std::uint8_t> gone;  // old nodes absorbed by another
+    auto kept = renumber(code, gone, progress);
+    const std::size_t count = kept.size();
+    if (count != remains.nodes.size())
+        throw Error("simplify", "internal: the remaining nodes are not one an old node");
+    write_nodes_and_arcs(result.graph, kept, remains, code);
+    detail::release(code);
+    detail::release(kept);
+    detail::release(remains.nodes);
+    detail::release(remains.live_ends);
+    detail::release(remains.live_offsets);
+    detail::release(remains.live_nodes);
+    const std::size_t nv = input_vertices_;
+    if (parked_.restore) {
+        parked_.restore(owned_->vertex_nodes);
+        if (owned_->vertex_nodes.size() != nv)
+            throw Error("simplify", "the vertices' nodes came back with the wrong size");
+    }
+    std::vector<i32> size = vertex_counts(count);
+    remake_vertex_lists(progress);
+    report_progress(progress, 0.5, "simplify");
+    write_vertices(result, rewrite_field, size, gone, progress);
     detail::release(size);
     detail::release(gone);
     detail::release(node_map_);

@@ -169,21 +169,9 @@ bool lists_ascending(const ReebGraph& g) {
 
 }  // namespace
 
-WorkingGraph::WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big_degree,
-                           const ProgressFn& progress, ReebGraph* owned,
-                           const std::function<void()>& areas_read,
-                           const VertexNodesParking& parking, std::size_t wave)
-    : g_(g),
-      input_nodes_(g.node_count()),
-      input_vertices_(g.vertex_nodes.size()),
-      big_degree_(big_degree) {
-    // Its passes: the lists (0 to 0.1), the nodes (to 0.6), the arcs (to 1), each with its
-    // large blocks made a slice at a time (their first touch is slow, docs/performance.md).
+void WorkingGraph::number_listed_nodes(const ReebGraph& g, const ProgressFn& progress) {
     using detail::PassProgress;
-    const PassProgress nodes(progress, 0.25, 0.6, "simplify"), arcs(progress, 0.7, 1, "simplify");
     const std::size_t nn = g.node_count(), na = g.arc_count(), nl = g.arc_nodes.size();
-    owned_ = owned;
-    if (owned) detail::release(owned->node_arcs);  // not read here
     // node_map_[n]: arc ends marked, the other regular nodes of the lists by their position in
     // arc_nodes; then the new numbers.
     constexpr i32 kEnd = -2;
@@ -239,14 +227,15 @@ WorkingGraph::WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big
             node_map_[idx(r)] = static_cast<i32>(p);
         }
     }
-    // The critical nodes (arc ends, and critical nodes in lists) as a bit each: a critical
-    // node's new number is its rank among them, which the arcs' pass reads instead of
-    // node_map_ (4 bytes a node, parked before it).
-    detail::RankedBits critical_nodes(nn);
-    for (std::size_t n = 0; n < nn; ++n)
-        if (node_map_[n] < 0) critical_nodes.set(n);
-    critical_nodes.count();
-    critical_count_ = static_cast<i32>(critical_nodes.members());
+}
+
+bool WorkingGraph::copy_nodes(const TriangleMesh& mesh, const ReebGraph& g,
+                              const detail::RankedBits& critical_nodes, ReebGraph* owned,
+                              std::size_t wave, const ProgressFn& progress) {
+    using detail::PassProgress;
+    const PassProgress nodes(progress, 0.25, 0.6, "simplify");
+    const std::size_t nn = g.node_count(), nl = g.arc_nodes.size();
+    constexpr std::size_t kGrain = std::size_t{1} << 14;
     // The regular nodes' records are written in list order, at random: made whole first (a
     // slice at a time: a large block's first touch is slow, docs/performance.md). The
     // critical nodes' are written in order by the nodes' pass: their pages are touched as it
@@ -274,7 +263,6 @@ WorkingGraph::WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big
     // and the critical nodes' records appended, their pages touched first on every thread.
     total_area_ = 0;
     std::atomic<bool> all_sorted{true};  // every node's vertex list ascending
-    wave = std::max<std::size_t>(1, wave);
     std::vector<double> wave_area(std::min(nn, wave));
     i32 k = 0;
     for (std::size_t n0 = 0; n0 < nn; n0 += wave) {
@@ -327,34 +315,38 @@ WorkingGraph::WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big
     const bool sorted = all_sorted;
     detail::release(wave_area);
     total_area_ = mesh_area_or_one(total_area_);
-    if (areas_read) areas_read();  // (before the arcs: their copy's end is the peak)
-    // The new numbers are read again only by write_result, once the working graph is freed:
-    // they may wait elsewhere through the arcs' copy (the peak) and the cancellations.
-    if (owned && parking.on()) {
-        map_parked_ = parking;
-        map_parked_.park(node_map_);
+    return sorted;
+}
+
+void WorkingGraph::release_copied_nodes(ReebGraph& owned, bool sorted,
+                                        const VertexNodesParking& parking) {
+    detail::release(owned.node_values);
+    detail::release(owned.node_kinds);
+    // The vertex lists or the vertices' nodes, whichever write_result will not read.
+    if (lists_from_vertex_nodes_ != (sorted && owned.vertex_nodes.size() == input_vertices_))
+        throw Error("simplify", "internal: the vertex lists' order changed during the copy");
+    if (lists_from_vertex_nodes_) {
+        detail::release(owned.node_vertices);
+        detail::release(owned.node_vertex_offsets);
+    } else {
+        detail::release(owned.vertex_nodes);
     }
+    // Read again only by write_result: they may wait elsewhere through the peak.
+    if (lists_from_vertex_nodes_ && parking.on()) {
+        parked_ = parking;
+        parked_.park(owned.vertex_nodes);
+    }
+}
+
+void WorkingGraph::copy_arcs(const ReebGraph& g, const detail::RankedBits& critical_nodes,
+                             ReebGraph* owned, std::size_t wave, const ProgressFn& progress) {
+    using detail::PassProgress;
+    const PassProgress arcs(progress, 0.7, 1, "simplify");
+    const std::size_t na = g.arc_count();
+    constexpr std::size_t kGrain = std::size_t{1} << 14;
     const auto critical_number = [&](i32 n) {
         return static_cast<i32>(critical_nodes.rank(idx(n)));
     };
-    if (owned) {  // the nodes are copied
-        detail::release(owned->node_values);
-        detail::release(owned->node_kinds);
-        // The vertex lists or the vertices' nodes, whichever write_result will not read.
-        if (lists_from_vertex_nodes_ != (sorted && owned->vertex_nodes.size() == input_vertices_))
-            throw Error("simplify", "internal: the vertex lists' order changed during the copy");
-        if (lists_from_vertex_nodes_) {
-            detail::release(owned->node_vertices);
-            detail::release(owned->node_vertex_offsets);
-        } else {
-            detail::release(owned->vertex_nodes);
-        }
-        // Read again only by write_result: they may wait elsewhere through the peak.
-        if (lists_from_vertex_nodes_ && parking.on()) {
-            parked_ = parking;
-            parked_.park(owned->vertex_nodes);
-        }
-    }
     // Arc a joins its lower then its upper end, a in order. As with the critical nodes, the
     // arcs' records are written in order into a block reserved, not filled, first, and the
     // input's arcs, offsets and listed nodes go back to the system behind the pass: the end
@@ -420,6 +412,42 @@ WorkingGraph::WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big
         detail::release(owned->arc_offsets);
         detail::release(owned->arc_nodes);
     }
+}
+
+WorkingGraph::WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big_degree,
+                           const ProgressFn& progress, ReebGraph* owned,
+                           const std::function<void()>& areas_read,
+                           const VertexNodesParking& parking, std::size_t wave)
+    : g_(g),
+      input_nodes_(g.node_count()),
+      input_vertices_(g.vertex_nodes.size()),
+      big_degree_(big_degree) {
+    // Its passes: the lists (0 to 0.1), the nodes (to 0.6), the arcs (to 1), each with its
+    // large blocks made a slice at a time (their first touch is slow, docs/performance.md).
+    using detail::PassProgress;
+    const std::size_t nn = g.node_count(), na = g.arc_count();
+    owned_ = owned;
+    if (owned) detail::release(owned->node_arcs);  // not read here
+    number_listed_nodes(g, progress);
+    // The critical nodes (arc ends, and critical nodes in lists) as a bit each: a critical
+    // node's new number is its rank among them, which the arcs' pass reads instead of
+    // node_map_ (4 bytes a node, parked before it).
+    detail::RankedBits critical_nodes(nn);
+    for (std::size_t n = 0; n < nn; ++n)
+        if (node_map_[n] < 0) critical_nodes.set(n);
+    critical_nodes.count();
+    critical_count_ = static_cast<i32>(critical_nodes.members());
+    wave = std::max<std::size_t>(1, wave);
+    const bool sorted = copy_nodes(mesh, g, critical_nodes, owned, wave, progress);
+    if (areas_read) areas_read();  // (before the arcs: their copy's end is the peak)
+    // The new numbers are read again only by write_result, once the working graph is freed:
+    // they may wait elsewhere through the arcs' copy (the peak) and the cancellations.
+    if (owned && parking.on()) {
+        map_parked_ = parking;
+        map_parked_.park(node_map_);
+    }
+    if (owned) release_copied_nodes(*owned, sorted, parking);  // the nodes are copied
+    copy_arcs(g, critical_nodes, owned, wave, progress);
     // The lists' sets, made once the input's arcs are freed (the copy's end is the peak of
     // the simplification's memory), with room for as many new sets again, reserved and not
     // touched: a set made by a cancellation then copies no array (a vector growing copies

@@ -32,6 +32,10 @@
 #include "terrain/core/progress.hpp"
 #include "terrain/reeb/simplify.hpp"
 
+namespace terrain::detail {
+class RankedBits;
+}  // namespace terrain::detail
+
 namespace terrain::reeb::internal {
 
 using detail::i32;
@@ -310,6 +314,60 @@ class WorkingGraph {
     }
     // A run with room for kInline << shift arcs: a freed one, or a new one at the arena's end.
     i32 take_run(std::uint8_t shift);
+
+    // What the output reads of the working graph, taken out: the nodes that remain (by their
+    // index here, in order) and the arcs that live, with their lists (a few thousand nodes on
+    // a simplified grid). The working graph then goes, before the new numbers come back
+    // (parked through the cancellations) and the arrays of every node and vertex are made:
+    // the peak of the simplification's memory.
+    struct Remaining {
+        i32 index = kNone;  // here
+        float value = 0;
+        NodeKind kind = NodeKind::regular;
+        std::uint8_t lower = 1, upper = 1;  // link counts, for a critical node changed
+        bool changed = false;
+    };
+    struct Remains {
+        std::vector<Remaining> nodes;
+        std::vector<std::array<i32, 2>> live_ends;  // the arcs that live, in order
+        std::vector<i32> live_offsets, live_nodes;
+    };
+    // write_result's passes (simplify_output.cpp). final_codes: code[i], for an absorbed node
+    // the critical node that finally took it, for a remaining node kNone, the critical nodes'
+    // (the regular nodes' are written over their forwards; 0 to 0.2 of the progress);
+    // take_remains (to 0.3); renumber: the remaining nodes numbered in the order of the old
+    // ones, node_map_ each old node's new node, `gone` the absorbed ones, returning {old
+    // node, internal index} by new id (to 0.4); write_nodes_and_arcs: the output's nodes and
+    // arcs; vertex_counts: each new node's vertex count; remake_vertex_lists: the input's
+    // vertex lists again from its vertices' nodes, when they are to be (to 0.5);
+    // write_vertices: the vertices grouped by new node, each one's node, absorbed flag and
+    // value (to 1).
+    std::vector<i32> final_codes(const ProgressFn& progress);
+    Remains take_remains(const std::vector<i32>& code, const ProgressFn& progress);
+    std::vector<std::array<i32, 2>> renumber(std::vector<i32>& code,
+                                             std::vector<std::uint8_t>& gone,
+                                             const ProgressFn& progress);
+    void write_nodes_and_arcs(ReebGraph& out, const std::vector<std::array<i32, 2>>& kept,
+                              const Remains& remains, const std::vector<i32>& code);
+    std::vector<i32> vertex_counts(std::size_t count);
+    void remake_vertex_lists(const ProgressFn& progress);
+    void write_vertices(SimplifyResult& result, bool rewrite_field, std::vector<i32>& size,
+                        const std::vector<std::uint8_t>& gone, const ProgressFn& progress);
+
+    // The copy's passes (working_graph.cpp). number_listed_nodes: node_map_ marks the arc ends
+    // and numbers the lists' regular nodes by their position in the lists (0 to 0.1 of the
+    // progress); copy_nodes: the nodes' records and areas, a wave at a time (0.1 to 0.6),
+    // returning whether every node's vertex list is ascending; release_copied_nodes: what of
+    // `owned` write_result will not read; copy_arcs: the arcs' records and lists, each arc
+    // joined to its ends (0.7 to 1). critical_nodes: the arc ends and the lists' critical
+    // nodes, a bit each, a critical node's new number its rank among them.
+    void number_listed_nodes(const ReebGraph& g, const ProgressFn& progress);
+    bool copy_nodes(const TriangleMesh& mesh, const ReebGraph& g,
+                    const detail::RankedBits& critical_nodes, ReebGraph* owned, std::size_t wave,
+                    const ProgressFn& progress);
+    void release_copied_nodes(ReebGraph& owned, bool sorted, const VertexNodesParking& parking);
+    void copy_arcs(const ReebGraph& g, const detail::RankedBits& critical_nodes, ReebGraph* owned,
+                   std::size_t wave, const ProgressFn& progress);
 
     // Big nodes (working_graph.cpp). make_big moves node n's run into a new BigNode;
     // release_big gives a node's BigNode back (emptied) once the node is gone.

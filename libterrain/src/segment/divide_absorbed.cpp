@@ -272,33 +272,21 @@ class Flooding {
 
 }  // namespace
 
-namespace internal {
+namespace {
 
-DivideCounts divide_absorbed(const TriangleMesh& mesh, const reeb::ReebGraph& graph,
-                             const std::vector<float>& field,
-                             const std::vector<std::uint8_t>& absorbed, Segmentation& segmentation,
-                             const std::vector<std::uint32_t>* finer, const ProgressFn& progress,
-                             std::size_t parallel_batch) {
-    const std::size_t n = mesh.vertex_count();
-    if (finer && finer->size() != n)
-        throw Error("segment", "divide_absorbed: the finer labels do not match the mesh");
-    auto& labels = segmentation.labels;  // as grown until the end, then as divided
-    if (field.size() != n || absorbed.size() != n || labels.size() != n ||
-        graph.vertex_nodes.size() != n)
-        throw Error("segment", "divide_absorbed: the field, flags, labels and mesh disagree");
-    DivideCounts counts;
-    for (std::size_t v = 0; v < n; ++v) counts.absorbed += absorbed[v] != 0;
-    if (counts.absorbed == 0) {
-        report_progress(progress, 1, "divide");
-        return counts;
-    }
+// 1. Absorbed vertices leave their regions: the sites' labels are the regions left (their
+// costs 0 until the flooding); 1b. with a finer scale's labels, absorbed vertices first go
+// with their finer region. Progress 0 to 0.03.
+std::vector<Site> leave_regions(const std::vector<std::uint8_t>& absorbed,
+                                const std::vector<std::uint32_t>& labels,
+                                const std::vector<std::uint32_t>* finer,
+                                const ProgressFn& progress) {
+    const std::size_t n = labels.size();
     // (Passes over every vertex, the large blocks made a slice at a time: their first touch
     // is slow, docs/performance.md.)
     const auto pass = [&](double from) {
         return detail::PassProgress(progress, from, from + 0.015, "divide");
     };
-    // 1. Absorbed vertices leave their regions: the sites' labels are the regions left (their
-    // costs 0 until the flooding).
     std::vector<Site> sites;
     detail::assign_in_slices(sites, n, Site{0}, pass(0));
     constexpr std::size_t kGrain = std::size_t{1} << 14;  // (passes of each vertex its own)
@@ -307,56 +295,59 @@ DivideCounts divide_absorbed(const TriangleMesh& mesh, const reeb::ReebGraph& gr
                                 for (std::size_t v = r.begin(); v < r.end(); ++v)
                                     sites[v] = site_of(0.0f, absorbed[v] ? 0 : labels[v]);
                             });
-    // 1b. With a finer scale's labels: absorbed vertices first go with their finer region.
     if (finer) {
         const auto here = finer_to_here(*finer, sites);
         for (std::size_t v = 0; v < n; ++v)
             if (absorbed[v]) sites[v] = site_of(0.0f, here[(*finer)[v]]);
     }
+    return sites;
+}
+
+// 2. The part of each region connected to its seed's own vertices; the other vertices of
+// regions lose their label. Returns how many did.
+std::size_t keep_seed_parts(const TriangleMesh& mesh, const reeb::ReebGraph& graph,
+                            const Segmentation& segmentation, std::vector<Site>& sites) {
+    const std::size_t n = sites.size();
+    std::size_t detached = 0;
     const auto neighbours = [&](std::size_t v, auto&& f) {
         for (const i32 w : mesh.neighbors_of(v)) f(idx(w));
     };
-    // 2. The part of each region connected to its seed's own vertices.
-    {
-        std::vector<std::uint8_t> kept(n, 0);
-        std::vector<std::size_t> stack;
-        // (The seeds' vertices found in one pass in vertex order: a seed node's list holds
-        // the vertices absorbed into it too, most of the surface, in an order scattered over
-        // it. The parts kept are the same in any order.)
-        const auto& seeds = segmentation.seeds;
-        for (std::size_t seed = 0; seed < n; ++seed) {
-            const std::uint32_t label = label_of(sites[seed]);
-            if (label == 0 || kept[seed] || label > seeds.size() ||
-                graph.vertex_nodes[seed] != seeds[label - 1])
-                continue;
-            kept[seed] = 1;
-            stack.push_back(seed);
-            while (!stack.empty()) {
-                const std::size_t v = stack.back();
-                stack.pop_back();
-                neighbours(v, [&](std::size_t u) {
-                    if (label_of(sites[u]) != label || kept[u]) return;
-                    kept[u] = 1;
-                    stack.push_back(u);
-                });
-            }
+    std::vector<std::uint8_t> kept(n, 0);
+    std::vector<std::size_t> stack;
+    // (The seeds' vertices found in one pass in vertex order: a seed node's list holds
+    // the vertices absorbed into it too, most of the surface, in an order scattered over
+    // it. The parts kept are the same in any order.)
+    const auto& seeds = segmentation.seeds;
+    for (std::size_t seed = 0; seed < n; ++seed) {
+        const std::uint32_t label = label_of(sites[seed]);
+        if (label == 0 || kept[seed] || label > seeds.size() ||
+            graph.vertex_nodes[seed] != seeds[label - 1])
+            continue;
+        kept[seed] = 1;
+        stack.push_back(seed);
+        while (!stack.empty()) {
+            const std::size_t v = stack.back();
+            stack.pop_back();
+            neighbours(v, [&](std::size_t u) {
+                if (label_of(sites[u]) != label || kept[u]) return;
+                kept[u] = 1;
+                stack.push_back(u);
+            });
         }
-        for (std::size_t v = 0; v < n; ++v)
-            if (label_of(sites[v]) != 0 && !kept[v]) {
-                sites[v] = site_of(0.0f, 0);
-                ++counts.detached;
-            }
     }
-    report_progress(progress, 0.2, "divide");
-    // 3. Flooding from the regions' edges: the shortest paths in the metric where a step
-    // into u for region r costs |field(u) - mean(r)| plus a constant per mean edge length.
-    const float step = kStepShare * field_spread(field);
-    const EdgeLengths lengths =
-        edge_lengths(mesh, detail::PassProgress(progress, 0.2, 0.23, "divide"));
-    // cost: a labelled vertex's path cost; for the others, the best offer so far (with the
-    // offer's region in the label), so that only better offers are queued (the same result as
-    // queuing every one: costs grow along a path, so a vertex's first offer taken is its
-    // cheapest).
+    for (std::size_t v = 0; v < n; ++v)
+        if (label_of(sites[v]) != 0 && !kept[v]) {
+            sites[v] = site_of(0.0f, 0);
+            ++detached;
+        }
+    return detached;
+}
+
+// The vertices left without a label opened to offers (an infinite cost), the others final;
+// returns how many are to be labelled. Progress 0.23 to 0.245.
+std::size_t open_unlabelled(std::vector<Site>& sites, const ProgressFn& progress) {
+    const std::size_t n = sites.size();
+    constexpr std::size_t kGrain = std::size_t{1} << 14;  // (passes of each vertex its own)
     std::atomic<std::size_t> unlabelled{0};  // (the absorbed and detached, less those kept)
     detail::parallel_slices(
         n, kGrain, progress, 0.23, 0.245, "divide", [&](const tbb::blocked_range<std::size_t>& r) {
@@ -372,10 +363,19 @@ DivideCounts divide_absorbed(const TriangleMesh& mesh, const reeb::ReebGraph& gr
             unlabelled += here;
         });
     const std::size_t to_label = unlabelled.load();
-    // Each region's mean of the field over the vertices it kept (area-weighted), fixed for
-    // the flooding.
-    std::vector<double> sum(segmentation.seeds.size() + 1, 0.0),
-        weight(segmentation.seeds.size() + 1, 0.0);
+    return to_label;
+}
+
+// Each region's mean of the field over the vertices it kept (area-weighted), fixed for the
+// flooding; progress 0.245 to 0.26.
+std::vector<float> region_means(const TriangleMesh& mesh, const std::vector<float>& field,
+                                const std::vector<Site>& sites, std::size_t region_count,
+                                const ProgressFn& progress) {
+    const std::size_t n = sites.size();
+    const auto pass = [&](double from) {
+        return detail::PassProgress(progress, from, from + 0.015, "divide");
+    };
+    std::vector<double> sum(region_count + 1, 0.0), weight(region_count + 1, 0.0);
     const auto summed = pass(0.245);
     for (std::size_t v = 0; v < n; ++v) {
         summed.at(v, n);
@@ -387,11 +387,23 @@ DivideCounts divide_absorbed(const TriangleMesh& mesh, const reeb::ReebGraph& gr
     std::vector<float> mean(sum.size(), 0.0f);
     for (std::size_t r = 1; r < mean.size(); ++r)
         mean[r] = weight[r] > 0 ? static_cast<float>(sum[r] / weight[r]) : 0.0f;
+    return mean;
+}
+
+// 3. The flooding from the regions' edges, in batches of offers; progress 0.26 to 1.
+void flood(const TriangleMesh& mesh, const Flooding& flooding, const std::vector<Site>& sites,
+           std::size_t to_label, std::size_t parallel_batch, const ProgressFn& progress) {
+    const std::size_t n = sites.size();
+    const auto neighbours = [&](std::size_t v, auto&& f) {
+        for (const i32 w : mesh.neighbors_of(v)) f(idx(w));
+    };
+    const auto pass = [&](double from) {
+        return detail::PassProgress(progress, from, from + 0.015, "divide");
+    };
     // (A path's cost never falls below the cost of the vertex it leaves, so the offers wait in
     // a monotone queue: core/radix_heap.hpp.)
     detail::RadixHeap<Step> heap;
     const auto queue = [&](const Step& s) { heap.push(s); };
-    const Flooding flooding(mesh, field, sites, mean, step, lengths);
     const auto fronts = pass(0.26);
     for (std::size_t w = 0; w < n; ++w)
         if (fronts.at(w, n); is_final(sites[w])) {
@@ -452,6 +464,47 @@ DivideCounts divide_absorbed(const TriangleMesh& mesh, const reeb::ReebGraph& gr
         if ((labelled >> 16) != (before >> 16))
             report_progress(progress, 0.3 + 0.7 * double(labelled) / double(to_label), "divide");
     }
+}
+
+}  // namespace
+
+namespace internal {
+
+DivideCounts divide_absorbed(const TriangleMesh& mesh, const reeb::ReebGraph& graph,
+                             const std::vector<float>& field,
+                             const std::vector<std::uint8_t>& absorbed, Segmentation& segmentation,
+                             const std::vector<std::uint32_t>* finer, const ProgressFn& progress,
+                             std::size_t parallel_batch) {
+    const std::size_t n = mesh.vertex_count();
+    if (finer && finer->size() != n)
+        throw Error("segment", "divide_absorbed: the finer labels do not match the mesh");
+    auto& labels = segmentation.labels;  // as grown until the end, then as divided
+    if (field.size() != n || absorbed.size() != n || labels.size() != n ||
+        graph.vertex_nodes.size() != n)
+        throw Error("segment", "divide_absorbed: the field, flags, labels and mesh disagree");
+    DivideCounts counts;
+    for (std::size_t v = 0; v < n; ++v) counts.absorbed += absorbed[v] != 0;
+    if (counts.absorbed == 0) {
+        report_progress(progress, 1, "divide");
+        return counts;
+    }
+    std::vector<Site> sites = leave_regions(absorbed, labels, finer, progress);
+    counts.detached = keep_seed_parts(mesh, graph, segmentation, sites);
+    report_progress(progress, 0.2, "divide");
+    // 3. Flooding from the regions' edges: the shortest paths in the metric where a step
+    // into u for region r costs |field(u) - mean(r)| plus a constant per mean edge length.
+    const float step = kStepShare * field_spread(field);
+    const EdgeLengths lengths =
+        edge_lengths(mesh, detail::PassProgress(progress, 0.2, 0.23, "divide"));
+    // cost: a labelled vertex's path cost; for the others, the best offer so far (with the
+    // offer's region in the label), so that only better offers are queued (the same result as
+    // queuing every one: costs grow along a path, so a vertex's first offer taken is its
+    // cheapest).
+    const std::size_t to_label = open_unlabelled(sites, progress);
+    const std::vector<float> mean =
+        region_means(mesh, field, sites, segmentation.seeds.size(), progress);
+    const Flooding flooding(mesh, field, sites, mean, step, lengths);
+    flood(mesh, flooding, sites, to_label, parallel_batch, progress);
     report_progress(progress, 1, "divide");
     for (std::size_t v = 0; v < n; ++v) {
         if (!is_final(sites[v]))

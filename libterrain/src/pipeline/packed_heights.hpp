@@ -1,0 +1,73 @@
+#pragma once
+// Private: the DEM's values packed as floats while the stages that do not read them run
+// (pipeline::segment; docs/performance.md).
+#include <cmath>
+#include <cstddef>
+#include <vector>
+
+#include "../core/pass_progress.hpp"
+#include "../core/release.hpp"
+#include "parked_arrays.hpp"
+#include "terrain/core/dem.hpp"
+#include "terrain/core/progress.hpp"
+
+namespace terrain::pipeline::internal {
+
+// The DEM's values held as floats while the stages that do not read them run, when every
+// value is one exactly (16- and 32-bit samples, and integers times a power of two below 2^24
+// of them): 4 bytes a pixel less. They are doubles again, the same numbers, where they are
+// read (the placing of the positions, the region graph's points); a DEM with a value no float
+// holds keeps its doubles. Packed again later, the values are not checked again.
+class PackedHeights {
+  public:
+    void pack(Dem& dem, const ProgressFn& progress) {
+        const std::size_t n = dem.values.size();
+        const detail::PassProgress checked(progress, 0, 0.4, "mesh"),
+            packed(progress, 0.4, 1, "mesh");
+        if (!exact_) {
+            for (std::size_t i = 0; i < n; ++i) {
+                checked.at(i, n);
+                const double v = dem.values[i];
+                if (!std::isnan(v) && static_cast<double>(static_cast<float>(v)) != v) return;
+            }
+            exact_ = true;
+        }
+        values_.reserve(n);
+        for (std::size_t i = 0; i < n; ++i) {
+            packed.at(i, n);
+            values_.push_back(static_cast<float>(dem.values[i]));
+        }
+        detail::release(dem.values);
+        packed_ = true;
+    }
+    // The bytes of the DEM's values as held now.
+    std::size_t bytes(const Dem& dem) const {
+        return packed_ ? values_.size() * sizeof(float) : dem.values.size() * sizeof(double);
+    }
+    // The floats parked (parked_arrays.hpp) and read back.
+    bool park(internal::ParkedArrays& parked, const ProgressFn& progress) {
+        return packed_ && parked.park(values_, progress, 0, 1);
+    }
+    void restore(internal::ParkedArrays& parked, const ProgressFn& progress) {
+        if (packed_) parked.restore(values_, progress, 0, 1);
+    }
+    void unpack(Dem& dem, const ProgressFn& progress) {
+        if (!packed_) return;
+        const std::size_t n = values_.size();
+        const detail::PassProgress unpacked(progress, 0, 1, "mesh");
+        dem.values.reserve(n);
+        for (std::size_t i = 0; i < n; ++i) {
+            unpacked.at(i, n);
+            dem.values.push_back(static_cast<double>(values_[i]));
+        }
+        detail::release(values_);
+        packed_ = false;
+    }
+
+  private:
+    std::vector<float> values_;
+    bool packed_ = false;
+    bool exact_ = false;  // every value is a float
+};
+
+}  // namespace terrain::pipeline::internal
