@@ -209,15 +209,16 @@ void find_centres(const TriangleMesh& mesh, const Dem& dem,
                   const std::vector<std::uint32_t>& labels, Floors& floors) {
     const std::size_t m = floors.in.size() - 1;
     for (std::size_t v = 0; v < mesh.vertex_count(); ++v) {
-        if (labels[v] == 0 || labels[v] > m) continue;
+        if (labels[v] == 0 || labels[v] > m || floors.in[labels[v]].empty()) continue;
+        const auto p = mesh.position(v);
+        const double h = vertex_height(mesh, dem, v);
+        const int col = int(std::size_t(mesh.vertex_pixel[v]) % std::size_t(dem.width));
         for (const auto f : floors.in[labels[v]]) {
             auto& fl = floors.floors[std::size_t(f)];
-            const auto p = mesh.position(v);
             for (int k = 0; k < 3; ++k) fl.sum[std::size_t(k)] += p[std::size_t(k)];
             ++fl.count;
-            fl.lowest = std::min(fl.lowest, vertex_height(mesh, dem, v));
-            if (fl.first_col < 0)
-                fl.first_col = int(std::size_t(mesh.vertex_pixel[v]) % std::size_t(dem.width));
+            fl.lowest = std::min(fl.lowest, h);
+            if (fl.first_col < 0) fl.first_col = col;
         }
     }
     for (auto& fl : floors.floors) {

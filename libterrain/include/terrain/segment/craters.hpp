@@ -58,10 +58,12 @@ struct CraterOptions {
 };
 
 // The craters of a DEM's segmentation: `labels` per mesh vertex (1..regions), `graph` its
-// region graph (segment::region_graph), `dem` the DEM the mesh was made from. For each
-// concave region with convex neighbours: the highest vertex of those neighbours in each of 36
-// directions from the floor's centroid (between crest_from and crest_to floor radii) is a rim crest
-// point; a circle is fitted to them (twice, dropping points more than a quarter radius off);
+// region graph (segment::region_graph), `dem` the DEM the mesh was made from. A floor is a
+// concave region with convex neighbours, or two adjacent concave regions of comparable areas
+// rounder together than one of them (a floor the segmentation cut in two; the crater names
+// the larger as floor_region). For each floor: the highest vertex of its convex neighbours in each
+// of 36 directions from the floor's centroid (between crest_from and crest_to floor radii) is a rim
+// crest point; a circle is fitted to them (twice, dropping points more than a quarter radius off);
 // kept when crest points are found in half the directions or more, the radius is between
 // 0.8 crest_from and crest_to floor radii, the depth positive and the confidence at least
 // min_confidence. Of two craters
