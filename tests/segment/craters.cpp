@@ -162,3 +162,64 @@ TEST_CASE("Craters: two floors side by side stay two craters", "[craters]") {
     // No crater spans both.
     for (const auto& k : table) CHECK(k.diameter_m < 3 * R);
 }
+
+TEST_CASE("Craters: the confidence's terms", "[craters]") {
+    segment::CraterEvidence e;
+    e.rim_fraction = 0.75;
+    e.radius_m = 40;
+    e.pixel_m = 10;
+    e.circularity = 0.8;
+    e.floor_mean = 30;
+    // Half a pixel of RMS is the grid's: no misfit.
+    e.fit_rms_m = 5;
+    CHECK(segment::crater_confidence(e) == Approx(0.75));
+    // Beyond it, the misfit: sqrt(13^2 - 5^2) = 12 m on a 40 m radius, quality 1 - 1.2 -> 0.
+    e.fit_rms_m = 13;
+    CHECK(segment::crater_confidence(e) == 0);
+    e.fit_rms_m = std::sqrt(25.0 + 16.0);  // misfit 4 m: quality 0.6
+    CHECK(segment::crater_confidence(e) == Approx(0.75 * 0.6));
+    e.fit_rms_m = 0;
+    // Roundness: circularity 0.2 of the 0.4 that takes the whole.
+    e.circularity = 0.2;
+    CHECK(segment::crater_confidence(e) == Approx(0.375));
+    e.circularity = 1;
+    // Concavity: a floor at 43.75 or below has it all, at 50 none, half way half.
+    for (const auto& [mean, share] : std::vector<std::pair<double, double>>{
+             {43.75, 1}, {20, 1}, {46.875, 0.5}, {50, 0}, {60, 0}})
+        CHECK(segment::crater_confidence({0.75, 0, 40, 10, 1, mean}) == Approx(0.75 * share));
+}
+
+TEST_CASE("Craters: a bowl a few pixels wide is listed", "[craters]") {
+    // A floor of a few dozen pixels, a rim sampled by a vertex or two in each direction.
+    for (const double R : {4.0, 5.0}) {
+        const double cx = 30.3, cy = 29.6;
+        auto result = segment_dem(bowl_dem(60, cx, cy, R, 0.2 * R, 0.04 * R));
+        REQUIRE(result.craters);
+        const auto& table = result.craters->craters;
+        INFO("R = " << R << " px, " << table.size() << " craters");
+        CHECK(std::count_if(table.begin(), table.end(), [&](const auto& k) {
+                  return std::hypot(k.col - cx, k.row - cy) < 0.5 * R &&
+                         k.diameter_m == Approx(2 * R).epsilon(0.25);
+              }) == 1);
+    }
+}
+
+TEST_CASE("Craters: a floor round a central peak is one crater", "[craters]") {
+    // A complex crater: the bowl with a peak at its centre; the floor is a ring round it,
+    // inside the rim.
+    const double cx = 80.3, cy = 79.6, R = 30, depth = 6, rim = 1.2;
+    const auto dem = test::grid_dem(160, 160, [=](int c, int r) {
+        const double d = std::hypot(c + 0.5 - cx, r + 0.5 - cy);
+        const double bowl = d < R ? depth * ((d / R) * (d / R) - 1) : 0.0;
+        const double w = (d - R) / (0.3 * R), p = d / (0.15 * R);
+        return bowl + rim * std::exp(-w * w) + 0.6 * depth * std::exp(-p * p);
+    });
+    auto result = segment_dem(dem);
+    REQUIRE(result.craters);
+    const auto& table = result.craters->craters;
+    INFO(table.size() << " craters");
+    CHECK(std::count_if(table.begin(), table.end(), [&](const auto& k) {
+              return std::hypot(k.col - cx, k.row - cy) < 0.25 * R &&
+                     k.diameter_m == Approx(2 * R).epsilon(0.1);
+          }) == 1);
+}

@@ -123,6 +123,7 @@ struct Floor {
     Circle circle;
     std::array<bool, kSectors> kept{};
     double crest = 0;
+    double spread = 0;  // the sum of the floor vertices' squared distances from the centroid
 };
 
 // The possible floors of a segmentation and which floors each region is in or rims.
@@ -255,6 +256,7 @@ void find_crests(const TriangleMesh& mesh, const Dem& dem, const std::vector<std
             auto& fl = floors.floors[std::size_t(f)];
             const V3 d = sub(p, fl.centre);
             const double x = dot(d, fl.e1), y = dot(d, fl.e2);
+            fl.spread += x * x + y * y;
             fl.col.add({1, x, y}, unwrapped(fl, double(pixel % std::size_t(dem.width)) + 0.5));
             fl.row.add({1, x, y}, double(pixel / std::size_t(dem.width)) + 0.5);
         }
@@ -293,6 +295,12 @@ std::vector<std::size_t> fit_rims(const CraterOptions& options, std::vector<Floo
                 fl.kept[i] = false;
         }
         if (!fit_circle(fl.x, fl.y, fl.kept, c)) continue;
+        // The floor lies within its rim: its RMS distance from the circle's centre is at most
+        // the radius (a disk filling the circle: 0.71 radius; a floor round a central peak:
+        // about as much). A moat round a knob, rimmed by the knob's flanks, lies outside it.
+        const double inside =
+            fl.spread / double(std::max<std::size_t>(fl.count, 1)) + c.x * c.x + c.y * c.y;
+        if (!(inside <= c.r * c.r)) continue;
         fl.circle = c;
         double crest = 0;
         for (int s = 0; s < kSectors; ++s)
@@ -347,7 +355,6 @@ bool make_crater(const TriangleMesh& mesh, const Dem& dem, const RegionGraph& gr
                  const CraterOptions& options, const Floor& fl, Crater& k,
                  std::array<double, 2>& xy) {
     const auto& c = fl.circle;
-    const double quality = std::max(0.0, 1 - 4 * c.rms / c.r);
     k.floor_region = fl.members[0];
     k.diameter_m = 2 * c.r;
     k.depth_m = fl.crest - fl.lowest;
@@ -355,9 +362,21 @@ bool make_crater(const TriangleMesh& mesh, const Dem& dem, const RegionGraph& gr
     k.fit_rms_m = c.rms;
     k.field_scale_m = graph.regions[fl.members[0] - 1].field_scale_m;
     k.circularity = std::min(1.0, 4 * std::numbers::pi * fl.area / (fl.perimeter * fl.perimeter));
-    const double roundness =
-        options.round_floor > 0 ? std::min(1.0, k.circularity / options.round_floor) : 1.0;
-    k.confidence = k.rim_fraction * quality * roundness;
+    double field = 0, area = 0;  // the floor's mean field, over its one or two regions
+    for (const auto id : fl.members)
+        if (id != 0) {
+            const auto& region = graph.regions[id - 1];
+            field += region.field_mean * region.area_m2;
+            area += region.area_m2;
+        }
+    CraterEvidence evidence;
+    evidence.rim_fraction = k.rim_fraction;
+    evidence.fit_rms_m = c.rms;
+    evidence.radius_m = c.r;
+    evidence.pixel_m = std::sqrt(fl.area / double(std::max<std::size_t>(fl.count, 1)));
+    evidence.circularity = k.circularity;
+    evidence.floor_mean = area > 0 ? field / area : options.concave_below;
+    k.confidence = crater_confidence(evidence, options);
     if (k.confidence < options.min_confidence) return false;
     for (int s = 0; s < kSectors; ++s)
         if (fl.kept[std::size_t(s)]) k.rim_regions.push_back(fl.from[std::size_t(s)]);
@@ -448,6 +467,20 @@ void to_lonlat(const Dem& dem, CraterTable& table, std::vector<double>& cx,
 }
 
 }  // namespace
+
+double crater_confidence(const CraterEvidence& e, const CraterOptions& options) {
+    const double half_pixel = 0.5 * e.pixel_m;
+    const double misfit =
+        std::sqrt(std::max(0.0, e.fit_rms_m * e.fit_rms_m - half_pixel * half_pixel));
+    const double quality = e.radius_m > 0 ? std::max(0.0, 1 - 4 * misfit / e.radius_m) : 0.0;
+    const double roundness =
+        options.round_floor > 0 ? std::min(1.0, e.circularity / options.round_floor) : 1.0;
+    const double band = options.concave_below - options.concave_full;
+    const double concavity =
+        band > 0 ? std::clamp((options.concave_below - e.floor_mean) / band, 0.0, 1.0)
+                 : (e.floor_mean < options.concave_below ? 1.0 : 0.0);
+    return std::clamp(e.rim_fraction, 0.0, 1.0) * quality * roundness * concavity;
+}
 
 CraterTable find_craters(const TriangleMesh& mesh, const Dem& dem,
                          const std::vector<std::uint32_t>& labels, const RegionGraph& graph,

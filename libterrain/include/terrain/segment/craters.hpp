@@ -28,8 +28,7 @@ struct Crater {
     double field_scale_m = 0;  // the floor region's field scale (0 without one)
     std::uint32_t floor_region = 0;
     std::vector<std::uint32_t> rim_regions;  // the convex regions the crest was found in
-    // rim_fraction x fit quality (1 - 4 fit_rms_m / radius, at least 0) x roundness (the
-    // floor's circularity over CraterOptions::round_floor, at most 1): in [0, 1].
+    // In [0, 1]: crater_confidence(), rim fraction x fit quality x roundness x concavity.
     double confidence = 0;
     // The rim circle as a closed ring of kRimPoints + 1 points, in the centre's coordinates
     // (lon, lat, longitudes kept within 180 degrees of the centre's; or map x, y).
@@ -47,15 +46,36 @@ struct CraterOptions {
     double concave_below = 50;  // a floor's mean field (shape index x 100) is below this
     double convex_above = 50;   // a rim region's mean field is above this
     double min_rim_fraction = 0.5;
-    double min_confidence = 0.4;
+    double min_confidence = 0.3;
     // A floor this round (4 pi area / perimeter^2) or rounder takes its whole confidence; a
     // less round one, in proportion.
     double round_floor = 0.4;
+    // A floor whose mean field is this low or lower (the top of Koenderink's concave classes:
+    // shape index -1/8) takes its whole confidence; one between this and concave_below, in
+    // proportion to how far below concave_below it is.
+    double concave_full = 43.75;
 
     // The rim crest is looked for between these multiples of the floor's radius (of a disk
     // of its area) from its centroid.
     double crest_from = 0.8, crest_to = 1.4;
 };
+
+// What a crater's confidence is made of (CraterOptions for the constants):
+struct CraterEvidence {
+    double rim_fraction = 0;  // share of the 36 directions with a crest point on the circle
+    double fit_rms_m = 0;     // the crest points' RMS distance to the circle
+    double radius_m = 0;      // the circle's
+    double pixel_m = 0;       // the grid's spacing at the floor (square root of a vertex's area)
+    double circularity = 0;   // the floor's, 4 pi area / perimeter^2
+    double floor_mean = 0;    // the floor's mean field (shape index x 100)
+};
+// rim fraction x fit quality x roundness x concavity, in [0, 1]:
+// - fit quality 1 - 4 misfit / radius (at least 0), the misfit being the RMS beyond what the
+//   grid explains: a crest point is a vertex, up to half a pixel off the crest it samples, so
+//   misfit^2 = max(0, rms^2 - (pixel / 2)^2);
+// - roundness min(1, circularity / round_floor);
+// - concavity (concave_below - floor_mean) / (concave_below - concave_full), within [0, 1].
+double crater_confidence(const CraterEvidence& evidence, const CraterOptions& options = {});
 
 // The craters of a DEM's segmentation: `labels` per mesh vertex (1..regions), `graph` its
 // region graph (segment::region_graph), `dem` the DEM the mesh was made from. A floor is a
@@ -65,7 +85,8 @@ struct CraterOptions {
 // of 36 directions from the floor's centroid (between crest_from and crest_to floor radii) is a rim
 // crest point; a circle is fitted to them (twice, dropping points more than a quarter radius off);
 // kept when crest points are found in half the directions or more, the radius is between
-// 0.8 crest_from and crest_to floor radii, the depth positive and the confidence at least
+// 0.8 crest_from and crest_to floor radii, the floor within the circle (its RMS distance from
+// the centre at most the radius), the depth positive and the confidence at least
 // min_confidence. Of two craters
 // whose centres are within half the larger radius and whose radii are within 1.5x, the more
 // confident stays. Deterministic. Throws terrain::Error (stage "craters") on sizes that do
