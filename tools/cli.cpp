@@ -115,13 +115,12 @@ void add_dem_options(po::options_description& options, DemOptionValues& values) 
 io::ReadDemOptions to_read_options(const DemOptionValues& values) {
     io::ReadDemOptions options;
     options.band = values.band;
-    if (values.elevation == "radius")
-        options.elevation = ElevationKind::radius;
-    else if (values.elevation == "height")
-        options.elevation = ElevationKind::height;
-    else if (values.elevation != "auto")
-        throw Error("options",
-                    "--elevation must be radius, height or auto, not '" + values.elevation + "'");
+    if (values.elevation != "auto") {
+        options.elevation = value_named(kElevationNames, values.elevation);
+        if (!options.elevation)
+            throw Error("options", "--elevation must be radius, height or auto, not '" +
+                                       values.elevation + "'");
+    }
     options.nan_as_nodata = values.nan_nodata;
     if (values.pixel_size < 0 || !std::isfinite(values.pixel_size) || values.pixel_size > 1e9)
         throw Error("options", "--pixel-size must be a number of metres in (0, 1e9]");

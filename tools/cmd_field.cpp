@@ -69,7 +69,7 @@ int run_field(int argc, char** argv) {
         io::check_output_path(output, overwrite);
 
         const auto progress = terminal_progress(quiet);
-        const Input input = load_input(input_path, input_values, field_values.name,
+        const Input input = load_input(input_path, input_values, field_options.kind,
                                        scaled_progress(progress, 0, 0.4));
         const auto field_progress = scaled_progress(progress, 0.4, 1);
         std::vector<float> values;

@@ -29,7 +29,7 @@ int run_mesh(int argc, char** argv) {
             return 0;
         io::check_output_path(output, overwrite);
         const TriangleMesh mesh =
-            load_input(input_path, input_values, "", terminal_progress(quiet)).mesh;
+            load_input(input_path, input_values, std::nullopt, terminal_progress(quiet)).mesh;
         io::write_ply(mesh, output, overwrite);
 
         const auto topo = mesh_topology(mesh);

@@ -75,7 +75,7 @@ int run_reeb(int argc, char** argv) {
             throw UsageError("--write-field and -o name the same file '" + common.output + "'");
 
         const auto progress = terminal_progress(common.quiet);
-        const Input input = load_input(common.input, input_values, field_values.name,
+        const Input input = load_input(common.input, input_values, field_options.kind,
                                        scaled_progress(progress, 0, 0.3));
         const Dem* dem = input.dem ? &*input.dem : nullptr;
         if (!min_area.empty())

@@ -43,7 +43,7 @@ int run_segment(int argc, char** argv) {
         pipeline::OutputDirectory dir(common.output, common.overwrite);
 
         const auto progress = terminal_progress(common.quiet);
-        auto input = load_input(common.input, input_values, field_values.name,
+        auto input = load_input(common.input, input_values, field_values.options.kind,
                                 scaled_progress(progress, 0, 0.15), true);
         check_field_limits(field_values.options, input.mesh);  // --radius against the mesh
         print_input_warnings("segment", input);

@@ -59,7 +59,7 @@ int run_sweep(int argc, char** argv) {
         pipeline::OutputDirectory dir(common.output, common.overwrite);
 
         const auto progress = terminal_progress(common.quiet);
-        auto input = load_input(common.input, input_values, field_values.name,
+        auto input = load_input(common.input, input_values, field_values.options.kind,
                                 scaled_progress(progress, 0, 0.15));
         check_field_limits(field_values.options, input.mesh);  // --radius against the mesh
         print_input_warnings("sweep", input);

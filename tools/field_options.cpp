@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "terrain/core/error.hpp"
+#include "terrain/pipeline/options.hpp"
 
 namespace terrain::cli {
 
@@ -35,12 +36,6 @@ void add_field_options(po::options_description& options, FieldOptionValues& valu
         "sdf: no bilateral smoothing of the face values")(
         "allow-open", po::bool_switch(&sdf.allow_open),
         "sdf: compute on a mesh with holes (rays through them are lost)");
-}
-
-field::ShapeIndexWindow parse_window(const std::string& name) {
-    if (name == "disk") return field::ShapeIndexWindow::disk;
-    if (name == "ball") return field::ShapeIndexWindow::ball;
-    throw Error("options", "--window must be disk or ball, not '" + name + "'");
 }
 
 bool no_scale_option(const po::variables_map& vm) {
@@ -102,7 +97,7 @@ field::FieldOptions to_field_options(const FieldOptionValues& values, const po::
         throw Error("options", "--rings must be between 1 and " + std::to_string(kMaxRings));
     if (!(out.shape_index.radius >= 0) || !std::isfinite(out.shape_index.radius))
         throw Error("options", "--radius must be a positive number of metres");
-    out.shape_index.window = parse_window(values.window);
+    out.shape_index.window = pipeline::parse_window(values.window);
     if (out.sdf.rays < 1 || out.sdf.rays > kMaxRays)
         throw Error("options", "--rays must be between 1 and " + std::to_string(kMaxRays));
     if (!(values.cone_angle_degrees > 0 && values.cone_angle_degrees < 180))

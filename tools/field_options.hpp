@@ -32,9 +32,6 @@ constexpr int kMaxRings = 10;
 constexpr int kMaxRays = 1000;
 constexpr double kMaxRadiusEdges = 20;
 
-// The window --window names (disk or ball); throws terrain::Error for another name.
-field::ShapeIndexWindow parse_window(const std::string& name);
-
 // The library's options from the parsed values; throws UsageError for contradictions.
 field::FieldOptions to_field_options(const FieldOptionValues& values, const po::variables_map& vm);
 

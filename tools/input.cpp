@@ -16,8 +16,8 @@ void add_input_options(po::options_description& options, InputOptionValues& valu
         "mesh input: repair degenerate or non-manifold elements instead of refusing");
 }
 
-Input load_input(const std::string& path, const InputOptionValues& values, const std::string& field,
-                 const ProgressFn& progress, bool segment) {
+Input load_input(const std::string& path, const InputOptionValues& values,
+                 std::optional<field::FieldKind> field, const ProgressFn& progress, bool segment) {
     pipeline::InputOptions options;
     options.dem = to_read_options(values.dem);  // checks the values
     // The pipeline's memory plan for the field computed next (segment: pipeline::segment's),
@@ -27,10 +27,11 @@ Input load_input(const std::string& path, const InputOptionValues& values, const
     if (!values.dem.max_memory.empty())
         options.max_memory = parse_memory_size(values.dem.max_memory);
     options.repair = values.repair;
-    if (!io::is_mesh_file(path)) {
-        if (values.frame != "body" && values.frame != "map" && values.frame != "auto")
+    // (A mesh file keeps its own frame: --frame is not read.)
+    if (!io::is_mesh_file(path) && values.frame != "auto") {
+        options.frame = value_named(pipeline::kFrameNames, values.frame);
+        if (!options.frame)
             throw Error("options", "--frame must be body, map or auto, not '" + values.frame + "'");
-        options.frame = values.frame;
     }
     return pipeline::load_input(path, options, progress);
 }

@@ -7,6 +7,7 @@
 
 #include "cli.hpp"
 #include "dem_options.hpp"
+#include "terrain/field/field_kind.hpp"
 #include "terrain/pipeline/segment.hpp"
 
 namespace terrain::cli {
@@ -24,9 +25,10 @@ using Input = pipeline::Input;
 
 // Reads `path` as a mesh file (.off/.ply/.obj) or a DEM and builds the mesh
 // (pipeline::load_input, with the options checked and the memory planned for computing
-// `field` next: "shape-index", "sdf", "height", or "" for meshing only, and `segment` for
-// pipeline::segment's own plan; --max-memory).
-Input load_input(const std::string& path, const InputOptionValues& values, const std::string& field,
-                 const ProgressFn& progress, bool segment = false);
+// `field` next, none for meshing only, and `segment` for pipeline::segment's own plan;
+// --max-memory).
+Input load_input(const std::string& path, const InputOptionValues& values,
+                 std::optional<field::FieldKind> field, const ProgressFn& progress,
+                 bool segment = false);
 
 }  // namespace terrain::cli

@@ -37,24 +37,25 @@ void check_one_area_threshold(const po::variables_map& vm, const std::string& ar
 pipeline::SegmentOptions to_pipeline_options(const FieldOptionValues& field,
                                              const SegmentOptionValues& values) {
     pipeline::SegmentOptions out;
-    out.field = field.name;
+    out.field = field.options.kind;
     out.shape_index = field.options.shape_index;
-    out.shape_index.window = parse_window(field.window);  // (to_field_options parsed it too)
     out.rays = field.options.sdf.rays;
     out.cone_angle_degrees = field.cone_angle_degrees;
     out.postprocess = !field.no_postprocess;
     out.allow_open = field.options.sdf.allow_open;
     out.simplify = values.simplify;
-    out.min_area = values.min_area;
-    out.cost = values.cost;
     out.saddle_penalty = values.grow.saddle_penalty;
-    out.absorbed = values.absorbed;
     out.format = values.format;
     out.landform_defaults = values.landform_defaults;
     if (values.craters != "on" && values.craters != "off")
         throw UsageError("--craters takes on or off, not '" + values.craters + "'");
     out.craters = values.craters == "on";
+    // The numbers first, then the names (of several bad values, the first in this order is
+    // the one reported).
     pipeline::check_options(out);
+    out.cost = pipeline::parse_cost(values.cost);
+    out.min_area = pipeline::parse_min_area(values.min_area);
+    out.absorbed = pipeline::parse_absorbed(values.absorbed);
     return out;
 }
 

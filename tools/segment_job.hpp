@@ -31,8 +31,9 @@ void add_segment_options(po::options_description& options, SegmentOptionValues& 
 // Throws UsageError (exit status 2) when both --area-ratio and `area_option` are given.
 void check_one_area_threshold(const po::variables_map& vm, const std::string& area_option);
 
-// The pipeline's options from the parsed field and segment options; checked before any
-// long work (terrain::Error, exit status 1).
+// The pipeline's options from the field options (to_field_options' values) and the segment
+// options, their texts parsed (terrain/pipeline/options.hpp); checked before any long work
+// (terrain::Error, exit status 1).
 pipeline::SegmentOptions to_pipeline_options(const FieldOptionValues& field,
                                              const SegmentOptionValues& values);
 

@@ -70,11 +70,17 @@ void bind_dem(py::module_& m) {
           py::arg("geotransform") = py::none(), py::arg("crs") = "", py::arg("elevation") = "auto");
 }
 
-// pipeline::SegmentOptions, every option of the segment job.
+// pipeline::SegmentOptions, every option of the segment job. The options the library holds as
+// values are given and read back as the command line's names (terrain/pipeline/options.hpp),
+// each read once, when it is set.
 void bind_segment_options(py::module_& m) {
     py::class_<pipeline::SegmentOptions>(m, "SegmentOptions")
         .def(py::init<>())
-        .def_readwrite("field", &pipeline::SegmentOptions::field)
+        .def_property(
+            "field", [](const pipeline::SegmentOptions& o) { return field::to_string(o.field); },
+            [](pipeline::SegmentOptions& o, const std::string& v) {
+                o.field = field::parse_field_kind(v);
+            })
         .def_property(
             "rings", [](const pipeline::SegmentOptions& o) { return o.shape_index.rings; },
             [](pipeline::SegmentOptions& o, int v) { o.shape_index.rings = v; })
@@ -105,13 +111,10 @@ void bind_segment_options(py::module_& m) {
         .def_property(
             "window",
             [](const pipeline::SegmentOptions& o) {
-                return o.shape_index.window == field::ShapeIndexWindow::disk ? "disk" : "ball";
+                return field::to_string(o.shape_index.window);
             },
             [](pipeline::SegmentOptions& o, const std::string& v) {
-                if (v != "disk" && v != "ball")
-                    throw Error("options", "window must be disk or ball, not '" + v + "'");
-                o.shape_index.window =
-                    v == "disk" ? field::ShapeIndexWindow::disk : field::ShapeIndexWindow::ball;
+                o.shape_index.window = pipeline::parse_window(v, "window");
             })
         .def_readwrite("rays", &pipeline::SegmentOptions::rays)
         .def_readwrite("cone_angle", &pipeline::SegmentOptions::cone_angle_degrees)
@@ -124,19 +127,32 @@ void bind_segment_options(py::module_& m) {
             "area_ratio", [](const pipeline::SegmentOptions& o) { return o.simplify.area_ratio; },
             [](pipeline::SegmentOptions& o, double v) { o.simplify.area_ratio = v; })
         .def_property(
-            "min_area", [](const pipeline::SegmentOptions& o) { return o.min_area; },
+            "min_area",
+            [](const pipeline::SegmentOptions& o) { return pipeline::to_string(o.min_area); },
             [](pipeline::SegmentOptions& o, const py::object& v) {
-                // An area as text ("5km2") or a number of m^2; None clears it.
+                // An area as text ("5km2", "auto") or a number of m^2 (kept as Python writes
+                // it, "150000000.0"); None clears it.
                 if (v.is_none())
-                    o.min_area.clear();
+                    o.min_area = {};
                 else if (py::isinstance<py::str>(v))
-                    o.min_area = v.cast<std::string>();
+                    o.min_area = pipeline::parse_min_area(v.cast<std::string>());
                 else
-                    o.min_area = py::str(py::float_(v)).cast<std::string>();
+                    o.min_area =
+                        pipeline::parse_min_area(py::str(py::float_(v)).cast<std::string>());
             })
-        .def_readwrite("cost", &pipeline::SegmentOptions::cost)
+        .def_property(
+            "cost",
+            [](const pipeline::SegmentOptions& o) { return pipeline::name_or_auto(o.cost); },
+            [](pipeline::SegmentOptions& o, const std::string& v) {
+                o.cost = pipeline::parse_cost(v);
+            })
         .def_readwrite("saddle_penalty", &pipeline::SegmentOptions::saddle_penalty)
-        .def_readwrite("absorbed", &pipeline::SegmentOptions::absorbed)
+        .def_property(
+            "absorbed",
+            [](const pipeline::SegmentOptions& o) { return pipeline::name_or_auto(o.absorbed); },
+            [](pipeline::SegmentOptions& o, const std::string& v) {
+                o.absorbed = pipeline::parse_absorbed(v);
+            })
         .def_readwrite("format", &pipeline::SegmentOptions::format)
         .def_readwrite("craters", &pipeline::SegmentOptions::craters)
         .def("check", &pipeline::check_options);

@@ -23,8 +23,7 @@ std::string crs_to_wkt(const std::string& text) {
 
 std::optional<ElevationKind> parse_elevation(const std::string& name) {
     if (name == "auto") return std::nullopt;
-    if (name == "height") return ElevationKind::height;
-    if (name == "radius") return ElevationKind::radius;
+    if (const auto kind = value_named(kElevationNames, name)) return *kind;
     throw Error("read", "elevation must be auto, height or radius, not '" + name + "'");
 }
 
@@ -240,7 +239,7 @@ std::uint64_t memory_limit_argument(const py::object& max_memory) {
 pipeline::InputOptions input_options(int band, const std::string& elevation, bool nan_nodata,
                                      std::optional<double> pixel_size, const std::string& frame,
                                      bool repair, const py::object& max_memory,
-                                     const std::string& field, bool segment) {
+                                     field::FieldKind field, bool segment) {
     pipeline::InputOptions o;
     o.planned_field = field;
     o.planned_segment = segment;  // pipeline::segment's own plan
@@ -249,9 +248,8 @@ pipeline::InputOptions input_options(int band, const std::string& elevation, boo
     o.dem.elevation = parse_elevation(elevation);
     o.dem.nan_as_nodata = nan_nodata;
     o.dem.pixel_size = pixel_size;
-    o.frame = frame;
+    o.frame = pipeline::parse_frame(frame);
     o.repair = repair;
-    pipeline::parse_frame(frame);
     return o;
 }
 

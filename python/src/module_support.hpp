@@ -129,7 +129,7 @@ std::uint64_t memory_limit_argument(const py::object& max_memory);
 pipeline::InputOptions input_options(int band, const std::string& elevation, bool nan_nodata,
                                      std::optional<double> pixel_size, const std::string& frame,
                                      bool repair, const py::object& max_memory,
-                                     const std::string& field, bool segment = false);
+                                     field::FieldKind field, bool segment = false);
 py::object labels_array(const pipeline::Input& input, const std::vector<std::uint32_t>& labels);
 void write_polygons(const pipeline::Input& input, const std::vector<std::uint32_t>& labels,
                     const segment::RegionGraph& regions, const std::string& path,

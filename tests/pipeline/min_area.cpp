@@ -30,10 +30,10 @@ TEST_CASE("parse_area reads m^2, km2, ha and refuses what is not an area", "[pip
     for (const char* bad :
          {"", "km2", "abc", "5km", "5 acres", "5km2x", "-3km2", "0", "0km2", "nan", "inf", "1e400"})
         CHECK_THROWS_AS(pipeline::parse_area(bad), Error);
+    CHECK_THROWS_AS(pipeline::parse_min_area("12 parsecs"), Error);
     pipeline::SegmentOptions options;
-    options.min_area = "12 parsecs";
-    CHECK_THROWS_AS(pipeline::check_options(options), Error);
-    options.min_area = "12km2";
+    options.min_area = pipeline::parse_min_area("12km2");
+    CHECK(options.min_area.m2 == 12e6);
     CHECK_NOTHROW(pipeline::check_options(options));
     // Lists for the sweep: sorted by area, duplicates once, bad items named.
     const auto areas = pipeline::parse_min_areas("5km2,200ha,1km2,1000000");
@@ -62,7 +62,7 @@ TEST_CASE("min_area X gives the labels of area ratio 100 X / A on a mesh of area
     CHECK(reeb::area_ratio_for_area(input.mesh, 10 * A) == 100);  // capped
 
     pipeline::SegmentOptions by_area, by_ratio;
-    by_area.min_area = text;
+    by_area.min_area = pipeline::parse_min_area(text);
     by_ratio.simplify.area_ratio = 100 * X / A;
     const auto a =
         pipeline::segment(pipeline::load_input(test::sample("moon_ldem4_copernicus.tif")), by_area);
@@ -136,7 +136,7 @@ TEST_CASE("the same crater is kept in a small and a large tile at the same --min
     const Dem small = crop(large, 80, 80, 80);
 
     pipeline::SegmentOptions by_area;
-    by_area.min_area = "2km2";  // below the crater's 4.9 km^2
+    by_area.min_area = pipeline::parse_min_area("2km2");  // below the crater's 4.9 km^2
     const auto s = pipeline::segment(pipeline::input_from_dem(small), by_area);
     const auto l = pipeline::segment(pipeline::input_from_dem(large), by_area);
     CHECK(crater_kept(s, 40, 40, radius));
@@ -161,11 +161,11 @@ TEST_CASE("pipeline::sweep over areas: each scale is a segment at that --min-are
     CHECK(sweep.scales[0].min_area_m2 == 1e8);
     CHECK(sweep.scales[0].ratio < sweep.scales[1].ratio);
     // The finest scale is a segment at its area; the coarser one continues from it.
-    options.min_area = "100km2";
+    options.min_area = pipeline::parse_min_area("100km2");
     const auto one = pipeline::segment(pipeline::load_input(path), options);
     CHECK(sweep.scales[0].ratio == one.area_ratio_percent);
     CHECK(sweep.scales[0].segmentation.labels == one.segmentation.labels);
-    options.min_area = "400km2";
+    options.min_area = pipeline::parse_min_area("400km2");
     const auto coarse = pipeline::segment(pipeline::load_input(path), options);
     CHECK(sweep.scales[1].ratio == coarse.area_ratio_percent);
     CHECK(sweep.scales[0].segmentation.region_count >= sweep.scales[1].segmentation.region_count);

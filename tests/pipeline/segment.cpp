@@ -135,8 +135,9 @@ TEST_CASE("pipeline::segment gives the DEM back bit for bit, floats or not", "[p
         parking.park_min_bytes = 0;
         parking.park_directory = test::scratch_dir("pipeline_parked").string();
         holding.park_min_bytes = SIZE_MAX;
-        parking.field = holding.field = field;
-        const auto result = pipeline::segment(pipeline::input_from_dem(dem, "map"), parking);
+        parking.field = holding.field = field::parse_field_kind(field);
+        const auto result =
+            pipeline::segment(pipeline::input_from_dem(dem, MeshFrame::map), parking);
         REQUIRE(result.dem());
         const auto& back = result.dem()->values;
         REQUIRE(back.size() == dem.values.size());
@@ -148,7 +149,7 @@ TEST_CASE("pipeline::segment gives the DEM back bit for bit, floats or not", "[p
         const std::size_t n = dem.values.size(), nv = result.input.mesh.vertex_count();
         const std::size_t dem_bytes = (step == 0.5 ? 4 : 8) * n;
         pipeline::SegmentResult unsimplified;
-        unsimplified.input = pipeline::input_from_dem(dem, "map");
+        unsimplified.input = pipeline::input_from_dem(dem, MeshFrame::map);
         pipeline::compute_field(unsimplified, holding);
         const std::size_t nodes = pipeline::compute_reeb(unsimplified).node_count();
         CHECK(result.parked_bytes ==
@@ -171,7 +172,7 @@ TEST_CASE("pipeline::segment gives the DEM back bit for bit, floats or not", "[p
         CHECK(result.parked_most == std::max(sweeps, result.parked_bytes));
         CHECK(result.parked_file >= result.parked_most);
         CHECK(result.parked_file <= result.parked_most + 9 * 4096);
-        const auto held = pipeline::segment(pipeline::input_from_dem(dem, "map"), holding);
+        const auto held = pipeline::segment(pipeline::input_from_dem(dem, MeshFrame::map), holding);
         CHECK(result.label_pixels() == held.label_pixels());
         CHECK(result.field == held.field);
         CHECK(result.segmentation.labels == held.segmentation.labels);
@@ -199,12 +200,11 @@ TEST_CASE("pipeline options are checked before any work", "[pipeline]") {
     CHECK_THROWS_WITH(pipeline::check_options(options),
                       "segment: --persistence must be a number >= 0");
     options = {};
-    options.cost = "cheap";
-    CHECK_THROWS_AS(pipeline::check_options(options), Error);
-    options = {};
-    options.field = "slope";
+    options.min_area = pipeline::MinArea::area(-2);
+    CHECK_THROWS_WITH(pipeline::check_options(options),
+                      "segment: --min-area takes an area above 0 in m^2 or with a unit (5km2, "
+                      "2000m2, 3ha); '-2' is not one");
     CHECK_THROWS_AS(pipeline::segment(pipeline::Input{}, options), Error);
-    CHECK_THROWS_AS(pipeline::parse_frame("sideways"), Error);
     CHECK_THROWS_AS(pipeline::parse_area_ratios("0.5,200"), Error);
     CHECK(pipeline::parse_area_ratios("1,0.25,1") == std::vector<double>{0.25, 1});
 }
@@ -333,7 +333,7 @@ TEST_CASE("pipeline::segment on a large grid: every stage reports, never going b
         reported.insert(std::string(m));
         return true;
     };
-    auto input = pipeline::input_from_dem(dem, "map", scaled_progress(progress, 0, 0.2));
+    auto input = pipeline::input_from_dem(dem, MeshFrame::map, scaled_progress(progress, 0, 0.2));
     const auto result = pipeline::segment(std::move(input), {}, scaled_progress(progress, 0.2, 1));
     CHECK(result.segmentation.region_count > 1);
     CHECK(std::is_sorted(seen.begin(), seen.end()));
@@ -368,10 +368,10 @@ TEST_CASE("pipeline::segment: a mesh file's defaults are the paper's, absorbed n
                                  0.2 * std::sin(40.0 * p[0]));
         pipeline::SegmentOptions options;
         options.landform_defaults = true;  // as the command line sets it with no scale option
-        options.field = "height";
+        options.field = field::FieldKind::height;
         options.simplify.persistence = 0.02;
         options.simplify.area_ratio = 2;
-        if (!absorbed.empty()) options.absorbed = absorbed;
+        options.absorbed = pipeline::parse_absorbed(absorbed.empty() ? "auto" : absorbed);
         return pipeline::segment(std::move(input), options);
     };
     const auto by_default = run("");

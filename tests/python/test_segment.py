@@ -206,6 +206,40 @@ def test_min_area_is_the_cli_and_an_area_ratio(cli, moon, tmp_path):
     assert graph.critical_before > len(graph.nodes["node"])
 
 
+def test_options_given_by_name_read_back_and_refuse_other_names(moon):
+    # The library holds values; the module reads the command line's names and gives them back.
+    options = terrain._terrain.SegmentOptions()
+    assert (options.field, options.cost, options.absorbed, options.min_area, options.window) == (
+        "shape-index", "auto", "auto", "", "disk")
+    for attribute, names in (("field", ("sdf", "height", "shape-index")),
+                             ("cost", ("graph", "standard", "auto")),
+                             ("absorbed", ("divide", "whole", "auto")),
+                             ("window", ("ball", "disk")),
+                             ("min_area", ("5km2", "20000ha", "auto", "1e6"))):
+        for name in names:
+            setattr(options, attribute, name)
+            assert getattr(options, attribute) == name
+    options.min_area = 1.5e8  # a number of m^2, kept as Python writes it (run.json records it)
+    assert options.min_area == "150000000.0"
+    options.min_area = None
+    assert options.min_area == ""
+    for given, line in (
+            ({"cost": "cheap"}, "segment: unknown cost 'cheap'; use graph or standard"),
+            ({"absorbed": "bad"}, "segment: --absorbed is divide, whole or auto; 'bad' is none "
+                                  "of them"),
+            ({"field": "Height"}, "field: unknown field 'Height'; use shape-index, sdf or height"),
+            ({"min_area": "AUTO"}, "segment: --min-area takes an area above 0 in m^2 or with a "
+                                   "unit (5km2, 2000m2, 3ha); 'AUTO' is not one"),
+            ({"min_area": -5}, "segment: --min-area takes an area above 0 in m^2 or with a unit "
+                               "(5km2, 2000m2, 3ha); '-5.0' is not one"),
+            ({"frame": "sideways"}, "mesh: the frame must be body, map or auto, not 'sideways'"),
+            ({"window": "cube", "radius": 30000}, "options: window must be disk or ball, not "
+                                                  "'cube'")):
+        with pytest.raises(terrain.Error) as error:
+            terrain.segment(moon, **given)
+        assert str(error.value) == line
+
+
 def test_window_is_the_cli_and_disk_by_default(cli, moon, tmp_path):
     # --radius of about 4 pixels of the 7.6 km crop.
     disk = terrain.shape_index(moon, radius=30000)

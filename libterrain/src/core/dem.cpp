@@ -3,7 +3,7 @@
 namespace terrain {
 
 const char* to_string(ElevationKind kind) {
-    return kind == ElevationKind::radius ? "radius" : "height";
+    return name_of(kElevationNames, kind);
 }
 
 const char* to_string(CrsKind kind) {

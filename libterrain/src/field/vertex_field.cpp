@@ -8,15 +8,12 @@
 namespace terrain::field {
 
 FieldKind parse_field_kind(const std::string& name) {
-    if (name == "shape-index") return FieldKind::shape_index;
-    if (name == "sdf") return FieldKind::sdf;
-    if (name == "height") return FieldKind::height;
+    if (const auto kind = value_named(kFieldKindNames, name)) return *kind;
     throw Error("field", "unknown field '" + name + "'; use shape-index, sdf or height");
 }
 
 const char* to_string(FieldKind kind) {
-    constexpr const char* kNames[] = {"shape-index", "sdf", "height"};  // FieldKind's order
-    return kNames[static_cast<int>(kind)];
+    return name_of(kFieldKindNames, kind);
 }
 
 std::vector<float> height_field(const TriangleMesh& mesh, const Dem* dem) {

@@ -263,9 +263,10 @@ void frame_caption(MapFrame& frame, const Dem& dem, const PreviewCaption& captio
     const bool local = !dem.body.has_crs;
     frame.title = (local ? std::string("local grid") : dem.body.name) +
                   (input.empty() ? std::string() : " · " + input);
-    frame.landform_classes = caption.field == "shape-index";
-    frame.caption.push_back(frame.landform_classes ? "field: shape index ×100"
-                                                   : "field: " + caption.field);
+    frame.landform_classes = caption.field == field::FieldKind::shape_index;
+    frame.caption.push_back(frame.landform_classes
+                                ? "field: shape index ×100"
+                                : std::string("field: ") + field::to_string(caption.field));
     for (const auto& p : caption.parameters) frame.caption.push_back(p);
     if (caption.regions > 0) frame.caption.push_back(std::to_string(caption.regions) + " regions");
     frame.caption.push_back(

@@ -14,13 +14,6 @@ namespace terrain::pipeline {
 using internal::clock;
 using internal::since;
 
-std::optional<MeshFrame> parse_frame(const std::string& name) {
-    if (name == "body") return MeshFrame::body;
-    if (name == "map") return MeshFrame::map;
-    if (name == "auto") return std::nullopt;
-    throw Error("mesh", "the frame must be body, map or auto, not '" + name + "'");
-}
-
 Input load_input(const std::string& path, const InputOptions& options, const ProgressFn& progress) {
     const auto t0 = clock::now();
     const MemoryPlan plan =
@@ -33,16 +26,16 @@ Input load_input(const std::string& path, const InputOptions& options, const Pro
         input.read_seconds = since(t0);
         return input;
     }
-    const auto frame = parse_frame(options.frame);
     io::ReadDemOptions dem_options = options.dem;
     dem_options.memory = plan;
     Dem dem = io::read_dem(path, dem_options, scaled_progress(progress, 0, 0.3));
     const double read_seconds = since(t0);
     mesh::DemToMeshOptions mesh_options;
-    mesh_options.frame = frame;
+    mesh_options.frame = options.frame;
     // pipeline::segment frees the triangles of a tree before the field (below): they may go
     // before the mesh's areas and adjacency, unless the SDF is to cast rays through them.
-    mesh_options.release_triangles = options.planned_segment && options.planned_field != "sdf";
+    mesh_options.release_triangles =
+        options.planned_segment && options.planned_field != field::FieldKind::sdf;
     const auto t1 = clock::now();
     Input input;
     input.mesh = mesh::dem_to_mesh(dem, mesh_options, scaled_progress(progress, 0.3, 1));
@@ -52,9 +45,9 @@ Input load_input(const std::string& path, const InputOptions& options, const Pro
     return input;
 }
 
-Input input_from_dem(Dem dem, const std::string& frame, const ProgressFn& progress) {
+Input input_from_dem(Dem dem, std::optional<MeshFrame> frame, const ProgressFn& progress) {
     mesh::DemToMeshOptions mesh_options;
-    mesh_options.frame = parse_frame(frame);
+    mesh_options.frame = frame;
     const auto t0 = clock::now();
     Input input;
     input.mesh = mesh::dem_to_mesh(dem, mesh_options, progress);

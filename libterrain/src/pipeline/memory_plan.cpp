@@ -1,7 +1,5 @@
 #include "terrain/pipeline/memory_plan.hpp"
 
-#include "terrain/field/vertex_field.hpp"
-
 namespace terrain::pipeline {
 namespace {
 constexpr double MB = 1024.0 * 1024.0;
@@ -11,7 +9,7 @@ constexpr double MB = 1024.0 * 1024.0;
 // segment` on the samples and shared DEMs (8 400 to 1 036 800 pixels) and on meshes written
 // from them (8 400 to 1 033 922 vertices, two faces a vertex), with a margin of about 25 %
 // over the measured slope; the table is in docs/robustness.md.
-MemoryPlan memory_plan(const std::string& field, std::uint64_t limit, bool segment) {
+MemoryPlan memory_plan(std::optional<field::FieldKind> field, std::uint64_t limit, bool segment) {
     MemoryPlan plan;
     plan.limit = limit;
     plan.bytes_per_corner = 0;  // counted in the faces (triangles)
@@ -20,7 +18,7 @@ MemoryPlan memory_plan(const std::string& field, std::uint64_t limit, bool segme
     plan.base_bytes = 50 * MB;
     plan.bytes_per_vertex = 130;
     plan.bytes_per_face = 200;
-    const bool sdf = !field.empty() && field::parse_field_kind(field) == field::FieldKind::sdf;
+    const bool sdf = field == field::FieldKind::sdf;
     if (sdf) {
         plan.bytes_per_vertex = 150;
         plan.bytes_per_face = 240;
@@ -34,7 +32,7 @@ MemoryPlan memory_plan(const std::string& field, std::uint64_t limit, bool segme
     // after the large data are freed, make a floor of about 176 MB); up to 116 for the field,
     // the Reeb graph and a sweep, which hold them (the sweep keeps the Reeb graph beside each
     // scale's working graph); 545 with the SDF.
-    if (field.empty()) {
+    if (!field) {
         plan.bytes_per_pixel = 16;
         plan.bytes_per_valid_pixel = 84;
     } else {

@@ -1,12 +1,10 @@
 #include "terrain/pipeline/segment.hpp"
 
 #include <algorithm>
-#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <numbers>
 #include <type_traits>
 
 #include "../core/pass_progress.hpp"
@@ -40,83 +38,6 @@ using internal::clock;
 using internal::PackedHeights;
 using internal::since;
 
-void check_options(const SegmentOptions& o) {
-    field::parse_field_kind(o.field);
-    if (!std::isfinite(o.simplify.persistence) || o.simplify.persistence < 0)
-        throw Error("segment", "--persistence must be a number >= 0");
-    if (!std::isfinite(o.simplify.area_ratio) || o.simplify.area_ratio < 0 ||
-        o.simplify.area_ratio > 100)
-        throw Error("segment", "--area-ratio is a percentage of the surface: between 0 and 100");
-    if (!std::isfinite(o.saddle_penalty) || o.saddle_penalty < 0)
-        throw Error("segment", "--saddle-penalty must be a number >= 0");
-    if (o.cost != "auto") segment::parse_grow_cost(o.cost);
-    if (!o.min_area.empty() && o.min_area != "auto") parse_area(o.min_area);
-    parse_absorbed(o.absorbed);
-}
-
-Absorbed parse_absorbed(const std::string& name, bool dem) {
-    if (name == "divide") return Absorbed::divide;
-    if (name == "whole") return Absorbed::whole;
-    if (name == "auto") return dem ? Absorbed::divide : Absorbed::whole;
-    throw Error("segment", "--absorbed is divide, whole or auto; '" + name + "' is none of them");
-}
-
-SegmentOptions resolve_options(const SegmentOptions& options, bool dem) {
-    SegmentOptions out = options;
-    if (out.absorbed == "auto") out.absorbed = dem ? "divide" : "whole";
-    if (out.landform_defaults && dem && out.field == "shape-index") {
-        out.shape_index.auto_scale = true;
-        out.min_area = "auto";
-    }
-    out.landform_defaults = false;
-    return out;
-}
-
-double min_area_m2(const SegmentOptions& options, const TriangleMesh& mesh) {
-    if (options.min_area.empty()) return 0;
-    if (options.min_area != "auto") return parse_area(options.min_area);
-    const double pixel = mean_vertex_area(mesh);
-    if (!(pixel > 0) || !std::isfinite(pixel))
-        throw Error("segment", "--min-area auto needs a mesh with a positive area");
-    return kAutoMinAreaPixels * pixel;
-}
-
-double parse_area(const std::string& text, const std::string& option) {
-    std::size_t used = 0;
-    double value = 0;
-    try {
-        value = std::stod(text, &used);
-    } catch (const std::exception&) {
-        used = 0;
-    }
-    std::string unit = used > 0 ? text.substr(used) : std::string();
-    unit.erase(0, unit.find_first_not_of(' '));
-    std::transform(unit.begin(), unit.end(), unit.begin(),
-                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-    double scale = 0;
-    if (unit.empty() || unit == "m2" || unit == "m^2")
-        scale = 1;
-    else if (unit == "km2" || unit == "km^2")
-        scale = 1e6;
-    else if (unit == "ha")
-        scale = 1e4;
-    const double m2 = value * scale;
-    if (used == 0 || scale == 0 || !std::isfinite(m2) || m2 <= 0)
-        throw Error("segment", option +
-                                   " takes an area above 0 in m^2 or with a unit (5km2, "
-                                   "2000m2, 3ha); '" +
-                                   text + "' is not one");
-    return m2;
-}
-
-reeb::SimplifyOptions simplify_options(const SegmentOptions& options, const TriangleMesh& mesh) {
-    reeb::SimplifyOptions out = options.simplify;
-    out.rewrite_field = false;  // (the regions grow on the graph and the field as computed)
-    if (!options.min_area.empty())
-        out.area_ratio = reeb::area_ratio_for_area(mesh, min_area_m2(options, mesh));
-    return out;
-}
-
 std::vector<std::string> georeference_warnings(const Dem& dem) {
     const std::string name = "'" + (dem.source.empty() ? std::string("the DEM") : dem.source) + "'";
     if (!dem.has_transform) {
@@ -131,22 +52,6 @@ std::vector<std::string> georeference_warnings(const Dem& dem) {
                 " has no CRS: the outputs are in its local map metres, with no "
                 "longitude/latitude"};
     return {};
-}
-
-field::FieldOptions field_options(const SegmentOptions& o) {
-    field::FieldOptions out;
-    out.kind = field::parse_field_kind(o.field);
-    out.shape_index = o.shape_index;
-    out.sdf.rays = o.rays;
-    out.sdf.cone_angle = o.cone_angle_degrees * std::numbers::pi / 180.0;
-    out.sdf.postprocess = o.postprocess;
-    out.sdf.allow_open = o.allow_open;
-    return out;
-}
-
-segment::GrowCost grow_cost(const SegmentOptions& o, bool dem) {
-    if (o.cost == "auto") return dem ? segment::GrowCost::graph : segment::GrowCost::standard;
-    return segment::parse_grow_cost(o.cost);
 }
 
 MeshCounts mesh_counts(const TriangleMesh& mesh) {
@@ -188,7 +93,7 @@ void compute_field(SegmentResult& result, const SegmentOptions& options,
     } else {
         result.field = field::vertex_field(result.input.mesh, result.dem(), fo, progress);
     }
-    if (options.field == "shape-index") {
+    if (options.field == field::FieldKind::shape_index) {
         result.shape_index_method =
             field::shape_index_method(result.input.mesh, options.shape_index);
         result.shape_index_window =
@@ -242,7 +147,7 @@ ScaleResult grow_scale(const Input& input, const std::vector<float>& field,
     segment::GrowOptions grow;
     grow.saddle_penalty = options.saddle_penalty;
     grow.cost = grow_cost(options, input.dem.has_value());
-    const bool divide = parse_absorbed(options.absorbed, input.dem.has_value()) == Absorbed::divide;
+    const bool divide = absorbed_mode(options, input.dem.has_value()) == Absorbed::divide;
     out.segmentation = segment::grow_regions(input.mesh, simplified.graph, grow,
                                              scaled_progress(progress, 0, divide ? 0.5 : 1));
     if (divide)
@@ -349,7 +254,7 @@ bool SegmentRun::field() {
     // The SDF casts rays through them: it keeps them. (The loop check is counted with the
     // field, which it precedes.)
     const auto tf = clock::now();
-    const auto kind = field::parse_field_kind(options.field);
+    const auto kind = options.field;
     const bool tree = kind != field::FieldKind::sdf &&
                       (mesh.triangles_released() || mesh.triangles_releasable()) &&
                       reeb::reeb_is_tree(mesh, scaled_progress(progress, 0, 0.02));
@@ -470,7 +375,7 @@ double SegmentRun::regions(const std::vector<double>& ranges) {
     // On a DEM, with the regions of valid pixels in no triangle (segment::label_pixels).
     result.segmentation.region_count = static_cast<std::uint32_t>(result.regions.regions.size());
     internal::set_region_scales(result);
-    if (options.min_area == "auto") internal::set_area_ranges(result, ranges);
+    if (options.min_area.is_auto()) internal::set_area_ranges(result, ranges);
     if (options.craters && result.input.dem)
         result.craters = segment::find_craters(mesh, *result.input.dem, result.segmentation.labels,
                                                result.regions);
@@ -520,7 +425,7 @@ SegmentResult segment(Input input, const SegmentOptions& requested, const Progre
     // The regions' range of area thresholds, simplifying the graph on (counted with the
     // simplification): the graph goes as it is read.
     std::vector<double> ranges;
-    if (options.min_area == "auto") {
+    if (options.min_area.is_auto()) {
         const auto tr = clock::now();
         segment::AreaRangeOptions range;
         range.floor_m2 = result.min_area_m2;

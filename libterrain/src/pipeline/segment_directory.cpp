@@ -89,26 +89,27 @@ std::vector<std::string> write_segment_directory(SegmentResult& result, const Se
     out.preview_caption.input = fs::path(input_path).filename().string();
     out.preview_caption.field = options.field;
     auto& caption = out.preview_caption.parameters;
-    if (options.field == "shape-index" && options.shape_index.auto_scale)
+    const bool shape_index = options.field == field::FieldKind::shape_index;
+    if (shape_index && options.shape_index.auto_scale)
         caption.push_back(scale_caption(result.field_radii));
-    else if (options.field == "shape-index")
+    else if (shape_index)
         caption.push_back(
             options.shape_index.radius > 0
                 ? "radius " + JsonWriter::number(options.shape_index.radius) + " m (" +
                       field::shape_index_window(result.input.mesh, options.shape_index) + ")"
                 : std::to_string(options.shape_index.rings) + " rings");
     caption.push_back("persistence " + JsonWriter::number(options.simplify.persistence));
-    if (options.min_area == "auto")
+    if (options.min_area.is_auto())
         caption.push_back("min area auto (" + caption_area(result.min_area_m2) + ")");
     else
-        caption.push_back(
-            "area ratio " + JsonWriter::number(result.area_ratio_percent) + " %" +
-            (options.min_area.empty() ? std::string() : " (min area " + options.min_area + ")"));
-    caption.push_back("cost " +
-                      std::string(options.cost == "auto" ? (result.input.dem ? "graph" : "standard")
-                                                         : options.cost) +
+        caption.push_back("area ratio " + JsonWriter::number(result.area_ratio_percent) + " %" +
+                          (options.min_area.is_set()
+                               ? " (min area " + to_string(options.min_area) + ")"
+                               : std::string()));
+    const bool dem = result.input.dem.has_value();
+    caption.push_back("cost " + std::string(segment::to_string(grow_cost(options, dem))) +
                       ", saddle penalty " + JsonWriter::number(options.saddle_penalty));
-    caption.push_back("absorbed " + options.absorbed);
+    caption.push_back("absorbed " + std::string(to_string(absorbed_mode(options, dem))));
     // The preview is written last, once the large data is freed.
     io::PreviewImage preview;
     const bool deferred = write.release_memory && result.input.dem;
@@ -177,7 +178,7 @@ void write_run_json(const SegmentResult& result, const std::string& input_path,
     j.field("input", fs::absolute(input_path).lexically_normal().string());
     j.key("parameters")
         .begin_object()
-        .field("field", options.field)
+        .field("field", field::to_string(options.field))
         .field("rings", options.shape_index.rings);
     if (options.shape_index.auto_scale) {
         j.field("radius", "auto").key("radii_m").begin_array();
@@ -190,16 +191,16 @@ void write_run_json(const SegmentResult& result, const std::string& input_path,
     }
     j.field("persistence", options.simplify.persistence)
         .field("area_ratio_percent",
-               options.min_area.empty() ? options.simplify.area_ratio : result.area_ratio_percent);
-    if (!options.min_area.empty())
-        j.field("min_area", options.min_area).field("min_area_m2", result.min_area_m2);
+               options.min_area.is_set() ? result.area_ratio_percent : options.simplify.area_ratio);
+    if (options.min_area.is_set())
+        j.field("min_area", to_string(options.min_area)).field("min_area_m2", result.min_area_m2);
     if (result.regions.has_area_range) internal::write_area_range(j, result);
-    j.field("cost", options.cost == "auto" ? (dem ? "graph" : "standard") : options.cost.c_str())
+    j.field("cost", segment::to_string(grow_cost(options, dem)))
         .field("saddle_penalty", options.saddle_penalty)
-        .field("absorbed", options.absorbed)
+        .field("absorbed", to_string(absorbed_mode(options, dem)))
         .field("format", options.format)
         .field("frame", to_string(result.input.mesh.frame));
-    if (options.field == "shape-index") {
+    if (options.field == field::FieldKind::shape_index) {
         const auto& mesh = result.input.mesh;
         j.field("shape_index_method",
                 !result.shape_index_method.empty()
@@ -210,7 +211,7 @@ void write_run_json(const SegmentResult& result, const std::string& input_path,
                        ? result.shape_index_window
                        : std::string(field::shape_index_window(mesh, options.shape_index)));
     }
-    if (options.field == "sdf")
+    if (options.field == field::FieldKind::sdf)
         j.field("rays", options.rays)
             .field("cone_angle_degrees", options.cone_angle_degrees)
             .field("postprocess", options.postprocess)

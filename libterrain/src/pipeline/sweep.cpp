@@ -8,7 +8,6 @@
 #include <chrono>
 #include <cmath>
 #include <fstream>
-#include <sstream>
 
 #include "terrain/core/error.hpp"
 #include "terrain/core/json_writer.hpp"
@@ -45,52 +44,6 @@ void check_ratios(const std::vector<double>& ratios) {
 }
 
 }  // namespace
-
-std::vector<double> parse_area_ratios(const std::string& text) {
-    std::vector<double> out;
-    std::stringstream ss(text);
-    std::string item;
-    while (std::getline(ss, item, ',')) {
-        std::size_t used = 0;
-        double v = 0;
-        try {
-            v = std::stod(item, &used);
-        } catch (const std::exception&) {
-            used = 0;
-        }
-        if (used != item.size() || !std::isfinite(v) || v <= 0 || v > 100)
-            throw Error("sweep",
-                        "--area-ratios takes percentages in (0, 100] separated by commas; '" +
-                            item + "' is not one");
-        out.push_back(v);
-    }
-    if (out.empty()) throw Error("sweep", "--area-ratios needs at least one value");
-    std::sort(out.begin(), out.end());
-    out.erase(std::unique(out.begin(), out.end()), out.end());
-    return out;
-}
-
-std::vector<AreaThreshold> parse_min_areas(const std::string& text) {
-    std::vector<AreaThreshold> out;
-    std::stringstream ss(text);
-    std::string item;
-    while (std::getline(ss, item, ',')) {
-        try {
-            out.push_back({item, parse_area(item, "--min-areas")});
-        } catch (const Error& e) {
-            // The same message, from the sweep's stage.
-            throw Error("sweep", std::string(e.what()).substr(e.stage().size() + 2));
-        }
-    }
-    if (out.empty()) throw Error("sweep", "--min-areas needs at least one value");
-    std::stable_sort(out.begin(), out.end(),
-                     [](const AreaThreshold& a, const AreaThreshold& b) { return a.m2 < b.m2; });
-    out.erase(
-        std::unique(out.begin(), out.end(),
-                    [](const AreaThreshold& a, const AreaThreshold& b) { return a.m2 == b.m2; }),
-        out.end());
-    return out;
-}
 
 namespace {
 
@@ -165,7 +118,7 @@ SweepResult run_sweep(Input input, const std::vector<ScaleSpec>& specs,
             SegmentOptions scale_options = options;
             scale_options.simplify.area_ratio = specs[i].ratio;
             scale_options.simplify.rewrite_field = false;  // (nor does a sweep read it)
-            scale_options.min_area.clear();
+            scale_options.min_area = {};
             auto simplified = reeb::simplify(base.input.mesh, i == 0 ? graph : finer.graph,
                                              scale_options.simplify);
             // Absorbed at this scale or a finer one.
@@ -401,11 +354,12 @@ std::vector<std::string> write_sweep_directory(SweepResult& result, const Segmen
     }
     const std::string per_scale = per_scale_json(scales, by_area);
     SegmentOptions recorded = options;
-    recorded.min_area.clear();
+    recorded.min_area = {};
     if (!scales.empty()) {
         recorded.simplify.area_ratio = scales.back().ratio;
         base.area_ratio_percent = scales.back().ratio;
-        if (by_area) recorded.min_area = scales.back().name;
+        if (by_area)
+            recorded.min_area = MinArea::area(scales.back().min_area_m2, scales.back().name);
     }
     write_run_json(base, input_path, recorded, files, d + "run.json", {{"scales", per_scale}});
     files.push_back("run.json");

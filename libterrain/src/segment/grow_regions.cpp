@@ -21,13 +21,12 @@
 namespace terrain::segment {
 
 GrowCost parse_grow_cost(const std::string& name) {
-    if (name == "graph") return GrowCost::graph;
-    if (name == "standard") return GrowCost::standard;
+    if (const auto cost = value_named(kGrowCostNames, name)) return *cost;
     throw Error("segment", "unknown cost '" + name + "'; use graph or standard");
 }
 
 const char* to_string(GrowCost cost) {
-    return cost == GrowCost::graph ? "graph" : "standard";
+    return name_of(kGrowCostNames, cost);
 }
 
 namespace {

@@ -11,11 +11,17 @@
 
 #include "terrain/core/body.hpp"
 #include "terrain/core/georef.hpp"
+#include "terrain/core/names.hpp"
 
 namespace terrain {
 
 enum class ElevationKind { height, radius };
 
+// The names --elevation (and the Python module's elevation=) give the kinds, besides "auto".
+inline constexpr Named<ElevationKind> kElevationNames[] = {
+    {"radius", ElevationKind::radius},
+    {"height", ElevationKind::height},
+};
 const char* to_string(ElevationKind kind);
 
 struct Dem {

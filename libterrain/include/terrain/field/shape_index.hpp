@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "terrain/core/names.hpp"
 #include "terrain/core/progress.hpp"
 #include "terrain/mesh/triangle_mesh.hpp"
 
@@ -27,6 +28,15 @@ enum class ShapeIndexMethod { automatic, mesh, grid };
 // the radius in 3-D, reached through vertices within it, with the tangent-frame fit
 // (docs/field.md, "Windows and methods").
 enum class ShapeIndexWindow { disk, ball };
+
+// The windows' names (--window, run.json).
+inline constexpr Named<ShapeIndexWindow> kShapeIndexWindowNames[] = {
+    {"disk", ShapeIndexWindow::disk},
+    {"ball", ShapeIndexWindow::ball},
+};
+inline const char* to_string(ShapeIndexWindow window) {
+    return name_of(kShapeIndexWindowNames, window);
+}
 
 struct ShapeIndexOptions {
     int rings = 2;      // neighbourhood: vertices within this many mesh edges

@@ -1,23 +1,18 @@
 #pragma once
-// The scalar field the Reeb graph is built on, chosen by name, and its way back to the DEM's
-// pixels.
+// The scalar field the Reeb graph is built on, chosen by its kind, and its way back to the
+// DEM's pixels.
 
 #include <string>
 #include <vector>
 
 #include "terrain/core/dem.hpp"
 #include "terrain/core/progress.hpp"
+#include "terrain/field/field_kind.hpp"
 #include "terrain/field/sdf.hpp"
 #include "terrain/field/shape_index.hpp"
 #include "terrain/mesh/triangle_mesh.hpp"
 
 namespace terrain::field {
-
-enum class FieldKind { shape_index, sdf, height };
-
-// "shape-index", "sdf" or "height"; throws terrain::Error for anything else.
-FieldKind parse_field_kind(const std::string& name);
-const char* to_string(FieldKind kind);
 
 struct FieldOptions {
     FieldKind kind = FieldKind::shape_index;

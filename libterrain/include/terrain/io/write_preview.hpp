@@ -9,14 +9,16 @@
 #include <vector>
 
 #include "terrain/core/dem.hpp"
+#include "terrain/field/field_kind.hpp"
 
 namespace terrain::io {
 
 // What the map's caption says beyond what the DEM tells (its body, CRS and pixel size): plain
 // values from the caller.
 struct PreviewCaption {
-    std::string input;                    // the input's file name
-    std::string field = "shape-index";    // shape-index: the colour bar names the landform classes
+    std::string input;  // the input's file name
+    // The shape index: the colour bar names the landform classes.
+    field::FieldKind field = field::FieldKind::shape_index;
     std::vector<std::string> parameters;  // the thresholds: "persistence 10", "area ratio 0.5 %"
     std::size_t regions = 0;              // 0: not stated
 };

@@ -6,18 +6,19 @@
 // budget", gives the measurements the figures come from).
 
 #include <cstdint>
-#include <string>
+#include <optional>
 
 #include "terrain/core/memory_budget.hpp"
+#include "terrain/field/field_kind.hpp"
 
 namespace terrain::pipeline {
 
-// The plan of reading an input and working on it with `field` ("shape-index", "height",
-// "sdf"; "" for reading and meshing only, as `terrain mesh` does), with the caller's limit
-// in bytes (0: the memory available only). `segment`: the work is pipeline::segment (one
-// scale), which frees and parks on disk what its stages do not read, so a DEM costs less
-// than the field, the Reeb graph or a sweep over scales, which hold them. Throws
-// terrain::Error for an unknown field.
-MemoryPlan memory_plan(const std::string& field, std::uint64_t limit = 0, bool segment = false);
+// The plan of reading an input and working on it with `field` (unset for reading and meshing
+// only, as `terrain mesh` does), with the caller's limit in bytes (0: the memory available
+// only). `segment`: the work is pipeline::segment (one scale), which frees and parks on disk
+// what its stages do not read, so a DEM costs less than the field, the Reeb graph or a sweep
+// over scales, which hold them.
+MemoryPlan memory_plan(std::optional<field::FieldKind> field, std::uint64_t limit = 0,
+                       bool segment = false);
 
 }  // namespace terrain::pipeline

@@ -24,6 +24,7 @@
 #include "terrain/field/vertex_field.hpp"
 #include "terrain/io/read_dem.hpp"
 #include "terrain/mesh/triangle_mesh.hpp"
+#include "terrain/pipeline/options.hpp"
 #include "terrain/reeb/reeb_graph.hpp"
 #include "terrain/reeb/simplify.hpp"
 #include "terrain/segment/craters.hpp"
@@ -42,55 +43,57 @@ struct Input {
 
 struct InputOptions {
     io::ReadDemOptions dem;
-    // body, map or auto: body-fixed X,Y,Z, or map easting/northing/height (auto: body for
-    // planetary and geographic CRSs, map otherwise).
-    std::string frame = "auto";
+    // A DEM's mesh in body-fixed X,Y,Z, or in map easting/northing/height; unset (auto): body
+    // for planetary and geographic CRSs, map otherwise (mesh::default_frame).
+    std::optional<MeshFrame> frame;
     bool repair = false;  // mesh files: repair degenerate or non-manifold elements
-    // The memory plan (pipeline/memory_plan.hpp): the field computed after reading ("" for
+    // The memory plan (pipeline/memory_plan.hpp): the field computed after reading (unset for
     // reading and meshing only) and a limit in bytes (0: none but the memory available).
     // load_input checks the input's declared size against it before reading; it replaces
     // dem.memory.
-    std::string planned_field = "shape-index";
+    std::optional<field::FieldKind> planned_field = field::FieldKind::shape_index;
     std::uint64_t max_memory = 0;
     // The work is pipeline::segment, one scale, which frees and parks what its stages do not
     // read: its own, lower plan (memory_plan's `segment`).
     bool planned_segment = false;
 };
 
-// The frame named by InputOptions::frame; throws terrain::Error (stage "mesh") otherwise.
-std::optional<MeshFrame> parse_frame(const std::string& name);
-
 // Reads `path` as a mesh file (.off/.ply/.obj) or as a DEM, and meshes the DEM.
 Input load_input(const std::string& path, const InputOptions& options = {},
                  const ProgressFn& progress = {});
 // A DEM held in memory (georeferenced: geo::georeference(dem) has run), meshed.
-Input input_from_dem(Dem dem, const std::string& frame = "auto", const ProgressFn& progress = {});
+Input input_from_dem(Dem dem, std::optional<MeshFrame> frame = std::nullopt,
+                     const ProgressFn& progress = {});
 
-// The options of `terrain segment` (docs/cli.md), with its defaults.
+// The options of `terrain segment` (docs/cli.md), with its defaults. The command line and the
+// Python module read them from text with the parsers of terrain/pipeline/options.hpp.
 struct SegmentOptions {
-    std::string field = "shape-index";          // shape-index, sdf or height
+    // The shape index, the SDF or the height.
+    field::FieldKind field = field::FieldKind::shape_index;
     field::ShapeIndexOptions shape_index;       // rings, radius
     int rays = 25;                              // sdf: rays per face
     double cone_angle_degrees = 120;            // sdf: opening of each face's cone of rays
     bool postprocess = true;                    // sdf: bilateral smoothing of the face values
     bool allow_open = false;                    // sdf: a mesh with holes is accepted
     reeb::SimplifyOptions simplify{10.0, 0.5};  // persistence, area ratio (percent)
-    // The area threshold in the user's units ("5km2", "2000m2", "3ha", "1e6": m^2), "auto"
-    // (kAutoMinAreaPixels of the mesh's mean vertex area: the DEM's pixel, whatever the
-    // extent), or empty.
+    // The area threshold: an area in m^2 (parse_min_area reads "5km2", "2000m2", "3ha", "1e6"),
+    // auto (kAutoMinAreaPixels of the mesh's mean vertex area: the DEM's pixel, whatever the
+    // extent), or none.
     // When set it replaces simplify.area_ratio: an arc is cancelled when its area on the body
     // is below it, applied as the equivalent ratio 100 * min_area / (the mesh's area) percent
     // (reeb::area_ratio_for_area), so the same landform is kept whatever the tile's extent.
-    std::string min_area;
-    std::string cost = "auto";  // graph, standard, or auto: graph for DEMs, standard for meshes
+    MinArea min_area;
+    // Graph (Reeb-graph constrained) or standard; unset (auto): graph for DEMs, standard for
+    // meshes (grow_cost).
+    std::optional<segment::GrowCost> cost;
     double saddle_penalty = 20;
     std::string format = "GeoJSON";  // OGR driver of the region polygons
     // What the growing does with the vertices the simplification absorbed into surviving
-    // nodes: "divide" gives them back to the regions around by their own values
-    // (segment::divide_absorbed); "whole" keeps each node one unit, as the paper does;
-    // "auto" (default): divide on a DEM, whole on a mesh read from a file (where the paper's
-    // benchmark scores better so).
-    std::string absorbed = "auto";
+    // nodes: divide gives them back to the regions around by their own values
+    // (segment::divide_absorbed); whole keeps each node one unit, as the paper does; unset
+    // (auto, the default): divide on a DEM, whole on a mesh read from a file (where the
+    // paper's benchmark scores better so; absorbed_mode).
+    std::optional<Absorbed> absorbed;
     // Landforms at their own scale (docs/segment.md, "Landforms at their own scale"): on a DEM
     // with the shape index, the field's radius chosen per vertex (shape_index.auto_scale) and
     // min_area "auto", whatever shape_index and min_area say; a mesh file is left as it is.
@@ -108,25 +111,16 @@ struct SegmentOptions {
     std::size_t park_min_bytes = std::size_t{64} << 20;
 };
 
-enum class Absorbed { divide, whole };
-// "divide", "whole", or "auto" (divide when `dem`); throws terrain::Error otherwise.
-Absorbed parse_absorbed(const std::string& name, bool dem = true);
-
 // The smallest landform of min_area "auto", in mean vertex areas (pixels of a DEM): a floor
 // of about 5 pixels across, that of a crater of about 10.
 inline constexpr double kAutoMinAreaPixels = 20;
-// The options a run takes on this input: landform_defaults applied when `dem`.
+// The options a run takes on this input: landform_defaults applied when `dem`, absorbed set.
 SegmentOptions resolve_options(const SegmentOptions& options, bool dem);
-// The area threshold in m^2 that options.min_area gives on `mesh` (0 when it is empty).
+// The area threshold in m^2 that options.min_area gives on `mesh` (0 when it is none).
 double min_area_m2(const SegmentOptions& options, const TriangleMesh& mesh);
 
-// Thresholds and names, checked before any long work; throws terrain::Error.
+// The thresholds, checked before any long work; throws terrain::Error.
 void check_options(const SegmentOptions& options);
-
-// An area with an optional unit, in m^2: "5km2" (or km^2), "2000m2" (or m^2), "3ha", or a
-// plain number of m^2; above 0. Throws terrain::Error (stage "segment") naming `option`
-// otherwise.
-double parse_area(const std::string& text, const std::string& option = "--min-area");
 // The simplification thresholds applied on `mesh`: options.simplify, with the area ratio
 // given by options.min_area when it is set, without the rewritten field (the segmentation
 // does not read it).
@@ -141,6 +135,8 @@ std::vector<std::string> georeference_warnings(const Dem& dem);
 field::FieldOptions field_options(const SegmentOptions& options);
 // The cost `auto` resolves to: graph for a DEM, standard for a mesh file.
 segment::GrowCost grow_cost(const SegmentOptions& options, bool dem);
+// The absorbed vertices' mode `auto` resolves to: divide for a DEM, whole for a mesh file.
+Absorbed absorbed_mode(const SegmentOptions& options, bool dem);
 
 struct StageTime {
     std::string name;

@@ -13,18 +13,8 @@
 
 namespace terrain::pipeline {
 
-// "0.1,0.25,0.5" into sorted unique percentages in (0, 100]; throws terrain::Error (stage
-// "sweep") otherwise.
-std::vector<double> parse_area_ratios(const std::string& text);
-
-// An area threshold as given ("5km2") and in m^2.
-struct AreaThreshold {
-    std::string text;
-    double m2 = 0;
-};
-// "1km2,5km2,20km2" into thresholds sorted by area, equal areas once; throws terrain::Error
-// (stage "sweep") for an empty list or a value parse_area refuses.
-std::vector<AreaThreshold> parse_min_areas(const std::string& text);
+// The lists of scales as text (--area-ratios, --min-areas): parse_area_ratios and
+// parse_min_areas, terrain/pipeline/options.hpp.
 
 struct SweepScale {
     double ratio = 0;  // the area-ratio threshold applied (percent)

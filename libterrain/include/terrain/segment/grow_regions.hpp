@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "terrain/core/names.hpp"
 #include "terrain/core/progress.hpp"
 #include "terrain/mesh/triangle_mesh.hpp"
 #include "terrain/reeb/reeb_graph.hpp"
@@ -18,7 +19,14 @@
 namespace terrain::segment {
 
 enum class GrowCost { graph, standard };
-GrowCost parse_grow_cost(const std::string& name);  // "graph" or "standard"
+
+// The costs' names (--cost, run.json).
+inline constexpr Named<GrowCost> kGrowCostNames[] = {
+    {"graph", GrowCost::graph},
+    {"standard", GrowCost::standard},
+};
+// "graph" or "standard"; throws terrain::Error (stage "segment") for anything else.
+GrowCost parse_grow_cost(const std::string& name);
 const char* to_string(GrowCost cost);
 
 struct GrowOptions {
