@@ -61,7 +61,7 @@ struct ShapeIndexOptions {
     // rings and radius are ignored.
     bool auto_scale = false;
     std::vector<double> radii;
-    double contrast_curvedness = 0.2;
+    double contrast_curvedness = 0.14;
     double peak_dominance = 2.0;
     // A vertex whose window reaches beyond the grid method's tables (the disk near a pole)
     // gets no fit instead of the mesh path's (scale_selected_shape_index sets it above its

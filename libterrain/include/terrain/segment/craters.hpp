@@ -46,7 +46,7 @@ struct CraterOptions {
     double concave_below = 50;  // a floor's mean field (shape index x 100) is below this
     double convex_above = 50;   // a rim region's mean field is above this
     double min_rim_fraction = 0.5;
-    double min_confidence = 0.3;
+    double min_confidence = 0.35;
     // A floor this round (4 pi area / perimeter^2) or rounder takes its whole confidence; a
     // less round one, in proportion.
     double round_floor = 0.4;
