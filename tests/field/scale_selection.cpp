@@ -98,6 +98,22 @@ TEST_CASE("each crater is seen at its own radius, the plane reads planar", "[sca
     CHECK(s.field_at(175, 20) == 50.0f);
 }
 
+TEST_CASE("a shallow bowl keeps the contrast its curvedness is given", "[scale_selection]") {
+    // A paraboloid bowl of radius a = 32 m and depth d = 0.08 a (d/D 0.04, a lunar complex
+    // crater's) in a plane. At the 32 m rung its centre's curvedness is 4 d / (2 a) = 0.16
+    // (docs/field.md), so the field there is 50 (1 - w), w = c^2 / (c^2 + 0.14^2) = 0.57:
+    // about 22, concave; the constant 0.2 would leave it 30.5.
+    constexpr double a = 32, d = 0.08 * a;
+    const Selected s(160, [](double x, double y) {
+        const double q = std::hypot(x - 80, y - 80) / a;
+        return q < 1 ? d * (q * q - 1) : 0.0;
+    });
+    CHECK(s.radius_at(80, 80) == Approx(32.0).epsilon(0.02));
+    const double c = 4 * d / (2 * a), w = c * c / (c * c + 0.14 * 0.14);
+    CHECK(s.field_at(80, 80) == Approx(50 * (1 - w)).margin(3));
+    CHECK(s.field_at(80, 80) < 26);
+}
+
 TEST_CASE("a small crater on a large crater's floor keeps its own scale", "[scale_selection]") {
     const Selected s(
         192, [](double x, double y) { return crater(x, y, 96, 96, 40) + crater(x, y, 96, 96, 6); });
