@@ -73,6 +73,9 @@ install_packages() {
 build() {
   local launcher=()
   command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+  # Paths relative to the clone in ccache's keys: another clone of the same code (a CI run,
+  # a worktree) finds this one's objects.
+  export CCACHE_BASEDIR="${CCACHE_BASEDIR:-$here}"
   if [ ! -f "$build_dir/CMakeCache.txt" ]; then
     cmake -S . -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE=Release "${launcher[@]}"
   fi
