@@ -8,7 +8,7 @@
 #include <random>
 #include <vector>
 
-#include "../../libterrain/src/core/disjoint_sets.hpp"
+#include "terrain/internal/core/disjoint_sets.hpp"
 
 using terrain::detail::DisjointSets;
 using terrain::detail::find_root;

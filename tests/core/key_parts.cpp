@@ -8,7 +8,7 @@
 #include <random>
 #include <vector>
 
-#include "../../libterrain/src/core/key_parts.hpp"
+#include "terrain/internal/core/key_parts.hpp"
 
 namespace {
 

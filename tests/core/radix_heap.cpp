@@ -7,7 +7,7 @@
 #include <random>
 #include <vector>
 
-#include "../../libterrain/src/core/radix_heap.hpp"
+#include "terrain/internal/core/radix_heap.hpp"
 
 using terrain::detail::RadixHeap;
 

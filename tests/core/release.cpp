@@ -6,9 +6,9 @@
 #include <random>
 #include <vector>
 
-#include "../../libterrain/src/core/ranked_bits.hpp"
-#include "../../libterrain/src/core/release.hpp"
 #include "support/test_support.hpp"
+#include "terrain/internal/core/ranked_bits.hpp"
+#include "terrain/internal/core/release.hpp"
 
 using terrain::detail::PagesBehind;
 

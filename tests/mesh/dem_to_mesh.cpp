@@ -10,10 +10,10 @@
 #include <map>
 #include <numbers>
 
-#include "../../libterrain/src/mesh/grid_triangles.hpp"
 #include "support/test_support.hpp"
 #include "terrain/core/error.hpp"
 #include "terrain/geo/georeference.hpp"
+#include "terrain/internal/mesh/grid_triangles.hpp"
 #include "terrain/io/read_dem.hpp"
 #include "terrain/mesh/dem_to_mesh.hpp"
 

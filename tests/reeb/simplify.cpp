@@ -11,8 +11,8 @@
 
 #include <tbb/task_arena.h>
 
-#include "../../libterrain/src/core/release.hpp"
 #include "../../libterrain/src/reeb/simplifier.hpp"
+#include "terrain/internal/core/release.hpp"
 
 #include "support/test_meshes.hpp"
 #include "support/test_support.hpp"

@@ -16,10 +16,10 @@
 #include <limits>
 #include <numbers>
 
-#include "../core/pass_progress.hpp"
 #include "curvature_fit.hpp"
 #include "shape_index_fit.hpp"
 #include "terrain/core/error.hpp"
+#include "terrain/internal/core/pass_progress.hpp"
 
 namespace terrain::field {
 namespace detail {

@@ -8,9 +8,9 @@
 #include <cstdint>
 #include <limits>
 
-#include "../core/pass_progress.hpp"
-#include "../mesh/grid_triangles.hpp"
 #include "shape_index_fit.hpp"
+#include "terrain/internal/core/pass_progress.hpp"
+#include "terrain/internal/mesh/grid_triangles.hpp"
 
 namespace terrain::field::detail {
 

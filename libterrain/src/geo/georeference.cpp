@@ -8,8 +8,8 @@
 #include <numbers>
 
 #include "lonlat_mapping.hpp"
-#include "ogr_support.hpp"
 #include "terrain/geo/body.hpp"
+#include "terrain/internal/geo/ogr_support.hpp"
 
 namespace terrain::geo {
 namespace {

@@ -1,4 +1,4 @@
-#include "iau_crs.hpp"
+#include "terrain/internal/geo/iau_crs.hpp"
 
 #include <ogr_spatialref.h>
 

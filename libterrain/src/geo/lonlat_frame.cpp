@@ -1,4 +1,4 @@
-#include "lonlat_frame.hpp"
+#include "terrain/internal/geo/lonlat_frame.hpp"
 
 #include <cpl_conv.h>
 

@@ -6,8 +6,8 @@
 #include <cmath>
 #include <vector>
 
-#include "lonlat_frame.hpp"
 #include "terrain/core/error.hpp"
+#include "terrain/internal/geo/lonlat_frame.hpp"
 
 namespace terrain::geo {
 namespace {

@@ -7,8 +7,8 @@
 #include <memory>
 #include <string>
 
-#include "ogr_support.hpp"
 #include "terrain/core/georef.hpp"
+#include "terrain/internal/geo/ogr_support.hpp"
 
 namespace terrain::geo {
 

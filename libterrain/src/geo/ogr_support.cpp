@@ -1,4 +1,4 @@
-#include "ogr_support.hpp"
+#include "terrain/internal/geo/ogr_support.hpp"
 
 namespace terrain::geo {
 

@@ -12,10 +12,10 @@
 #include <memory>
 #include <string>
 
-#include "../geo/iau_crs.hpp"
-#include "../geo/ogr_support.hpp"
 #include "terrain/core/dem.hpp"
 #include "terrain/core/progress.hpp"
+#include "terrain/internal/geo/iau_crs.hpp"
+#include "terrain/internal/geo/ogr_support.hpp"
 #include "terrain/segment/regions.hpp"
 
 namespace terrain::io {

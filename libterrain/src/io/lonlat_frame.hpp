@@ -1,7 +1,7 @@
 #pragma once
 // Private: the output longitude/latitude frame of the geo layer, for the io writers.
 
-#include "../geo/lonlat_frame.hpp"
+#include "terrain/internal/geo/lonlat_frame.hpp"
 
 namespace terrain::io {
 

@@ -1,5 +1,5 @@
 #include "validate_dem.hpp"
-#include "../core/significant.hpp"
+#include "terrain/internal/core/significant.hpp"
 
 #include <cpl_json.h>
 #include <cpl_vsi.h>

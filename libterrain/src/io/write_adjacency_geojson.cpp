@@ -1,10 +1,10 @@
 
-#include "../geo/iau_crs.hpp"
 #include "dataset_files.hpp"
 #include "geojson_file.hpp"
 #include "lonlat_frame.hpp"
 #include "region_attributes.hpp"
 #include "terrain/core/error.hpp"
+#include "terrain/internal/geo/iau_crs.hpp"
 #include "terrain/io/write_adjacency.hpp"
 
 namespace terrain::io {

@@ -8,9 +8,9 @@
 #include <string>
 #include <vector>
 
-#include "../core/significant.hpp"
 #include "map_canvas.hpp"
 #include "terrain/core/error.hpp"
+#include "terrain/internal/core/significant.hpp"
 #include "terrain/io/write_craters.hpp"
 
 namespace terrain::io {

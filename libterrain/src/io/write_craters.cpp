@@ -6,13 +6,13 @@
 #include <memory>
 #include <variant>
 
-#include "../geo/iau_crs.hpp"
 #include "dataset_files.hpp"
 #include "geojson_file.hpp"
 #include "gpkg_support.hpp"
 #include "lonlat_frame.hpp"
 #include "terrain/core/error.hpp"
 #include "terrain/core/json_writer.hpp"
+#include "terrain/internal/geo/iau_crs.hpp"
 
 namespace terrain::io {
 namespace {

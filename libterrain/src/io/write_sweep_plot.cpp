@@ -10,9 +10,9 @@
 #include <utility>
 #include <vector>
 
-#include "../core/significant.hpp"
 #include "map_canvas.hpp"
 #include "terrain/core/error.hpp"
+#include "terrain/internal/core/significant.hpp"
 #include "terrain/io/write_sweep_plot.hpp"
 
 namespace terrain::io {

@@ -12,10 +12,10 @@
 #include <numbers>
 #include <numeric>
 
-#include "../core/pass_progress.hpp"
-#include "../core/release.hpp"
-#include "grid_triangles.hpp"
 #include "terrain/core/error.hpp"
+#include "terrain/internal/core/pass_progress.hpp"
+#include "terrain/internal/core/release.hpp"
+#include "terrain/internal/mesh/grid_triangles.hpp"
 
 namespace terrain::mesh {
 namespace {

@@ -14,11 +14,11 @@
 #include <string>
 #include <vector>
 
-#include "../core/pass_progress.hpp"
-#include "../core/release.hpp"
-#include "grid_triangles.hpp"
 #include "mesh_lists.hpp"
 #include "terrain/core/error.hpp"
+#include "terrain/internal/core/pass_progress.hpp"
+#include "terrain/internal/core/release.hpp"
+#include "terrain/internal/mesh/grid_triangles.hpp"
 #include "vertex_areas.hpp"
 
 namespace terrain {

@@ -6,8 +6,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "../core/disjoint_sets.hpp"
-#include "grid_triangles.hpp"
+#include "terrain/internal/core/disjoint_sets.hpp"
+#include "terrain/internal/mesh/grid_triangles.hpp"
 
 namespace terrain {
 

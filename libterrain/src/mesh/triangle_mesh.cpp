@@ -3,10 +3,10 @@
 // mesh_adjacency.cpp; its vertex areas: vertex_areas.cpp; its topology: mesh_topology.cpp;
 // pinches and unreferenced vertices: vertex_repairs.cpp.
 #include "terrain/mesh/triangle_mesh.hpp"
-#include "../core/pass_progress.hpp"
-#include "../core/release.hpp"
-#include "grid_triangles.hpp"
 #include "terrain/core/error.hpp"
+#include "terrain/internal/core/pass_progress.hpp"
+#include "terrain/internal/core/release.hpp"
+#include "terrain/internal/mesh/grid_triangles.hpp"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>

@@ -13,7 +13,7 @@
 #include <ranges>
 #include <vector>
 
-#include "grid_triangles.hpp"
+#include "terrain/internal/mesh/grid_triangles.hpp"
 
 namespace terrain::detail {
 

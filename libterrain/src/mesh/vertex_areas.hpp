@@ -1,7 +1,7 @@
 #pragma once
 // Vertex areas, one third of each incident triangle's (vertex_areas.cpp).
 
-#include "../core/pass_progress.hpp"
+#include "terrain/internal/core/pass_progress.hpp"
 #include "terrain/mesh/triangle_mesh.hpp"
 
 namespace terrain::detail {

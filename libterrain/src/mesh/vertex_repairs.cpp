@@ -13,11 +13,11 @@
 #include <utility>
 #include <vector>
 
-#include "../core/disjoint_sets.hpp"
-#include "../core/pass_progress.hpp"
-#include "../core/ranked_bits.hpp"
-#include "../core/release.hpp"
 #include "mesh_lists.hpp"
+#include "terrain/internal/core/disjoint_sets.hpp"
+#include "terrain/internal/core/pass_progress.hpp"
+#include "terrain/internal/core/ranked_bits.hpp"
+#include "terrain/internal/core/release.hpp"
 
 namespace terrain {
 

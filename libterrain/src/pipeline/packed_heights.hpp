@@ -5,11 +5,11 @@
 #include <cstddef>
 #include <vector>
 
-#include "../core/pass_progress.hpp"
-#include "../core/release.hpp"
 #include "parked_arrays.hpp"
 #include "terrain/core/dem.hpp"
 #include "terrain/core/progress.hpp"
+#include "terrain/internal/core/pass_progress.hpp"
+#include "terrain/internal/core/release.hpp"
 
 namespace terrain::pipeline::internal {
 

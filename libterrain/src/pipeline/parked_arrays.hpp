@@ -27,8 +27,8 @@
 #include <type_traits>
 #include <vector>
 
-#include "../core/pass_progress.hpp"
 #include "terrain/core/progress.hpp"
+#include "terrain/internal/core/pass_progress.hpp"
 
 namespace terrain::pipeline::internal {
 

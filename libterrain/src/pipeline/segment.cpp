@@ -7,9 +7,6 @@
 #include <fstream>
 #include <type_traits>
 
-#include "../core/pass_progress.hpp"
-#include "../core/release.hpp"
-#include "../core/significant.hpp"
 #include "packed_heights.hpp"
 #include "parked_arrays.hpp"
 #include "region_scales.hpp"
@@ -19,6 +16,9 @@
 #include "terrain/core/json_writer.hpp"
 #include "terrain/core/memory_budget.hpp"
 #include "terrain/core/version.hpp"
+#include "terrain/internal/core/pass_progress.hpp"
+#include "terrain/internal/core/release.hpp"
+#include "terrain/internal/core/significant.hpp"
 #include "terrain/io/dependency_versions.hpp"
 #include "terrain/io/mesh_files.hpp"
 #include "terrain/io/write_craters.hpp"

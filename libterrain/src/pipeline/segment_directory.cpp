@@ -7,14 +7,14 @@
 #include <utility>
 #include <vector>
 
-#include "../core/release.hpp"
-#include "../core/significant.hpp"
 #include "region_scales.hpp"
 #include "stage_clock.hpp"
 #include "terrain/core/error.hpp"
 #include "terrain/core/huge_pages.hpp"
 #include "terrain/core/json_writer.hpp"
 #include "terrain/core/version.hpp"
+#include "terrain/internal/core/release.hpp"
+#include "terrain/internal/core/significant.hpp"
 #include "terrain/io/dependency_versions.hpp"
 #include "terrain/io/write_craters.hpp"
 #include "terrain/io/write_label_raster.hpp"

@@ -7,7 +7,7 @@
 #include <algorithm>
 #include <vector>
 
-#include "../core/indices.hpp"
+#include "terrain/internal/core/indices.hpp"
 #include "terrain/reeb/simplify.hpp"
 
 namespace terrain::reeb {

@@ -14,8 +14,8 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
-#include "../core/indices.hpp"
-#include "../core/release.hpp"
+#include "terrain/internal/core/indices.hpp"
+#include "terrain/internal/core/release.hpp"
 
 namespace terrain::reeb::internal {
 

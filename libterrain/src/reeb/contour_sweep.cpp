@@ -26,12 +26,12 @@
 #include <utility>
 #include <vector>
 
-#include "../core/disjoint_sets.hpp"
-#include "../core/indices.hpp"
 #include "event_order.hpp"
 #include "half_edges.hpp"
 #include "link_components.hpp"
 #include "terrain/core/error.hpp"
+#include "terrain/internal/core/disjoint_sets.hpp"
+#include "terrain/internal/core/indices.hpp"
 
 namespace terrain::reeb::internal {
 

@@ -20,14 +20,14 @@
 #include <utility>
 #include <vector>
 
-#include "../core/disjoint_sets.hpp"
-#include "../core/indices.hpp"
-#include "../core/key_parts.hpp"
-#include "../core/pass_progress.hpp"
-#include "../core/release.hpp"
-#include "../mesh/grid_triangles.hpp"
 #include "link_components.hpp"
 #include "terrain/core/error.hpp"
+#include "terrain/internal/core/disjoint_sets.hpp"
+#include "terrain/internal/core/indices.hpp"
+#include "terrain/internal/core/key_parts.hpp"
+#include "terrain/internal/core/pass_progress.hpp"
+#include "terrain/internal/core/release.hpp"
+#include "terrain/internal/mesh/grid_triangles.hpp"
 
 namespace terrain::reeb::internal {
 

@@ -16,10 +16,10 @@
 #include <numeric>
 #include <utility>
 
-#include "../core/disjoint_sets.hpp"
-#include "../core/indices.hpp"
-#include "../core/pass_progress.hpp"
-#include "../core/release.hpp"
+#include "terrain/internal/core/disjoint_sets.hpp"
+#include "terrain/internal/core/indices.hpp"
+#include "terrain/internal/core/pass_progress.hpp"
+#include "terrain/internal/core/release.hpp"
 
 namespace terrain::reeb::internal {
 

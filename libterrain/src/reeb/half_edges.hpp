@@ -5,7 +5,7 @@
 
 #include <vector>
 
-#include "../core/indices.hpp"
+#include "terrain/internal/core/indices.hpp"
 #include "terrain/mesh/triangle_mesh.hpp"
 
 namespace terrain::reeb::internal {

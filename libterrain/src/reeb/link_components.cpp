@@ -12,8 +12,8 @@
 
 #include <algorithm>
 
-#include "../core/pass_progress.hpp"
-#include "../mesh/grid_triangles.hpp"
+#include "terrain/internal/core/pass_progress.hpp"
+#include "terrain/internal/mesh/grid_triangles.hpp"
 
 namespace terrain::reeb::internal {
 

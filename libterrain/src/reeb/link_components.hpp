@@ -8,9 +8,9 @@
 #include <utility>
 #include <vector>
 
-#include "../core/disjoint_sets.hpp"
-#include "../core/indices.hpp"
 #include "terrain/core/progress.hpp"
+#include "terrain/internal/core/disjoint_sets.hpp"
+#include "terrain/internal/core/indices.hpp"
 #include "terrain/mesh/triangle_mesh.hpp"
 #include "terrain/reeb/reeb_graph.hpp"
 

@@ -8,8 +8,8 @@
 #include <numeric>
 #include <string>
 
-#include "../core/disjoint_sets.hpp"
-#include "../core/pass_progress.hpp"
+#include "terrain/internal/core/disjoint_sets.hpp"
+#include "terrain/internal/core/pass_progress.hpp"
 #include "terrain/reeb/reeb_graph.hpp"
 
 namespace terrain::reeb {

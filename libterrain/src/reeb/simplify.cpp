@@ -33,10 +33,10 @@
 
 #include <tbb/blocked_range.h>
 
-#include "../core/pass_progress.hpp"
-#include "../core/release.hpp"
 #include "simplifier.hpp"
 #include "terrain/core/error.hpp"
+#include "terrain/internal/core/pass_progress.hpp"
+#include "terrain/internal/core/release.hpp"
 
 namespace terrain::reeb {
 

@@ -14,11 +14,11 @@
 #include <atomic>
 #include <numeric>
 
-#include "../core/disjoint_sets.hpp"
-#include "../core/key_parts.hpp"
-#include "../core/pass_progress.hpp"
-#include "../core/release.hpp"
 #include "terrain/core/error.hpp"
+#include "terrain/internal/core/disjoint_sets.hpp"
+#include "terrain/internal/core/key_parts.hpp"
+#include "terrain/internal/core/pass_progress.hpp"
+#include "terrain/internal/core/release.hpp"
 #include "working_graph.hpp"
 
 namespace terrain::reeb::internal {

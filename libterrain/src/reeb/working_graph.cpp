@@ -12,10 +12,10 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
-#include "../core/pass_progress.hpp"
-#include "../core/ranked_bits.hpp"
-#include "../core/release.hpp"
 #include "terrain/core/error.hpp"
+#include "terrain/internal/core/pass_progress.hpp"
+#include "terrain/internal/core/ranked_bits.hpp"
+#include "terrain/internal/core/release.hpp"
 
 namespace terrain::reeb::internal {
 

@@ -26,10 +26,10 @@
 #include <utility>
 #include <vector>
 
-#include "../core/indices.hpp"
 #include "arc_measures.hpp"
 #include "terrain/core/error.hpp"
 #include "terrain/core/progress.hpp"
+#include "terrain/internal/core/indices.hpp"
 #include "terrain/reeb/simplify.hpp"
 
 namespace terrain::detail {

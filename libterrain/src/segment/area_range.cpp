@@ -16,8 +16,8 @@
 #include <numeric>
 #include <string>
 
-#include "../core/release.hpp"
 #include "terrain/core/error.hpp"
+#include "terrain/internal/core/release.hpp"
 
 namespace terrain::segment {
 namespace {

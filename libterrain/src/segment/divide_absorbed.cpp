@@ -27,12 +27,12 @@
 #include <limits>
 #include <string>
 
-#include "../core/indices.hpp"
-#include "../core/pass_progress.hpp"
-#include "../core/radix_heap.hpp"
-#include "../mesh/prefetch_around.hpp"
 #include "divide_absorbed_internal.hpp"
 #include "terrain/core/error.hpp"
+#include "terrain/internal/core/indices.hpp"
+#include "terrain/internal/core/pass_progress.hpp"
+#include "terrain/internal/core/radix_heap.hpp"
+#include "terrain/internal/mesh/prefetch_around.hpp"
 
 namespace terrain::segment {
 

@@ -14,9 +14,9 @@
 #include <queue>
 #include <vector>
 
-#include "../core/indices.hpp"
-#include "../core/pass_progress.hpp"
 #include "terrain/core/error.hpp"
+#include "terrain/internal/core/indices.hpp"
+#include "terrain/internal/core/pass_progress.hpp"
 
 namespace terrain::segment {
 

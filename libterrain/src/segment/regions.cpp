@@ -10,10 +10,10 @@
 #include <string>
 #include <unordered_map>
 
-#include "../core/pass_progress.hpp"
-#include "../mesh/grid_triangles.hpp"
 #include "pixel_areas.hpp"
 #include "terrain/core/error.hpp"
+#include "terrain/internal/core/pass_progress.hpp"
+#include "terrain/internal/mesh/grid_triangles.hpp"
 #include "terrain/mesh/dem_to_mesh.hpp"
 
 namespace terrain::segment {

@@ -1,5 +1,5 @@
 #include "terrain/synth/vesta_crs.hpp"
-#include "../core/significant.hpp"
+#include "terrain/internal/core/significant.hpp"
 
 #include "terrain/synth/crater_field.hpp"
 

@@ -14,7 +14,7 @@
 #include <numeric>
 #include <vector>
 
-#include "indices.hpp"
+#include "terrain/internal/core/indices.hpp"
 
 namespace terrain::detail {
 

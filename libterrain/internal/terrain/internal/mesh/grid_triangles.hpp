@@ -12,7 +12,7 @@
 #include <string_view>
 #include <vector>
 
-#include "../core/pass_progress.hpp"
+#include "terrain/internal/core/pass_progress.hpp"
 #include "terrain/mesh/triangle_mesh.hpp"
 
 namespace terrain::detail {

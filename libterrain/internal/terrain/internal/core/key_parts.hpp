@@ -20,7 +20,7 @@
 #include <numeric>
 #include <vector>
 
-#include "pass_progress.hpp"
+#include "terrain/internal/core/pass_progress.hpp"
 
 namespace terrain::detail {
 
