@@ -104,7 +104,10 @@ def _prepare(dem, geotransform, crs, read):
     elevation = read.pop("elevation")
     xa = _xarray_support(dem)
     if xa is None:
-        return _source(dem, geotransform, crs, elevation), read, None
+        source = _source(dem, geotransform, crs, elevation)
+        if isinstance(source, str):  # a path: the library reads it with the read options
+            read["elevation"] = elevation
+        return source, read, None
     if xa.is_dataset(dem):
         raise Error("read: give a DataArray (one variable of the Dataset: ds['name']), not a "
                     "Dataset")

@@ -41,6 +41,16 @@ def test_options_reach_the_library(cli, moon, tmp_path):
     assert not np.array_equal(result.labels, default.labels)
 
 
+def test_read_options_reach_a_path(cli, tmp_path):
+    # Values that are radii from Vesta's centre read as heights: another mesh, other regions.
+    vesta = str(SAMPLE_FILES["vesta"])
+    out = tmp_path / "seg"
+    assert cli("segment", vesta, "-o", out, "-q", "--elevation", "height").returncode == 0
+    result = terrain.segment(vesta, elevation="height")
+    assert np.array_equal(result.labels, read_labels(out / "labels.tif"))
+    assert not np.array_equal(result.labels, terrain.segment(vesta).labels)
+
+
 def test_array_and_geotransform_equal_the_file(moon):
     from_file = terrain.segment(moon)
     ds = gdal.Open(moon)
