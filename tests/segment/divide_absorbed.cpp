@@ -191,6 +191,62 @@ TEST_CASE("Dividing absorbed vertices in batches of offers on the threads: the s
     }
 }
 
+TEST_CASE("Dividing through hooks gives the same regions, each hook called once",
+          "[segment][divide]") {
+    // The caller of pipeline::segment's kind: the field and the positions come only in the
+    // first hook, which takes the graph, the flags and the labels away; the labels come back
+    // in the second.
+    const auto dem = io::read_dem(test::sample("vesta_hamo_tile.lbl"));
+    auto mesh = mesh::dem_to_mesh(dem);
+    const auto field = field::shape_index_field(mesh);
+    reeb::SimplifyOptions o;
+    o.persistence = 10;
+    o.area_ratio = 0.5;
+    const auto simplified = reeb::simplify(mesh, reeb::build_reeb_graph(mesh, field), o);
+    const auto grown = segment::grow_regions(mesh, simplified.graph);
+    auto plain = grown;
+    const auto expected =
+        segment::divide_absorbed(mesh, simplified.graph, field, simplified.absorbed, plain);
+    REQUIRE(expected.relabelled > 0);
+    auto graph = simplified.graph;
+    auto absorbed = simplified.absorbed;
+    auto hooked = grown;
+    std::vector<float> given;
+    std::vector<std::uint32_t> away;
+    int first = 0, second = 0;
+    segment::DivideHooks hooks;
+    hooks.seed_parts_kept = [&](const ProgressFn&) {
+        ++first;
+        graph = reeb::ReebGraph{};
+        std::vector<std::uint8_t>().swap(absorbed);
+        away.swap(hooked.labels);
+        given = field;
+        mesh::restore_positions(dem, mesh);
+    };
+    hooks.flooded = [&] {
+        ++second;
+        CHECK(first == 1);
+        hooked.labels.swap(away);
+    };
+    REQUIRE(mesh.release_positions());
+    const auto counts =
+        segment::divide_absorbed(mesh, graph, given, absorbed, hooked, nullptr, {}, hooks);
+    CHECK(first == 1);
+    CHECK(second == 1);
+    CHECK(hooked.labels == plain.labels);
+    CHECK(counts.absorbed == expected.absorbed);
+    CHECK(counts.detached == expected.detached);
+    CHECK(counts.relabelled == expected.relabelled);
+    // A first hook that gives no field: the sizes disagree.
+    auto again = grown;
+    std::vector<float> none;
+    segment::DivideHooks empty_handed;
+    empty_handed.seed_parts_kept = [](const ProgressFn&) {};
+    CHECK_THROWS_AS(segment::divide_absorbed(mesh, simplified.graph, none, simplified.absorbed,
+                                             again, nullptr, {}, empty_handed),
+                    Error);
+}
+
 TEST_CASE("Dividing with nothing absorbed changes nothing, mismatched sizes throw",
           "[segment][divide]") {
     const auto dem = test::grid_dem(30, 20, [](int c, int r) { return c * c + r * r; });
@@ -203,6 +259,15 @@ TEST_CASE("Dividing with nothing absorbed changes nothing, mismatched sizes thro
     const auto counts =
         segment::divide_absorbed(mesh, simplified.graph, field, simplified.absorbed, s);
     CHECK(counts.absorbed == 0);
+    CHECK(s.labels == before);
+    // Hooks are called all the same, once each, in order.
+    std::vector<int> calls;
+    segment::DivideHooks hooks;
+    hooks.seed_parts_kept = [&](const ProgressFn&) { calls.push_back(1); };
+    hooks.flooded = [&] { calls.push_back(2); };
+    segment::divide_absorbed(mesh, simplified.graph, field, simplified.absorbed, s, nullptr, {},
+                             hooks);
+    CHECK(calls == std::vector<int>{1, 2});
     CHECK(s.labels == before);
     std::vector<float> short_field(field.begin(), field.end() - 1);
     CHECK_THROWS_AS(

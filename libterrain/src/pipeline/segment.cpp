@@ -135,11 +135,21 @@ reeb::ReebGraph compute_reeb(SegmentResult& result, const ProgressFn& progress, 
 
 namespace {
 
+// What the growing calls between its steps (segment::DivideHooks): graph_read once it reads
+// the simplified graph and its absorbed flags no more, with the regions as grown and a slice
+// of the progress (the field and the mesh's positions are read after it; the labels as grown
+// not until labels_read is called).
+struct GrowHooks {
+    std::function<void(segment::Segmentation&, const ProgressFn&)> graph_read;
+    std::function<void(segment::Segmentation&)> labels_read;
+};
+
 // Regions grown on a simplified graph.
 ScaleResult grow_scale(const Input& input, const std::vector<float>& field,
                        const SegmentOptions& options, const reeb::SimplifyResult& simplified,
                        double simplify_seconds, const ProgressFn& progress,
-                       const std::vector<std::uint32_t>* finer = nullptr) {
+                       const std::vector<std::uint32_t>* finer = nullptr,
+                       const GrowHooks& grow_hooks = {}) {
     ScaleResult out;
     out.after = reeb::summarize(simplified.graph);
     out.simplify_seconds = simplify_seconds;
@@ -150,10 +160,20 @@ ScaleResult grow_scale(const Input& input, const std::vector<float>& field,
     const bool divide = absorbed_mode(options, input.dem.has_value()) == Absorbed::divide;
     out.segmentation = segment::grow_regions(input.mesh, simplified.graph, grow,
                                              scaled_progress(progress, 0, divide ? 0.5 : 1));
-    if (divide)
-        out.divided =
-            segment::divide_absorbed(input.mesh, simplified.graph, field, simplified.absorbed,
-                                     out.segmentation, finer, scaled_progress(progress, 0.5, 1));
+    segment::DivideHooks hooks;
+    if (grow_hooks.graph_read)
+        hooks.seed_parts_kept = [&](const ProgressFn& slice) {
+            grow_hooks.graph_read(out.segmentation, slice);
+        };
+    if (grow_hooks.labels_read) hooks.flooded = [&] { grow_hooks.labels_read(out.segmentation); };
+    if (divide) {
+        out.divided = segment::divide_absorbed(input.mesh, simplified.graph, field,
+                                               simplified.absorbed, out.segmentation, finer,
+                                               scaled_progress(progress, 0.5, 1), hooks);
+    } else {
+        if (hooks.seed_parts_kept) hooks.seed_parts_kept(scaled_progress(progress, 1, 1));
+        if (hooks.flooded) hooks.flooded();
+    }
     out.grow_seconds = since(t0);
     return out;
 }
@@ -182,8 +202,9 @@ namespace {
 // through the stages that do not read them: the DEM's values (as floats when they all are
 // floats), then the field and the mesh's pixel maps, parked on disk (parked_arrays.hpp;
 // docs/performance.md, "Arrays parked on disk") when large. The DEM waits from before the
-// field (only the height field reads it) to the placing of the positions, and again through
-// the growing. Whether to park at all is decided the first time, on what all the arrays
+// field (only the height field reads it) to the placing of the positions (once the growing
+// has read the simplified graph for the last time), and again through the division of the
+// absorbed vertices. Whether to park at all is decided the first time, on what all the arrays
 // parked through the run hold (the field is a float a vertex).
 class SegmentRun {
   public:
@@ -201,9 +222,13 @@ class SegmentRun {
     reeb::ReebGraph reeb(bool tree);
     // The simplification, the arrays it does not read waiting; progress 0.41 to 0.6.
     reeb::SimplifyResult simplify(reeb::ReebGraph graph, const reeb::SimplifyOptions& thresholds);
-    // The arrays back, the positions placed again, the DEM waiting again; progress 0.6 to
-    // 0.62. Returns its time.
+    // The arrays the growing on the graph reads back (the vertices' areas, the adjacency's);
+    // progress 0.6 to 0.62. Returns its time.
     double restore_for_growing();
+    // The rest back for the division of the absorbed vertices: the field, the positions
+    // placed again (the vertices' areas waiting meanwhile), the DEM waiting again; progress 0
+    // to 1 of `progress`.
+    void restore_for_dividing(const ProgressFn& progress);
     // The region graph, its scales and area ranges, the craters; progress 0.905 to 1. Returns
     // its time.
     double regions(const std::vector<double>& ranges);
@@ -309,7 +334,11 @@ reeb::ReebGraph SegmentRun::reeb(bool tree) {
     };
     auto graph = compute_reeb(
         result, scaled_progress(progress, 0.21, 0.4), tree,
-        [&] { parked.park(result.field, {}, 0, 0); }, sweeps);
+        [&] {
+            parked.park(result.field, {}, 0, 0);
+            parked.park(result.field_scale, {}, 0, 0);
+        },
+        sweeps);
     const auto ta = clock::now();
     parked.restore(mesh.vertex_areas, progress, 0.4, 0.4);
     result.add_time("reeb", since(ta));
@@ -342,24 +371,33 @@ reeb::SimplifyResult SegmentRun::simplify(reeb::ReebGraph graph,
 }
 
 double SegmentRun::restore_for_growing() {
-    auto& result = result_;
     auto& mesh = mesh_;
     auto& parked = parked_;
     const auto& progress = progress_;
     const auto t2 = clock::now();
-    parked.restore(mesh.vertex_areas, progress, 0.6, 0.6);
-    parked.restore(mesh.neighbor_directions, progress, 0.6, 0.601);
-    parked.restore(mesh.vertex_pixel, progress, 0.601, 0.602);
-    parked.restore(mesh.pixel_vertex, progress, 0.602, 0.603);
-    parked.restore(result.field, progress, 0.603, 0.604);
-    // The DEM back as doubles for the placing of the positions, then waiting again through
-    // the growing, which does not read it; back for the region graph's points.
-    if (result.input.dem) restore_dem(scaled_progress(progress, 0.604, 0.61));
-    if (placed_again_)
-        mesh::restore_positions(*result.input.dem, mesh, scaled_progress(progress, 0.61, 0.615));
-    if (result.input.dem && parked.on()) hold_dem(scaled_progress(progress, 0.615, 0.62));
-    result.parked_growing = parked.parked_bytes();
+    parked.restore(mesh.vertex_areas, progress, 0.6, 0.605);
+    parked.restore(mesh.neighbor_directions, progress, 0.605, 0.61);
+    parked.restore(mesh.vertex_pixel, progress, 0.61, 0.615);
+    parked.restore(mesh.pixel_vertex, progress, 0.615, 0.62);
     return since(t2);
+}
+
+void SegmentRun::restore_for_dividing(const ProgressFn& progress) {
+    auto& result = result_;
+    auto& mesh = mesh_;
+    auto& parked = parked_;
+    // The vertices' areas wait while the positions are placed (the division reads them
+    // after).
+    parked.park(mesh.vertex_areas, progress, 0, 0);
+    parked.restore(result.field, progress, 0, 0.1);
+    // The DEM back as doubles for the placing of the positions, then waiting again through
+    // the division, which does not read it; back for the region graph's points.
+    if (result.input.dem) restore_dem(scaled_progress(progress, 0.1, 0.4));
+    if (placed_again_)
+        mesh::restore_positions(*result.input.dem, mesh, scaled_progress(progress, 0.4, 0.8));
+    if (result.input.dem && parked.on()) hold_dem(scaled_progress(progress, 0.8, 1));
+    parked.restore(mesh.vertex_areas, progress, 1, 1);
+    result.parked_growing = parked.parked_bytes();
 }
 
 double SegmentRun::regions(const std::vector<double>& ranges) {
@@ -368,6 +406,7 @@ double SegmentRun::regions(const std::vector<double>& ranges) {
     const auto& options = options_;
     const auto& progress = progress_;
     const auto t1 = clock::now();
+    parked_.restore(result.field_scale, progress, 0.9, 0.9);
     if (result.input.dem) restore_dem(scaled_progress(progress, 0.9, 0.905));
     result.regions = segment::region_graph(
         result.input.mesh, result.field, result.segmentation.labels,
@@ -417,30 +456,41 @@ SegmentResult segment(Input input, const SegmentOptions& requested, const Progre
     const double seconds = since(t0);
     // (Counted with the growing, which it precedes: the stages' times stay in run order.)
     const double placing = run.restore_for_growing();
+    // Once the growing has read the simplified graph for the last time: the regions' range
+    // of area thresholds, simplifying the graph on (counted with the simplification; the
+    // graph goes as it is read), then the arrays the division reads back. The absorbed flags
+    // go too.
+    std::vector<double> ranges;
+    double range_seconds = 0;
+    GrowHooks hooks;
+    hooks.graph_read = [&](segment::Segmentation& grown, const ProgressFn& slice) {
+        detail::release(simplified.absorbed);
+        const auto tr = clock::now();
+        if (options.min_area.is_auto()) {
+            segment::AreaRangeOptions range;
+            range.floor_m2 = result.min_area_m2;
+            range.persistence = thresholds.persistence;
+            ranges = segment::seed_area_ranges(mesh, std::move(simplified.graph), grown.seeds,
+                                               range, scaled_progress(slice, 0, 0.6));
+        }
+        simplified.graph = reeb::ReebGraph{};
+        range_seconds = since(tr);
+        // The labels as grown wait through the division's flooding, which does not read them.
+        run.parked().park(grown.labels, {}, 0, 0);
+        run.restore_for_dividing(scaled_progress(slice, 0.6, 1));
+    };
+    hooks.labels_read = [&](segment::Segmentation& grown) {
+        run.parked().restore(grown.labels, {}, 0, 0);
+    };
     auto scale = grow_scale(result.input, result.field, options, simplified, seconds,
-                            scaled_progress(progress, 0.62, 0.86));
+                            scaled_progress(progress, 0.62, 0.9), nullptr, hooks);
     result.segmentation = std::move(scale.segmentation);
     result.after = scale.after;
     result.divided = scale.divided;
-    // The regions' range of area thresholds, simplifying the graph on (counted with the
-    // simplification): the graph goes as it is read.
-    std::vector<double> ranges;
-    if (options.min_area.is_auto()) {
-        const auto tr = clock::now();
-        segment::AreaRangeOptions range;
-        range.floor_m2 = result.min_area_m2;
-        range.persistence = thresholds.persistence;
-        ranges =
-            segment::seed_area_ranges(mesh, std::move(simplified.graph), result.segmentation.seeds,
-                                      range, scaled_progress(progress, 0.86, 0.9));
-        scale.simplify_seconds += since(tr);
-    }
-    result.add_time("simplify", scale.simplify_seconds);
-    // The simplified graph, its rewritten field and its absorbed flags are read no more: they
-    // go before the DEM comes back as doubles for the region graph (the growing's peak).
+    result.add_time("simplify", scale.simplify_seconds + range_seconds);
     simplified = reeb::SimplifyResult{};
     const double region_seconds = run.regions(ranges);
-    result.add_time("grow", placing + scale.grow_seconds + region_seconds);
+    result.add_time("grow", placing + scale.grow_seconds - range_seconds + region_seconds);
     result.parked_file = run.parked().file_peak();
     result.parked_most = run.parked().most_parked();
     return result;

@@ -78,6 +78,17 @@ WorkingGraph::Remains WorkingGraph::take_remains(const std::vector<i32>& code,
     const auto code_of = [&](std::size_t i) { return i < nc ? code[i] : regular_[i - nc].forward; };
     Remains out;
     std::vector<Remaining>& remaining = out.nodes;
+    // (Counted first, the arrays made at their size: with a low area threshold half the
+    // vertices remain, and growing them by doubling held the old array beside the new at
+    // the simplification's peak of memory. The listed nodes are those that remain regular.)
+    std::size_t count = 0, critical = 0;
+    for (std::size_t i = 0; i < nc + nl; ++i)
+        if (code_of(i) == kNone) {
+            ++count;
+            critical += i < nc && (critical_[i].flags & kCritical);
+        }
+    remaining.reserve(count);
+    out.live_nodes.reserve(count - critical);
     for (std::size_t i = 0; i < nc + nl; ++i) {
         if (code_of(i) != kNone) continue;
         Remaining r;

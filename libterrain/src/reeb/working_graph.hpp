@@ -317,7 +317,8 @@ class WorkingGraph {
 
     // What the output reads of the working graph, taken out: the nodes that remain (by their
     // index here, in order) and the arcs that live, with their lists (a few thousand nodes on
-    // a simplified grid). The working graph then goes, before the new numbers come back
+    // a grid simplified at a single scale; with the landform defaults' low area threshold,
+    // half the vertices). The working graph then goes, before the new numbers come back
     // (parked through the cancellations) and the arrays of every node and vertex are made:
     // the peak of the simplification's memory.
     struct Remaining {

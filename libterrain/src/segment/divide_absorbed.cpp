@@ -474,38 +474,57 @@ DivideCounts divide_absorbed(const TriangleMesh& mesh, const reeb::ReebGraph& gr
                              const std::vector<float>& field,
                              const std::vector<std::uint8_t>& absorbed, Segmentation& segmentation,
                              const std::vector<std::uint32_t>* finer, const ProgressFn& progress,
-                             std::size_t parallel_batch) {
+                             std::size_t parallel_batch, const DivideHooks& hooks) {
     const std::size_t n = mesh.vertex_count();
     if (finer && finer->size() != n)
         throw Error("segment", "divide_absorbed: the finer labels do not match the mesh");
     auto& labels = segmentation.labels;  // as grown until the end, then as divided
-    if (field.size() != n || absorbed.size() != n || labels.size() != n ||
+    // (With a hook the field may come only from it: checked after it.)
+    const bool hooked = static_cast<bool>(hooks.seed_parts_kept);
+    const auto disagree = [] {
+        return Error("segment", "divide_absorbed: the field, flags, labels and mesh disagree");
+    };
+    if ((!hooked && field.size() != n) || absorbed.size() != n || labels.size() != n ||
         graph.vertex_nodes.size() != n)
-        throw Error("segment", "divide_absorbed: the field, flags, labels and mesh disagree");
+        throw disagree();
     DivideCounts counts;
     for (std::size_t v = 0; v < n; ++v) counts.absorbed += absorbed[v] != 0;
     if (counts.absorbed == 0) {
+        if (hooked) hooks.seed_parts_kept(progress);
+        if (hooks.flooded) hooks.flooded();
         report_progress(progress, 1, "divide");
         return counts;
     }
     std::vector<Site> sites = leave_regions(absorbed, labels, finer, progress);
     counts.detached = keep_seed_parts(mesh, graph, segmentation, sites);
     report_progress(progress, 0.2, "divide");
+    // The graph and the flags are read no more. With a hook, it takes 0.2 to 0.4 of the
+    // progress and the steps after 0.4 to 1 (their fractions 0.2 to 1 mapped there).
+    ProgressFn later = progress;
+    if (hooked) {
+        hooks.seed_parts_kept(scaled_progress(progress, 0.2, 0.4));
+        if (field.size() != n) throw disagree();
+        later = scaled_progress(progress, 0.25, 1);
+    }
     // 3. Flooding from the regions' edges: the shortest paths in the metric where a step
     // into u for region r costs |field(u) - mean(r)| plus a constant per mean edge length.
     const float step = kStepShare * field_spread(field);
     const EdgeLengths lengths =
-        edge_lengths(mesh, detail::PassProgress(progress, 0.2, 0.23, "divide"));
+        edge_lengths(mesh, detail::PassProgress(later, 0.2, 0.23, "divide"));
     // cost: a labelled vertex's path cost; for the others, the best offer so far (with the
     // offer's region in the label), so that only better offers are queued (the same result as
     // queuing every one: costs grow along a path, so a vertex's first offer taken is its
     // cheapest).
-    const std::size_t to_label = open_unlabelled(sites, progress);
+    const std::size_t to_label = open_unlabelled(sites, later);
     const std::vector<float> mean =
-        region_means(mesh, field, sites, segmentation.seeds.size(), progress);
+        region_means(mesh, field, sites, segmentation.seeds.size(), later);
     const Flooding flooding(mesh, field, sites, mean, step, lengths);
-    flood(mesh, flooding, sites, to_label, parallel_batch, progress);
-    report_progress(progress, 1, "divide");
+    flood(mesh, flooding, sites, to_label, parallel_batch, later);
+    report_progress(later, 1, "divide");
+    if (hooks.flooded) {
+        hooks.flooded();
+        if (labels.size() != n) throw disagree();
+    }
     for (std::size_t v = 0; v < n; ++v) {
         if (!is_final(sites[v]))
             throw Error("segment", "divide_absorbed: vertex " + std::to_string(v) +
@@ -522,9 +541,10 @@ DivideCounts divide_absorbed(const TriangleMesh& mesh, const reeb::ReebGraph& gr
 DivideCounts divide_absorbed(const TriangleMesh& mesh, const reeb::ReebGraph& graph,
                              const std::vector<float>& field,
                              const std::vector<std::uint8_t>& absorbed, Segmentation& segmentation,
-                             const std::vector<std::uint32_t>* finer, const ProgressFn& progress) {
+                             const std::vector<std::uint32_t>* finer, const ProgressFn& progress,
+                             const DivideHooks& hooks) {
     return internal::divide_absorbed(mesh, graph, field, absorbed, segmentation, finer, progress,
-                                     internal::kParallelBatch);
+                                     internal::kParallelBatch, hooks);
 }
 
 }  // namespace terrain::segment

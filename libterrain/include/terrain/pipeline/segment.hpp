@@ -162,7 +162,8 @@ struct SegmentResult {
     std::size_t critical_before = 0;  // critical nodes of the unsimplified Reeb graph
     std::size_t parked_bytes = 0;     // bytes parked on disk at the simplification's peak
     std::size_t parked_most = 0;      // the most bytes parked on disk at once (segment())
-    // Bytes parked while the field is computed and while the regions are grown (segment()).
+    // Bytes parked while the field is computed and while the absorbed vertices are divided
+    // (segment()).
     std::size_t parked_field = 0, parked_growing = 0;
     // The parked file's largest length: the most disk the run took at once (segment()).
     std::size_t parked_file = 0;
