@@ -26,15 +26,33 @@ def write_craters(path, lon_c, lat_c, radii, width, height):
                     f"{np.cos(lat_c[i]):.6f},0\n")
 
 
+def usage_error(message):
+    sys.exit(f"make_global_dem.py: {message} (usage: make_global_dem.py OUT.tif WIDTH [SEED] "
+             "[--craters CSV])")
+
+
 def main():
     args = sys.argv[1:]
+    if "-h" in args or "--help" in args:
+        print(__doc__)
+        return
     craters = None
     if "--craters" in args:
         k = args.index("--craters")
+        if k + 1 >= len(args):
+            usage_error("--craters needs a file name")
         craters = args[k + 1]
         del args[k:k + 2]
-    out, width = args[0], int(args[1])
-    seed = int(args[2]) if len(args) > 2 else 7
+    if len(args) not in (2, 3) or any(a.startswith("-") for a in args):
+        usage_error("give OUT.tif and WIDTH, and optionally SEED")
+    out = args[0]
+    try:
+        width = int(args[1])
+        seed = int(args[2]) if len(args) > 2 else 7
+    except ValueError:
+        usage_error("WIDTH and SEED are integers")
+    if width < 4 or width % 2:
+        usage_error("WIDTH is an even number of pixels, 4 or more")
     height = width // 2
     rng = np.random.default_rng(seed)
     # Craters: power-law radii (metres), uniform on the sphere.
