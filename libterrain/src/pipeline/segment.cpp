@@ -206,6 +206,28 @@ namespace {
 // has read the simplified graph for the last time), and again through the division of the
 // absorbed vertices. Whether to park at all is decided the first time, on what all the arrays
 // parked through the run hold (the field is a float a vertex).
+// segment()'s progress: one slice a stage, by the stages' measured cost on global grids of 1
+// to 66 M pixels (docs/performance.md): the field 0.2, the Reeb graph 0.2, the simplification
+// 0.2 (with the arrays parked before it), the growing and the division 0.3, the region graph
+// 0.1. Arrays parked or brought back between stages take a hundredth or two of the slice
+// they belong to; at(slice, t) is the point t of the way through a slice.
+struct Slice {
+    double from, to;
+};
+constexpr Slice kFieldSlice{0, 0.2};    // the tree check, the DEM held, the field
+constexpr Slice kReebSlice{0.2, 0.4};   // the vertices' areas parked, the Reeb graph
+constexpr Slice kParkSlice{0.4, 0.41};  // the field and the pixel maps parked
+constexpr Slice kSimplifySlice{0.41, 0.6};
+constexpr Slice kRestoreSlice{0.6, 0.62};  // the areas and the adjacency back
+constexpr Slice kGrowSlice{0.62, 0.9};     // growing, area ranges, division
+constexpr Slice kRegionsSlice{0.9, 1};     // the scales and the DEM back, the region graph
+constexpr double at(const Slice& slice, double t) {
+    return slice.from + t * (slice.to - slice.from);
+}
+ProgressFn slice_of(const ProgressFn& progress, const Slice& slice, double t0 = 0, double t1 = 1) {
+    return scaled_progress(progress, at(slice, t0), at(slice, t1));
+}
+
 class SegmentRun {
   public:
     SegmentRun(SegmentResult& result, const SegmentOptions& options, const ProgressFn& progress)
@@ -215,21 +237,21 @@ class SegmentRun {
           mesh_(result.input.mesh),
           parked_(options.park_directory, options.park_min_bytes) {}
 
-    // The field, the DEM held from before it unless it reads it; progress 0 to 0.2. Returns
+    // The field, the DEM held from before it unless it reads it; kFieldSlice. Returns
     // whether the Reeb graph is known to be a tree.
     bool field();
-    // The Reeb graph, the arrays it does not read waiting; progress 0.2 to 0.4.
+    // The Reeb graph, the arrays it does not read waiting; kReebSlice.
     reeb::ReebGraph reeb(bool tree);
-    // The simplification, the arrays it does not read waiting; progress 0.41 to 0.6.
+    // The simplification, the arrays it does not read waiting; kSimplifySlice.
     reeb::SimplifyResult simplify(reeb::ReebGraph graph, const reeb::SimplifyOptions& thresholds);
     // The arrays the growing on the graph reads back (the vertices' areas, the adjacency's);
-    // progress 0.6 to 0.62. Returns its time.
+    // kRestoreSlice. Returns its time.
     double restore_for_growing();
     // The rest back for the division of the absorbed vertices: the field, the positions
     // placed again (the vertices' areas waiting meanwhile), the DEM waiting again; progress 0
     // to 1 of `progress`.
     void restore_for_dividing(const ProgressFn& progress);
-    // The region graph, its scales and area ranges, the craters; progress 0.905 to 1. Returns
+    // The region graph, its scales and area ranges, the craters; kRegionsSlice. Returns
     // its time.
     double regions(const std::vector<double>& ranges);
 
@@ -282,28 +304,28 @@ bool SegmentRun::field() {
     const auto kind = options.field;
     const bool tree = kind != field::FieldKind::sdf &&
                       (mesh.triangles_released() || mesh.triangles_releasable()) &&
-                      reeb::reeb_is_tree(mesh, scaled_progress(progress, 0, 0.02));
+                      reeb::reeb_is_tree(mesh, slice_of(progress, kFieldSlice, 0, 0.1));
     if (tree)
         mesh.release_triangles();
     else
         mesh.restore_triangles();  // (released by load_input: the Reeb graph reads them)
     result.add_time("field", since(tf));
     const bool field_reads_dem = kind == field::FieldKind::height;
-    if (result.input.dem && !field_reads_dem) hold_dem(scaled_progress(progress, 0.02, 0.03));
+    if (result.input.dem && !field_reads_dem) hold_dem(slice_of(progress, kFieldSlice, 0.1, 0.15));
     result.parked_field = parked_.parked_bytes();
     compute_field(
         result, options,
-        scaled_progress(progress, field_reads_dem ? 0.02 : 0.03, field_reads_dem ? 0.19 : 0.2));
+        slice_of(progress, kFieldSlice, field_reads_dem ? 0.1 : 0.15, field_reads_dem ? 0.95 : 1));
     // A DEM mesh frees its positions (12 bytes a vertex) while the Reeb graph and the
     // simplification run, which do not read them, and places them again before the growing:
     // the same floats (docs/mesh.md, "Positions freed and placed again").
     placed_again_ = result.input.dem && mesh.release_positions();
     const auto tp = clock::now();
     if (result.input.dem) {
-        if (field_reads_dem) hold_dem(scaled_progress(progress, 0.19, 0.2));
+        if (field_reads_dem) hold_dem(slice_of(progress, kFieldSlice, 0.95, 1));
         // The vertices' areas wait through the Reeb graph, which does not read them (the
         // simplification does).
-        parked_.park(mesh.vertex_areas, progress, 0.2, 0.21);
+        parked_.park(mesh.vertex_areas, progress, at(kReebSlice, 0), at(kReebSlice, 0.05));
     }
     result.add_time("reeb", since(tp));  // (which it precedes: the times stay in run order)
     return tree;
@@ -333,14 +355,14 @@ reeb::ReebGraph SegmentRun::reeb(bool tree) {
         parked.restore(mesh.pixel_vertex, {}, 0, 0);
     };
     auto graph = compute_reeb(
-        result, scaled_progress(progress, 0.21, 0.4), tree,
+        result, slice_of(progress, kReebSlice, 0.05, 1), tree,
         [&] {
             parked.park(result.field, {}, 0, 0);
             parked.park(result.field_scale, {}, 0, 0);
         },
         sweeps);
     const auto ta = clock::now();
-    parked.restore(mesh.vertex_areas, progress, 0.4, 0.4);
+    parked.restore(mesh.vertex_areas, progress, kReebSlice.to, kReebSlice.to);
     result.add_time("reeb", since(ta));
     return graph;
 }
@@ -361,7 +383,7 @@ reeb::SimplifyResult SegmentRun::simplify(reeb::ReebGraph graph,
     };
     vertex_nodes.restore = [&](std::vector<std::int32_t>& v) { parked.restore(v, {}, 0, 0); };
     auto simplified = reeb::simplify(
-        result.input.mesh, std::move(graph), thresholds, scaled_progress(progress, 0.41, 0.6),
+        result.input.mesh, std::move(graph), thresholds, slice_of(progress, kSimplifySlice),
         [&] {
             if (parked.park(mesh.vertex_areas, {}, 0, 0))
                 result.parked_bytes = parked.parked_bytes();
@@ -375,10 +397,11 @@ double SegmentRun::restore_for_growing() {
     auto& parked = parked_;
     const auto& progress = progress_;
     const auto t2 = clock::now();
-    parked.restore(mesh.vertex_areas, progress, 0.6, 0.605);
-    parked.restore(mesh.neighbor_directions, progress, 0.605, 0.61);
-    parked.restore(mesh.vertex_pixel, progress, 0.61, 0.615);
-    parked.restore(mesh.pixel_vertex, progress, 0.615, 0.62);
+    parked.restore(mesh.vertex_areas, progress, at(kRestoreSlice, 0), at(kRestoreSlice, 0.25));
+    parked.restore(mesh.neighbor_directions, progress, at(kRestoreSlice, 0.25),
+                   at(kRestoreSlice, 0.5));
+    parked.restore(mesh.vertex_pixel, progress, at(kRestoreSlice, 0.5), at(kRestoreSlice, 0.75));
+    parked.restore(mesh.pixel_vertex, progress, at(kRestoreSlice, 0.75), kRestoreSlice.to);
     return since(t2);
 }
 
@@ -406,11 +429,11 @@ double SegmentRun::regions(const std::vector<double>& ranges) {
     const auto& options = options_;
     const auto& progress = progress_;
     const auto t1 = clock::now();
-    parked_.restore(result.field_scale, progress, 0.9, 0.9);
-    if (result.input.dem) restore_dem(scaled_progress(progress, 0.9, 0.905));
+    parked_.restore(result.field_scale, progress, kRegionsSlice.from, kRegionsSlice.from);
+    if (result.input.dem) restore_dem(slice_of(progress, kRegionsSlice, 0, 0.05));
     result.regions = segment::region_graph(
         result.input.mesh, result.field, result.segmentation.labels,
-        result.segmentation.region_count, result.dem(), scaled_progress(progress, 0.905, 1));
+        result.segmentation.region_count, result.dem(), slice_of(progress, kRegionsSlice, 0.05, 1));
     // On a DEM, with the regions of valid pixels in no triangle (segment::label_pixels).
     result.segmentation.region_count = static_cast<std::uint32_t>(result.regions.regions.size());
     internal::set_region_scales(result);
@@ -432,9 +455,7 @@ SegmentResult segment(Input input, const SegmentOptions& requested, const Progre
     result.input = std::move(input);
     result.timings.push_back({"read", result.input.read_seconds});
     if (result.input.dem) result.timings.push_back({"mesh", result.input.mesh_seconds});
-    // Slices of the progress by the stages' measured cost on global grids of 1 to 66 M
-    // pixels (docs/performance.md): field 0.2, Reeb graph 0.2, simplification 0.2, growing
-    // and dividing 0.3, region graph 0.1.
+    // The stages in turn, each in its slice of the progress (kFieldSlice ... kRegionsSlice).
     SegmentRun run(result, options, progress);
     auto& mesh = result.input.mesh;
     const bool tree = run.field();
@@ -443,10 +464,12 @@ SegmentResult segment(Input input, const SegmentOptions& requested, const Progre
     // which lowers the peak memory.
     const auto t0 = clock::now();
     if (run.parked().on()) {
-        if (!result.field.empty()) run.parked().park(result.field, progress, 0.4, 0.403);
-        run.parked().park(mesh.pixel_vertex, progress, 0.403, 0.406);
-        run.parked().park(mesh.vertex_pixel, progress, 0.406, 0.409);
-        run.parked().park(mesh.neighbor_directions, progress, 0.409, 0.41);
+        auto& parked = run.parked();
+        if (!result.field.empty())
+            parked.park(result.field, progress, at(kParkSlice, 0), at(kParkSlice, 0.3));
+        parked.park(mesh.pixel_vertex, progress, at(kParkSlice, 0.3), at(kParkSlice, 0.6));
+        parked.park(mesh.vertex_pixel, progress, at(kParkSlice, 0.6), at(kParkSlice, 0.9));
+        parked.park(mesh.neighbor_directions, progress, at(kParkSlice, 0.9), kParkSlice.to);
     }
     result.parked_bytes = run.parked().parked_bytes();
     const auto thresholds = simplify_options(options, result.input.mesh);
@@ -483,7 +506,7 @@ SegmentResult segment(Input input, const SegmentOptions& requested, const Progre
         run.parked().restore(grown.labels, {}, 0, 0);
     };
     auto scale = grow_scale(result.input, result.field, options, simplified, seconds,
-                            scaled_progress(progress, 0.62, 0.9), nullptr, hooks);
+                            slice_of(progress, kGrowSlice), nullptr, hooks);
     result.segmentation = std::move(scale.segmentation);
     result.after = scale.after;
     result.divided = scale.divided;
