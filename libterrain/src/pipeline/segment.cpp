@@ -198,14 +198,6 @@ ScaleResult segment_scale(const Input& input, const std::vector<float>& field,
 
 namespace {
 
-// One run of pipeline::segment: the result as it is made, and the arrays that wait unread
-// through the stages that do not read them: the DEM's values (as floats when they all are
-// floats), then the field and the mesh's pixel maps, parked on disk (parked_arrays.hpp;
-// docs/performance.md, "Arrays parked on disk") when large. The DEM waits from before the
-// field (only the height field reads it) to the placing of the positions (once the growing
-// has read the simplified graph for the last time), and again through the division of the
-// absorbed vertices. Whether to park at all is decided the first time, on what all the arrays
-// parked through the run hold (the field is a float a vertex).
 // segment()'s progress: one slice a stage, by the stages' measured cost on global grids of 1
 // to 66 M pixels (docs/performance.md): the field 0.2, the Reeb graph 0.2, the simplification
 // 0.2 (with the arrays parked before it), the growing and the division 0.3, the region graph
@@ -228,6 +220,14 @@ ProgressFn slice_of(const ProgressFn& progress, const Slice& slice, double t0 = 
     return scaled_progress(progress, at(slice, t0), at(slice, t1));
 }
 
+// One run of pipeline::segment: the result as it is made, and the arrays that wait unread
+// through the stages that do not read them: the DEM's values (as floats when they all are
+// floats), then the field and the mesh's pixel maps, parked on disk (parked_arrays.hpp;
+// docs/performance.md, "Arrays parked on disk") when large. The DEM waits from before the
+// field (only the height field reads it) to the placing of the positions (once the growing
+// has read the simplified graph for the last time), and again through the division of the
+// absorbed vertices. Whether to park at all is decided the first time, on what all the arrays
+// parked through the run hold (the field is a float a vertex).
 class SegmentRun {
   public:
     SegmentRun(SegmentResult& result, const SegmentOptions& options, const ProgressFn& progress)
