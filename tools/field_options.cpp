@@ -124,10 +124,10 @@ void check_field_limits(const field::FieldOptions& options, const TriangleMesh& 
     // The mean length of the mesh's edges, each counted from both ends.
     double sum = 0;
     std::size_t edges = 0;
-    for (std::size_t v = 0; v < mesh.vertex_count() && v < mesh.positions.size(); ++v)
+    for (std::size_t v = 0; v < mesh.vertex_count() && v < mesh.positions().size(); ++v)
         for (const auto w : mesh.neighbors_of(v)) {
-            const auto& a = mesh.positions[v];
-            const auto& b = mesh.positions[std::size_t(w)];
+            const auto& a = mesh.positions()[v];
+            const auto& b = mesh.positions()[std::size_t(w)];
             sum += std::hypot(double(a[0]) - b[0], double(a[1]) - b[1], double(a[2]) - b[2]);
             ++edges;
         }

@@ -27,7 +27,7 @@ using Face = std::array<std::int32_t, 3>;
 TriangleMesh make_mesh(const std::vector<Point>& points, const std::vector<Face>& faces) {
     TriangleMesh mesh;
     set_positions(mesh, points);
-    mesh.triangles = faces;
+    mesh.edit_triangles() = faces;
     finish_mesh(mesh);
     return mesh;
 }
@@ -223,7 +223,7 @@ TEST_CASE("SDF: a thin rod has smaller values than the thick drum on top of it",
     std::size_t checked = 0;
     for (std::size_t f = 0; f < mesh.triangle_count(); ++f) {
         double z = 0, r = 0;
-        for (auto v : mesh.triangles[f]) {
+        for (auto v : mesh.triangles()[f]) {
             const auto p = mesh.position(v);
             z += p[2] / 3;
             r += std::hypot(p[0], p[1]) / 3;
@@ -314,14 +314,14 @@ TEST_CASE("SDF: scale-free values, inward faces, open meshes, bad options", "[sd
             const auto p = mesh.position(v);
             points.push_back({p[0] * 250, p[1] * 250, p[2] * 250});
         }
-        const auto scaled = field::shape_diameter_function(make_mesh(points, mesh.triangles));
+        const auto scaled = field::shape_diameter_function(make_mesh(points, mesh.triangles()));
         CHECK(scaled.max_diameter == Approx(250 * sdf.max_diameter).epsilon(1e-5));
         for (std::size_t v = 0; v < mesh.vertex_count(); ++v)
             CHECK(scaled.values[v] == Approx(sdf.values[v]).margin(0.01));
     }
     SECTION("faces oriented inwards: the rays are cast the other way") {
         TriangleMesh flipped = mesh;
-        for (auto& t : flipped.triangles) std::swap(t[1], t[2]);
+        for (auto& t : flipped.edit_triangles()) std::swap(t[1], t[2]);
         const auto inward = field::shape_diameter_function(flipped);
         CHECK(inward.reoriented);
         for (std::size_t v = 0; v < mesh.vertex_count(); ++v)
@@ -329,7 +329,7 @@ TEST_CASE("SDF: scale-free values, inward faces, open meshes, bad options", "[sd
     }
     SECTION("an open mesh is refused, or computed when allowed") {
         TriangleMesh open = mesh;
-        open.triangles.pop_back();
+        open.edit_triangles().pop_back();
         CHECK_THROWS_WITH(field::shape_diameter_function(open),
                           Contains("not closed (3 boundary edges"));
         field::SdfOptions allow;

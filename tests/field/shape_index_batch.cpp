@@ -58,7 +58,7 @@ std::vector<TriangleMesh> test_meshes() {
 // A unit normal for vertex v: its position's direction, tilted by the vertex number (any unit
 // vector will do: the two paths must agree on it).
 Vec3 some_normal(const TriangleMesh& mesh, std::int32_t v) {
-    const auto& p = mesh.positions[std::size_t(v)];
+    const auto& p = mesh.positions()[std::size_t(v)];
     const double t = 0.1 * std::sin(double(v));
     Vec3 n{p[0] + mesh.origin[0] + t * 1e5, p[1] + mesh.origin[1], p[2] + mesh.origin[2] + 1e3};
     const double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);

@@ -17,7 +17,7 @@ TEST_CASE("faces.seg: one label per face, majority of its vertices, ties to the 
           "[write_mesh_labels]") {
     TriangleMesh mesh;
     set_positions(mesh, {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}, {2, 0, 0}, {2, 1, 0}});
-    mesh.triangles = {{0, 1, 2}, {1, 3, 2}, {1, 4, 3}, {4, 5, 3}};
+    mesh.edit_triangles() = {{0, 1, 2}, {1, 3, 2}, {1, 4, 3}, {4, 5, 3}};
     finish_mesh(mesh);
     const std::vector<std::uint32_t> labels = {1, 1, 2, 3, 2, 2};
     // {1,1,2} -> 1; {1,3,2} -> 1 (all differ); {1,2,3} -> 1; {2,2,3} -> 2.

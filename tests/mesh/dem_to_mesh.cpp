@@ -46,7 +46,7 @@ double total_area(const TriangleMesh& m) {
 // Signed volume enclosed (divergence theorem); positive when triangles face outwards.
 double signed_volume(const TriangleMesh& m) {
     double vol = 0;
-    for (const auto& t : m.triangles) {
+    for (const auto& t : m.triangles()) {
         const auto a = m.position(t[0]), b = m.position(t[1]), c = m.position(t[2]);
         vol += a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
                a[2] * (b[0] * c[1] - b[1] * c[0]);
@@ -58,7 +58,7 @@ void check_manifold(const TriangleMesh& mesh) {
     // Every edge in at most two triangles, each direction at most once (consistent
     // orientation); every vertex link a single fan.
     std::map<std::pair<int, int>, int> directed;
-    for (const auto& t : mesh.triangles)
+    for (const auto& t : mesh.triangles())
         for (int k = 0; k < 3; ++k) ++directed[{t[k], t[(k + 1) % 3]}];
     std::size_t repeated = 0;
     for (const auto& [edge, count] : directed) repeated += count != 1;
@@ -89,7 +89,7 @@ TEST_CASE("dem_to_mesh: counts on a full grid", "[mesh]") {
         CHECK(p[2] == Approx(col * 1.0 + row * 0.5));
     }
     // Triangles face up (counter-clockwise seen from +z).
-    for (const auto& t : mesh.triangles) {
+    for (const auto& t : mesh.triangles()) {
         const auto a = mesh.position(t[0]), b = mesh.position(t[1]), c = mesh.position(t[2]);
         CHECK((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]) > 0);
     }
@@ -114,13 +114,14 @@ TEST_CASE("dem_to_mesh: the shorter 3-D diagonal splits a block", "[mesh]") {
     const Dem dem = grid_dem(2, 2, 1.0, [](int c, int r) { return c == 1 && r == 0 ? 5.0 : 0.0; });
     const auto mesh = mesh::dem_to_mesh(dem);
     REQUIRE(mesh.triangle_count() == 2);
-    for (const auto& t : mesh.triangles) {
+    for (const auto& t : mesh.triangles()) {
         const bool has_00 = std::find(t.begin(), t.end(), 0) != t.end();
         const bool has_11 = std::find(t.begin(), t.end(), 3) != t.end();
         CHECK((has_00 && has_11));
     }
     const Dem other = grid_dem(2, 2, 1.0, [](int c, int r) { return c + r == 0 ? 5.0 : 0.0; });
-    for (const auto& t : mesh::dem_to_mesh(other).triangles) {
+    const auto other_mesh = mesh::dem_to_mesh(other);
+    for (const auto& t : other_mesh.triangles()) {
         const bool has_10 = std::find(t.begin(), t.end(), 1) != t.end();
         const bool has_01 = std::find(t.begin(), t.end(), 2) != t.end();
         CHECK((has_10 && has_01));
@@ -248,7 +249,7 @@ TEST_CASE("dem_to_mesh: a radius grid's vertices are each pixel's radius along i
                                        value * std::sin(ll[1] * degree)};
                 ++checked;
                 for (int k = 0; k < 3; ++k)
-                    differing += mesh.positions[std::size_t(v)][std::size_t(k)] !=
+                    differing += mesh.positions()[std::size_t(v)][std::size_t(k)] !=
                                  static_cast<float>(xyz[k] - mesh.origin[std::size_t(k)]);
             }
         }
@@ -302,15 +303,16 @@ namespace {
 void check_positions_placed_again(const TriangleMesh& mesh, const Dem& dem) {
     TriangleMesh copy = mesh;
     REQUIRE(copy.release_positions());
-    CHECK(copy.positions.empty());
+    // Read while released: an error, not an empty array.
+    CHECK_THROWS_WITH(copy.positions(), Catch::Contains("positions were read while released"));
     CHECK(copy.vertex_count() == mesh.vertex_count());
     mesh::restore_positions(dem, copy);
     CHECK_FALSE(copy.positions_released());
-    REQUIRE(copy.positions.size() == mesh.positions.size());
+    REQUIRE(copy.positions().size() == mesh.positions().size());
     std::size_t differ = 0;
     for (std::size_t v = 0; v < mesh.vertex_count(); ++v)
-        differ += std::memcmp(copy.positions[v].data(), mesh.positions[v].data(),
-                              sizeof(mesh.positions[v])) != 0;
+        differ += std::memcmp(copy.positions()[v].data(), mesh.positions()[v].data(),
+                              sizeof(mesh.positions()[v])) != 0;
     CHECK(differ == 0);
 }
 
@@ -336,11 +338,11 @@ std::size_t check_grid_adjacency(const TriangleMesh& mesh, const Dem& dem) {
     TriangleMesh released = mesh;
     REQUIRE(released.release_triangles());
     REQUIRE(released.release_positions());
-    CHECK(released.triangles.empty());
+    CHECK_THROWS_WITH(released.triangles(), Catch::Contains("triangles were read while released"));
     CHECK(released.triangle_count() == mesh.triangle_count());
     std::size_t count = 0, wrong = 0;
     detail::for_each_triangle(released, [&](std::size_t i, const std::array<std::int32_t, 3>& t) {
-        wrong += i != count || i >= mesh.triangles.size() || mesh.triangles[i] != t;
+        wrong += i != count || i >= mesh.triangles().size() || mesh.triangles()[i] != t;
         ++count;
     });
     CHECK(count == mesh.triangle_count());
@@ -423,9 +425,9 @@ TEST_CASE("dem_to_mesh: the adjacency on the grid is the triangles' adjacency", 
             mesh::dem_to_mesh(grid_dem(5, 5, 1.0, [](int c, int r) { return double(c * r); }));
         file.pixel_vertex.clear();
         CHECK_FALSE(file.release_triangles());
-        CHECK_FALSE(file.triangles.empty());
+        CHECK_FALSE(file.triangles().empty());
         CHECK_FALSE(file.release_positions());
-        CHECK_FALSE(file.positions.empty());
+        CHECK_FALSE(file.positions().empty());
     }
     SECTION("a grid two pixels wide keeps the CSR") {
         const Dem dem = grid_dem(2, 5, 1.0, [](int c, int r) { return double(c + r); });
@@ -489,15 +491,16 @@ TEST_CASE("dem_to_mesh: the same mesh whatever the thread count", "[mesh]") {
         CHECK(one.pixel_vertex == two.pixel_vertex);
         CHECK(one.pole_vertices == two.pole_vertices);
         CHECK(one.origin == two.origin);
-        CHECK(one.positions == two.positions);
-        CHECK(one.triangles == two.triangles);
+        CHECK(one.positions() == two.positions());
+        CHECK(one.triangles() == two.triangles());
         CHECK(one.vertex_areas == two.vertex_areas);
         // The areas (summed by bands of rows on the threads) are each vertex's thirds added in
         // triangle order, as one pass in order adds them.
         std::vector<double> sums(two.vertex_count(), 0.0);
-        for (const auto& t : two.triangles) {
-            const auto &a = two.positions[std::size_t(t[0])], &b = two.positions[std::size_t(t[1])],
-                       &c = two.positions[std::size_t(t[2])];
+        for (const auto& t : two.triangles()) {
+            const auto &a = two.positions()[std::size_t(t[0])],
+                       &b = two.positions()[std::size_t(t[1])],
+                       &c = two.positions()[std::size_t(t[2])];
             const double u[3] = {double(b[0]) - a[0], double(b[1]) - a[1], double(b[2]) - a[2]};
             const double w[3] = {double(c[0]) - a[0], double(c[1]) - a[1], double(c[2]) - a[2]};
             const double n[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2],
@@ -536,11 +539,11 @@ TEST_CASE("dem_to_mesh: triangles released before the areas and the adjacency, t
             CHECK(released.irregular_offsets == held.irregular_offsets);
             CHECK(released.irregular_neighbors == held.irregular_neighbors);
             CHECK(released.grid_edges == held.grid_edges);
-            CHECK(released.positions == held.positions);
+            CHECK(released.positions() == held.positions());
             CHECK(released.pixel_vertex == held.pixel_vertex);
             released.restore_triangles();
             CHECK_FALSE(released.triangles_released());
-            CHECK(released.triangles == held.triangles);
+            CHECK(released.triangles() == held.triangles());
         }
     }
     CHECK(mesh::dem_to_mesh(dems[1], releasing).irregular_vertices.size() > 0);  // seam, poles
@@ -609,7 +612,7 @@ TEST_CASE("dem_to_mesh: the same hill on a lon/lat grid and on a UTM grid has th
     auto relief = [](const TriangleMesh& m) {
         // Extra area over the flat footprint, and the top's height above the lowest vertex.
         double area = 0, flat = 0, lo = 1e300, hi = -1e300;
-        for (const auto& t : m.triangles) {
+        for (const auto& t : m.triangles()) {
             const auto a = m.position(t[0]), b = m.position(t[1]), c = m.position(t[2]);
             const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
             const double v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};

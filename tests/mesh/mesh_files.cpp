@@ -105,7 +105,7 @@ TEST_CASE("write_ply: binary PLY read back by CGAL, with pixel and area properti
     // CGAL's reader gives back the same mesh.
     const auto back = io::read_mesh(path);
     CHECK(back.vertex_count() == mesh.vertex_count());
-    CHECK(back.triangles == mesh.triangles);
+    CHECK(back.triangles() == mesh.triangles());
     for (std::size_t v = 0; v < mesh.vertex_count(); v += 97) {
         const auto p = mesh.position(v), q = back.position(v);
         CHECK(std::hypot(p[0] - q[0], p[1] - q[1], p[2] - q[2]) < 0.5);

@@ -14,6 +14,7 @@
 
 #include "../../libterrain/src/reeb/contour_tree.hpp"
 #include "../../libterrain/src/reeb/link_components.hpp"
+#include "support/recording_residency.hpp"
 #include "support/test_meshes.hpp"
 #include "support/test_support.hpp"
 #include "terrain/core/error.hpp"
@@ -167,7 +168,7 @@ TEST_CASE("Disk-like DEMs give a tree, a hole in the DEM can give a loop", "[ree
     CHECK(reeb::reeb_is_tree(disks_mesh));
     const auto f = test::noise_field(disks_mesh.vertex_count(), 11);
     const auto forest =
-        reeb::build_reeb_graph(disks_mesh, f, {reeb::ReebAlgorithm::contour_tree, false, {}, {}});
+        reeb::build_reeb_graph(disks_mesh, f, {reeb::ReebAlgorithm::contour_tree, false, nullptr});
     REQUIRE(reeb::check_reeb_graph(forest, f).empty());
     CHECK(reeb::summarize(forest).components == 2);
     CHECK(reeb::summarize(forest).loops == 0);
@@ -355,7 +356,7 @@ TEST_CASE("The contour tree and the sweep give the same graph on disks and spher
     CHECK_FALSE(reeb::reeb_is_tree(holed));
     CHECK_FALSE(reeb::reeb_is_tree(test::torus_mesh(3, 1, 12, 8, true)));
     CHECK_THROWS_WITH(reeb::build_reeb_graph(holed, test::noise_field(holed.vertex_count(), 1),
-                                             {reeb::ReebAlgorithm::contour_tree, false, {}, {}}),
+                                             {reeb::ReebAlgorithm::contour_tree, false, nullptr}),
                       Catch::Contains("disks or spheres"));
     // Noise on four levels (quantized): plateaus of every shape, degenerate saddles and
     // boundary runs.
@@ -369,9 +370,9 @@ TEST_CASE("The contour tree and the sweep give the same graph on disks and spher
     };
     for (const auto& [mesh, f] : cases) {
         const auto a =
-            reeb::build_reeb_graph(*mesh, f, {reeb::ReebAlgorithm::sweep, false, {}, {}});
+            reeb::build_reeb_graph(*mesh, f, {reeb::ReebAlgorithm::sweep, false, nullptr});
         const auto b =
-            reeb::build_reeb_graph(*mesh, f, {reeb::ReebAlgorithm::contour_tree, false, {}, {}});
+            reeb::build_reeb_graph(*mesh, f, {reeb::ReebAlgorithm::contour_tree, false, nullptr});
         REQUIRE(reeb::check_reeb_graph(b, f).empty());
         CHECK(a.node_vertices == b.node_vertices);
         CHECK(a.node_kinds == b.node_kinds);
@@ -422,50 +423,47 @@ TEST_CASE("A DEM mesh's Reeb graph is the same with its triangles released", "[r
     }
 }
 
-TEST_CASE("A tree's field may be taken away once the events are ordered", "[reeb]") {
-    // pipeline::segment parks the field on disk while the contour tree runs.
+TEST_CASE("The Reeb graph tells its stages: the field is away through the contour tree", "[reeb]") {
+    // pipeline::segment parks the field on disk while the contour tree runs and brings it
+    // back for contour tracking, on a mesh with loops.
     const auto globe_dem = io::read_dem(test::sample("moon_ldem1_global.tif"));
     const auto sphere = mesh::dem_to_mesh(globe_dem);
-    const auto f = quantized(test::noise_field(sphere.vertex_count(), 7));
-    const auto held = reeb::build_reeb_graph(sphere, f);
-    auto field = f;
-    int calls = 0;
-    reeb::ReebOptions options;
-    options.known_tree = true;
-    options.field_read = [&] {
-        ++calls;
-        std::vector<float>().swap(field);  // read any further, it would be out of bounds
-    };
-    const auto taken = reeb::build_reeb_graph(sphere, field, options);
-    CHECK(calls == 1);
-    CHECK(field.empty());
-    CHECK(taken.node_values == held.node_values);
-    CHECK(taken.node_kinds == held.node_kinds);
-    CHECK(taken.vertex_nodes == held.vertex_nodes);
-    CHECK(taken.arcs == held.arcs);
-    CHECK(taken.arc_nodes == held.arc_nodes);
-    // Not known to be a tree, or no callback: the field is not asked for.
-    field = f;
-    options.known_tree = false;
-    calls = 0;
-    CHECK(reeb::build_reeb_graph(sphere, field, options).arcs == held.arcs);
-    CHECK(calls == 0);
-    CHECK(field.size() == f.size());
-    // A mesh said to be a tree that has a loop: an error, not a read of the field taken away.
     const auto torus = test::torus_mesh(3, 1, 12, 8, true);
+    for (const TriangleMesh* mesh : {&sphere, &torus}) {
+        const bool tree = mesh == &sphere;
+        INFO((tree ? "sphere" : "torus"));
+        const auto f = quantized(test::noise_field(mesh->vertex_count(), 7));
+        const auto held = reeb::build_reeb_graph(*mesh, f);
+        auto field = f;
+        std::vector<float> aside;
+        test::RecordingResidency memory;
+        // Read any further while away, the field would be out of bounds.
+        memory.on_entry[Stage::reeb_links] = [&] { aside.swap(field); };
+        memory.on_entry[Stage::reeb_loops] = [&] { field.swap(aside); };
+        reeb::ReebOptions options;
+        options.memory = &memory;
+        const auto taken = reeb::build_reeb_graph(*mesh, field, options);
+        std::vector<Stage> stages{Stage::reeb_events, Stage::reeb_links, Stage::reeb_sweeps,
+                                  Stage::reeb_arcs};
+        if (!tree) stages.push_back(Stage::reeb_loops);
+        CHECK(memory.entered == stages);
+        CHECK(field.empty() == tree);
+        REQUIRE(reeb::check_reeb_graph(taken, f).empty());
+        check_same_graph(taken, held);
+    }
+    // A mesh said to be a tree that has a loop: an error.
     auto torus_field = test::noise_field(torus.vertex_count(), 2);
     reeb::ReebOptions wrong;
     wrong.known_tree = true;
-    wrong.field_read = [&] { std::vector<float>().swap(torus_field); };
     CHECK_THROWS_WITH(reeb::build_reeb_graph(torus, torus_field, wrong),
                       Catch::Contains("said to be a tree"));
 }
 
-TEST_CASE("The contour tree's sweeps let their caller park the vertex lists and nodes", "[reeb]") {
-    // pipeline::segment parks the graph's vertex lists, their offsets and the vertices' nodes
-    // on disk through the join and split sweeps. A quantized field makes plateaus (nodes of
-    // several vertices), whose links the sweeps read vertex by vertex: from the nodes around
-    // them listed before, not from the arrays taken away.
+TEST_CASE("The contour tree's sweeps stash the vertex lists, nodes and values", "[reeb]") {
+    // pipeline::segment parks the graph's vertex lists, their offsets, the vertices' nodes and
+    // the nodes' values on disk through the join and split sweeps. A quantized field makes
+    // plateaus (nodes of several vertices), whose links the sweeps read vertex by vertex:
+    // from the nodes around them listed before, not from the arrays taken away.
     const auto globe_dem = io::read_dem(test::sample("moon_ldem1_global.tif"));
     const auto sphere = mesh::dem_to_mesh(globe_dem);
     const auto torus = test::torus_mesh(3, 1, 24, 16, true);  // loops: the sweep after all
@@ -476,28 +474,17 @@ TEST_CASE("The contour tree's sweeps let their caller park the vertex lists and 
         for (std::size_t n = 0; n < held.node_count(); ++n)
             plateaus += held.node_vertex_offsets[n + 1] - held.node_vertex_offsets[n] > 1;
         CHECK(plateaus > 10);
-        std::map<const void*, std::vector<std::int32_t>> aside;
-        std::multiset<std::size_t> sizes;
-        int parks = 0, restores = 0;
+        test::RecordingResidency memory;
+        memory.on_entry[Stage::reeb_sweeps] = [&] { CHECK(memory.away() == 4); };
         reeb::ReebOptions options;
-        options.sweeps.park = [&](std::vector<std::int32_t>& v) {
-            ++parks;
-            sizes.insert(v.size());
-            aside[&v].swap(v);  // read while away, they would be empty
-        };
-        options.sweeps.restore = [&](std::vector<std::int32_t>& v) {
-            ++restores;
-            CHECK(v.empty());
-            REQUIRE(aside.count(&v) == 1);
-            v.swap(aside[&v]);
-            aside.erase(&v);
-        };
+        options.memory = &memory;
         const auto taken = reeb::build_reeb_graph(*mesh, f, options);
-        CHECK(parks == 3);
-        CHECK(restores == 3);
-        CHECK(aside.empty());
-        const std::size_t nv = mesh->vertex_count();
-        CHECK(sizes == std::multiset<std::size_t>{nv, nv, held.node_count() + 1});
+        CHECK(memory.stashes == 4);
+        CHECK(memory.taken_back == 4);
+        CHECK(memory.away() == 0);
+        const std::size_t nv = mesh->vertex_count(), nn = held.node_count();
+        std::multiset<std::size_t> sizes(memory.stashed_sizes.begin(), memory.stashed_sizes.end());
+        CHECK(sizes == std::multiset<std::size_t>{nv, nv, nn + 1, nn});
         REQUIRE(reeb::check_reeb_graph(taken, f).empty());
         check_same_graph(taken, held);
     }

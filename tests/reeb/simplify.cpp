@@ -14,6 +14,7 @@
 #include "../../libterrain/src/reeb/simplifier.hpp"
 #include "terrain/internal/core/release.hpp"
 
+#include "support/recording_residency.hpp"
 #include "support/test_meshes.hpp"
 #include "support/test_support.hpp"
 #include "terrain/core/error.hpp"
@@ -475,7 +476,7 @@ TEST_CASE("The working graph's copy a wave at a time gives the same simplificati
         const auto simplified = [&](std::size_t wave, bool handed_over) {
             reeb::ReebGraph copy = g;
             reeb::internal::Simplifier s(c.mesh, copy, o, reeb::internal::kBigDegree, {},
-                                         handed_over ? &copy : nullptr, {}, {}, wave);
+                                         handed_over ? &copy : nullptr, nullptr, wave);
             if (handed_over) s.own_input(copy);
             reeb::SimplifyResult r;
             s.run({}, r);
@@ -559,12 +560,13 @@ TEST_CASE(
     check_same_result(given, lent);
 }
 
-TEST_CASE("A graph handed over lets its caller set the mesh's areas aside once they are read",
+TEST_CASE("A graph handed over tells its stages: the areas are read in the first only",
           "[simplify]") {
-    // The callback comes once, before the cancellations; what the caller then does to the
-    // areas changes nothing: taken away (a mesh without areas counts 1 a vertex), or scrambled
-    // (a factor of 1 to 97 a vertex: had anything read them after, the area ratios, and so
-    // the result, would differ).
+    // Stage::simplify_nodes, then simplify_arcs before the cancellations, then
+    // simplify_output; what the caller does to the areas on entering the second changes
+    // nothing: taken away (a mesh without areas counts 1 a vertex), or scrambled (a factor of
+    // 1 to 97 a vertex: had anything read them after, the area ratios, and so the result,
+    // would differ).
     const auto& s = vesta();
     const auto o = paper_thresholds();
     const auto lent = reeb::simplify(s.mesh, reeb::build_reeb_graph(s.mesh, s.si), o);
@@ -573,75 +575,63 @@ TEST_CASE("A graph handed over lets its caller set the mesh's areas aside once t
         TriangleMesh mesh = s.mesh;
         REQUIRE(!mesh.vertex_areas.empty());
         std::vector<float> aside;
-        int calls = 0;
         double last = 0;
+        test::RecordingResidency memory;
+        memory.on_entry[Stage::simplify_arcs] = [&] {
+            CHECK(last < 0.5);  // before the cancellations
+            if (!scramble) {
+                aside.swap(mesh.vertex_areas);
+                return;
+            }
+            for (std::size_t v = 0; v < mesh.vertex_areas.size(); ++v)
+                mesh.vertex_areas[v] *= static_cast<float>(1 + (v * 2654435761u) % 97);
+        };
+        memory.on_entry[Stage::simplify_output] = [&] { CHECK(last > 0.5); };
         const auto given = reeb::simplify(
             mesh, reeb::build_reeb_graph(mesh, s.si), o,
             [&](double f, std::string_view) {
                 last = f;
                 return true;
             },
-            [&] {
-                ++calls;
-                CHECK(last < 0.5);  // before the cancellations
-                if (!scramble) {
-                    aside.swap(mesh.vertex_areas);
-                    return;
-                }
-                for (std::size_t v = 0; v < mesh.vertex_areas.size(); ++v)
-                    mesh.vertex_areas[v] *= static_cast<float>(1 + (v * 2654435761u) % 97);
-            });
-        CHECK(calls == 1);
+            memory);
+        CHECK(memory.entered == std::vector<Stage>{Stage::simplify_nodes, Stage::simplify_arcs,
+                                                   Stage::simplify_output});
         CHECK(mesh.vertex_areas.empty() == !scramble);
         check_same_result(given, lent);
     }
 }
 
-TEST_CASE("A graph handed over lets its caller park the vertices' nodes until the output",
-          "[simplify]") {
-    // Parked: the graph's vertices' nodes (from the copy of the nodes) and the working copy's
-    // new numbers of the nodes (from the copy of the arcs), both given back after the
+TEST_CASE("A graph handed over stashes the vertices' nodes until the output", "[simplify]") {
+    // Stashed: the graph's vertices' nodes (from the copy of the nodes) and the working copy's
+    // new numbers of the nodes (from the copy of the arcs), both taken back after the
     // cancellations, the new numbers once the working copy is freed.
     const auto& s = vesta();
     const auto o = paper_thresholds();
     const auto graph = reeb::build_reeb_graph(s.mesh, s.si);
     const auto lent = reeb::simplify(s.mesh, graph, o);
-    std::map<const void*, std::vector<std::int32_t>> aside;
-    int parks = 0, restores = 0;
     double last = 0;
-    std::multiset<std::size_t> parked_sizes;
-    reeb::VertexNodesParking parking;
-    parking.park = [&](std::vector<std::int32_t>& v) {
-        ++parks;
-        CHECK(last < 0.5);  // before the cancellations
-        parked_sizes.insert(v.size());
-        aside[&v].swap(v);  // read while away, they would be empty
-    };
-    parking.restore = [&](std::vector<std::int32_t>& v) {
-        ++restores;
-        CHECK(last > 0.5);  // after the cancellations
-        CHECK(v.empty());
-        REQUIRE(aside.count(&v) == 1);
-        v.swap(aside[&v]);
-        aside.erase(&v);
-    };
     const auto progress = [&](double f, std::string_view) {
         last = f;
         return true;
     };
+    test::RecordingResidency memory;
+    memory.on_entry[Stage::simplify_output] = [&] {
+        CHECK(memory.stashes == 2);
+        CHECK(memory.away() == 2);
+        CHECK(last > 0.5);  // after the cancellations
+    };
     const auto given =
-        reeb::simplify(s.mesh, reeb::build_reeb_graph(s.mesh, s.si), o, progress, {}, parking);
-    CHECK(parks == 2);
-    CHECK(restores == 2);
-    CHECK(aside.empty());
-    CHECK(parked_sizes == std::multiset<std::size_t>{s.mesh.vertex_count(), graph.node_count()});
+        reeb::simplify(s.mesh, reeb::build_reeb_graph(s.mesh, s.si), o, progress, memory);
+    CHECK(memory.taken_back == 2);
+    CHECK(memory.away() == 0);
+    std::multiset<std::size_t> sizes(memory.stashed_sizes.begin(), memory.stashed_sizes.end());
+    CHECK(sizes == std::multiset<std::size_t>{s.mesh.vertex_count(), graph.node_count()});
     check_same_result(given, lent);
     // Given back wrong: one error, not a read out of bounds.
-    last = 0;
-    parking.restore = [&](std::vector<std::int32_t>& v) { v.assign(3, 0); };
-    CHECK_THROWS_WITH(
-        reeb::simplify(s.mesh, reeb::build_reeb_graph(s.mesh, s.si), o, {}, {}, parking),
-        Catch::Contains("wrong size"));
+    test::RecordingResidency wrong;
+    wrong.on_take_back = [](std::vector<std::int32_t>& v) { v.assign(3, 0); };
+    CHECK_THROWS_WITH(reeb::simplify(s.mesh, reeb::build_reeb_graph(s.mesh, s.si), o, {}, wrong),
+                      Catch::Contains("wrong size"));
 }
 
 TEST_CASE("The simplification's output is the same at one and two threads", "[simplify]") {

@@ -214,7 +214,7 @@ TEST_CASE("OFF colours and vertex lines CGAL's scanner reads unchecked are refus
         INFO(text);
         const auto input = write_bytes(dir / ("valid" + std::to_string(i++) + ".off"), text);
         const auto mesh = terrain::io::read_mesh(input);
-        CHECK(mesh.triangles.size() >= 1);
+        CHECK(mesh.triangles().size() >= 1);
     }
 }
 
@@ -235,5 +235,5 @@ TEST_CASE("a PLY format line other than the second is refused, not read in anoth
     };
     check_mesh_cases_refused(dir, cases, "ply");
     const auto valid = write_bytes(dir / "valid.ply", "ply\nformat ascii 1.0\n" + body);
-    CHECK(terrain::io::read_mesh(valid).triangles.size() == 1);
+    CHECK(terrain::io::read_mesh(valid).triangles().size() == 1);
 }

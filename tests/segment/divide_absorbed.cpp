@@ -9,6 +9,7 @@
 #include <map>
 
 #include "../../libterrain/src/segment/divide_absorbed_internal.hpp"
+#include "support/recording_residency.hpp"
 #include "support/test_meshes.hpp"
 #include "support/test_support.hpp"
 #include "terrain/core/error.hpp"
@@ -164,7 +165,7 @@ TEST_CASE("Dividing absorbed vertices in batches of offers on the threads: the s
     const auto sphere = icosphere(40);
     std::vector<float> bumps(sphere.vertex_count());
     for (std::size_t v = 0; v < bumps.size(); ++v) {
-        const auto& p = sphere.positions[v];
+        const auto& p = sphere.positions()[v];
         const float noise = static_cast<float>((v * 2654435761u) % 1000) / 1000.0f;
         bumps[v] = v % 997 == 0 ? -10000.0f
                                 : 30.0f * std::sin(4.0f * p[0]) * std::cos(4.0f * p[1]) + noise;
@@ -191,11 +192,11 @@ TEST_CASE("Dividing absorbed vertices in batches of offers on the threads: the s
     }
 }
 
-TEST_CASE("Dividing through hooks gives the same regions, each hook called once",
+TEST_CASE("Dividing tells its stages: the same regions with what they do not read away",
           "[segment][divide]") {
-    // The caller of pipeline::segment's kind: the field and the positions come only in the
-    // first hook, which takes the graph, the flags and the labels away; the labels come back
-    // in the second.
+    // The caller of pipeline::segment's kind: the field and the positions come only on
+    // entering the flooding, which takes the graph, the flags and the labels away; the labels
+    // come back on entering the relabelling.
     const auto dem = io::read_dem(test::sample("vesta_hamo_tile.lbl"));
     auto mesh = mesh::dem_to_mesh(dem);
     const auto field = field::shape_index_field(mesh);
@@ -210,38 +211,30 @@ TEST_CASE("Dividing through hooks gives the same regions, each hook called once"
     REQUIRE(expected.relabelled > 0);
     auto graph = simplified.graph;
     auto absorbed = simplified.absorbed;
-    auto hooked = grown;
+    auto told = grown;
     std::vector<float> given;
     std::vector<std::uint32_t> away;
-    int first = 0, second = 0;
-    segment::DivideHooks hooks;
-    hooks.seed_parts_kept = [&](const ProgressFn&) {
-        ++first;
+    test::RecordingResidency memory;
+    memory.on_entry[Stage::flood] = [&] {
         graph = reeb::ReebGraph{};
         std::vector<std::uint8_t>().swap(absorbed);
-        away.swap(hooked.labels);
+        away.swap(told.labels);
         given = field;
         mesh::restore_positions(dem, mesh);
     };
-    hooks.flooded = [&] {
-        ++second;
-        CHECK(first == 1);
-        hooked.labels.swap(away);
-    };
+    memory.on_entry[Stage::relabel] = [&] { told.labels.swap(away); };
     REQUIRE(mesh.release_positions());
     const auto counts =
-        segment::divide_absorbed(mesh, graph, given, absorbed, hooked, nullptr, {}, hooks);
-    CHECK(first == 1);
-    CHECK(second == 1);
-    CHECK(hooked.labels == plain.labels);
+        segment::divide_absorbed(mesh, graph, given, absorbed, told, nullptr, {}, memory);
+    CHECK(memory.entered == std::vector<Stage>{Stage::flood, Stage::relabel});
+    CHECK(told.labels == plain.labels);
     CHECK(counts.absorbed == expected.absorbed);
     CHECK(counts.detached == expected.detached);
     CHECK(counts.relabelled == expected.relabelled);
-    // A first hook that gives no field: the sizes disagree.
+    // No field given on entering the flooding: the sizes disagree.
     auto again = grown;
     std::vector<float> none;
-    segment::DivideHooks empty_handed;
-    empty_handed.seed_parts_kept = [](const ProgressFn&) {};
+    test::RecordingResidency empty_handed;
     CHECK_THROWS_AS(segment::divide_absorbed(mesh, simplified.graph, none, simplified.absorbed,
                                              again, nullptr, {}, empty_handed),
                     Error);
@@ -260,14 +253,11 @@ TEST_CASE("Dividing with nothing absorbed changes nothing, mismatched sizes thro
         segment::divide_absorbed(mesh, simplified.graph, field, simplified.absorbed, s);
     CHECK(counts.absorbed == 0);
     CHECK(s.labels == before);
-    // Hooks are called all the same, once each, in order.
-    std::vector<int> calls;
-    segment::DivideHooks hooks;
-    hooks.seed_parts_kept = [&](const ProgressFn&) { calls.push_back(1); };
-    hooks.flooded = [&] { calls.push_back(2); };
+    // The stages are told all the same, once each, in order.
+    test::RecordingResidency memory;
     segment::divide_absorbed(mesh, simplified.graph, field, simplified.absorbed, s, nullptr, {},
-                             hooks);
-    CHECK(calls == std::vector<int>{1, 2});
+                             memory);
+    CHECK(memory.entered == std::vector<Stage>{Stage::flood, Stage::relabel});
     CHECK(s.labels == before);
     std::vector<float> short_field(field.begin(), field.end() - 1);
     CHECK_THROWS_AS(

@@ -300,7 +300,7 @@ TEST_CASE("Representative vertices are the deepest of one BFS, whatever the thre
     const std::size_t n = mesh.vertex_count();
     // The reference: triangle counts per vertex, then one BFS queue.
     std::vector<int> triangles(n, 0);
-    for (const auto& tri : mesh.triangles)
+    for (const auto& tri : mesh.triangles())
         for (const auto v : tri) ++triangles[std::size_t(v)];
     std::vector<int> depth(n, -1);
     std::vector<std::size_t> queue;
@@ -352,7 +352,7 @@ TEST_CASE("Boundary lengths are one pass's sums in triangle order, whatever the 
         return std::make_pair(std::min(a, b), std::max(a, b));
     };
     std::map<std::pair<std::uint32_t, std::uint32_t>, double> length;
-    for (const auto& tri : mesh.triangles) {
+    for (const auto& tri : mesh.triangles()) {
         const std::uint32_t l[3] = {t.labels[std::size_t(tri[0])], t.labels[std::size_t(tri[1])],
                                     t.labels[std::size_t(tri[2])]};
         if (l[0] == l[1] && l[1] == l[2]) continue;

@@ -23,8 +23,8 @@ std::vector<double> cgal_sdf_face_diameters(
 // The same for a TriangleMesh and field::SdfOptions.
 template <class Mesh, class SdfOptions>
 std::vector<double> cgal_sdf_face_diameters(const Mesh& mesh, const SdfOptions& options) {
-    return cgal_sdf_face_diameters(mesh.positions, mesh.triangles, options.rays, options.cone_angle,
-                                   options.postprocess);
+    return cgal_sdf_face_diameters(mesh.positions(), mesh.triangles(), options.rays,
+                                   options.cone_angle, options.postprocess);
 }
 
 }  // namespace terrain::test

@@ -24,7 +24,7 @@ TriangleMesh make_mesh(const std::vector<std::array<double, 3>>& points,
                        const std::vector<std::array<std::int32_t, 3>>& triangles) {
     TriangleMesh mesh;
     set_positions(mesh, points);
-    mesh.triangles = triangles;
+    mesh.edit_triangles() = triangles;
     finish_mesh(mesh);
     return mesh;
 }
@@ -102,7 +102,7 @@ TriangleMesh permute_mesh(const TriangleMesh& mesh, const std::vector<std::int32
         pts[static_cast<std::size_t>(perm[v])] = mesh.position(v);
     std::vector<std::array<std::int32_t, 3>> tris;
     for (std::size_t t = mesh.triangle_count(); t-- > 0;) {
-        const auto& tr = mesh.triangles[t];
+        const auto& tr = mesh.triangles()[t];
         const std::size_t k = t % 3;  // rotate the corners, keeping the orientation
         tris.push_back({perm[static_cast<std::size_t>(tr[k])],
                         perm[static_cast<std::size_t>(tr[(k + 1) % 3])],

@@ -159,11 +159,11 @@ inline bool fit_curvatures(const TriangleMesh& mesh, std::int32_t v, const Vec3&
     if (m < 3) return false;
     const auto [t1, t2] = tangent_frame(normal);
     // One pass: the normal equations of the raw tangent coordinates and their mean distance.
-    const auto& centre = mesh.positions[v];
+    const auto& centre = mesh.positions()[v];
     NormalEquations e;
     e.m = m;
     for (auto w : neighbours) {
-        const Vec3 d = sub(mesh.positions[w], centre);
+        const Vec3 d = sub(mesh.positions()[w], centre);
         const double u = dot(d, t1), s = dot(d, t2), h = dot(d, normal);
         e.scale += std::sqrt(u * u + s * s + h * h);
         const double row[5] = {u * u, u * s, s * s, u, s};

@@ -130,7 +130,7 @@ ScaleSelectedField scale_selected_shape_index(const TriangleMesh& mesh,
     // 1 / the distance from the body's centre on a body-fixed mesh; 0 on a map.
     const auto body_curvature = [&](std::int32_t v) {
         if (mesh.frame != MeshFrame::body) return 0.0;
-        const auto& p = mesh.positions[std::size_t(v)];
+        const auto& p = mesh.positions()[std::size_t(v)];
         const double x = mesh.origin[0] + p[0], y = mesh.origin[1] + p[1],
                      z = mesh.origin[2] + p[2];
         const double r = std::sqrt(x * x + y * y + z * z);

@@ -61,12 +61,12 @@ FaceData face_data(const TriangleMesh& mesh) {
     const std::size_t n = mesh.vertex_count(), f = mesh.triangle_count();
     d.points.resize(n);
     for (std::size_t v = 0; v < n; ++v)
-        for (int k = 0; k < 3; ++k) d.points[v][k] = mesh.positions[v][k];
+        for (int k = 0; k < 3; ++k) d.points[v][k] = mesh.positions()[v][k];
     d.twice_area.assign(f, 0.0);
     d.degenerate.assign(f, 0);
     d.repeated.assign(f, 0);
     for (std::size_t i = 0; i < f; ++i) {
-        const Face& t = mesh.triangles[i];
+        const Face& t = mesh.triangles()[i];
         for (int k = 0; k < 3; ++k)
             if (t[k] < 0 || static_cast<std::size_t>(t[k]) >= n)
                 throw Error("sdf", "face " + std::to_string(i) + " refers to vertex " +
@@ -109,7 +109,7 @@ Adjacency face_adjacency(const TriangleMesh& mesh, const FaceData& d) {
     edges.reserve(3 * mesh.triangle_count());
     for (std::size_t i = 0; i < mesh.triangle_count(); ++i) {
         if (d.repeated[i]) continue;
-        const Face& t = mesh.triangles[i];
+        const Face& t = mesh.triangles()[i];
         for (int k = 0; k < 3; ++k) {
             const auto [lo, hi] = std::minmax(t[k], t[(k + 1) % 3]);
             edges.push_back({lo, hi, static_cast<std::int32_t>(i), k});
@@ -138,7 +138,7 @@ Adjacency face_adjacency(const TriangleMesh& mesh, const FaceData& d) {
 double signed_volume6(const TriangleMesh& mesh, const FaceData& d) {
     double sum = 0;
     for (const std::int32_t f : d.ray_faces) {
-        const Face& t = mesh.triangles[f];
+        const Face& t = mesh.triangles()[f];
         sum += dot(d.points[t[0]], cross(d.points[t[1]], d.points[t[2]]));
     }
     return sum;
@@ -209,7 +209,7 @@ struct RayCaster {
 
     // The face's SDF, or kMissing when no ray left through the inner side of a face.
     double face_value(std::int32_t f, Scratch& s) const {
-        const Face& t = mesh.triangles[f];
+        const Face& t = mesh.triangles()[f];
         const Vec3 &p1 = data.points[t[0]], &p2 = data.points[t[1]], &p3 = data.points[t[2]];
         Vec3 centre;
         for (int k = 0; k < 3; ++k) centre[k] = (p1[k] + p2[k] + p3[k]) / 3.0;
@@ -334,7 +334,7 @@ SdfResult shape_diameter_function(const TriangleMesh& mesh, const SdfOptions& op
     result.degenerate_faces = mesh.triangle_count() - data.ray_faces.size();
     result.reoriented = signed_volume6(mesh, data) < 0;
 
-    const TriangleBvh bvh(data.points, mesh.triangles, data.ray_faces);
+    const TriangleBvh bvh(data.points, mesh.triangles(), data.ray_faces);
     report_progress(progress, 0.02, "sdf");
     // CGAL casts segments as long as the diagonal of the box around the non-degenerate
     // faces (its AABB tree's); so do we.
@@ -383,7 +383,7 @@ SdfResult shape_diameter_function(const TriangleMesh& mesh, const SdfOptions& op
     std::vector<double> sum(nv, 0), weight(nv, 0), plain(nv, 0);
     std::vector<std::int32_t> count(nv, 0);
     for (std::size_t f = 0; f < mesh.triangle_count(); ++f)
-        for (const std::int32_t v : mesh.triangles[f]) {
+        for (const std::int32_t v : mesh.triangles()[f]) {
             sum[v] += data.twice_area[f] * value[f];
             weight[v] += data.twice_area[f];
             plain[v] += value[f];

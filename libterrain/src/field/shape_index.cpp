@@ -33,12 +33,12 @@ void gather(const TriangleMesh& mesh, std::int32_t v, const ShapeIndexOptions& o
     if (!(options.radius > 0))
         return gather_where(
             mesh, v, options.rings, [](std::int32_t) { return true; }, s);
-    const auto& centre = mesh.positions[v];
+    const auto& centre = mesh.positions()[v];
     const double r2 = options.radius * options.radius;
     gather_where(
         mesh, v, -1,
         [&](std::int32_t w) {
-            const Vec3 d = sub(mesh.positions[w], centre);
+            const Vec3 d = sub(mesh.positions()[w], centre);
             return dot(d, d) <= r2;
         },
         s);

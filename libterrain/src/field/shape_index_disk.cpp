@@ -79,7 +79,7 @@ GroundSpacing ground_spacing(const TriangleMesh& mesh, const GridLayout& g, std:
     GroundSpacing out;
     out.up = up;
     const auto horizontal = [&](std::int32_t to, std::int32_t from, double share) {
-        const Vec3 d = sub(mesh.positions[std::size_t(to)], mesh.positions[std::size_t(from)]);
+        const Vec3 d = sub(mesh.positions()[std::size_t(to)], mesh.positions()[std::size_t(from)]);
         const double along = dot(d, up);
         return Vec3{(d[0] - along * up[0]) * share, (d[1] - along * up[1]) * share,
                     (d[2] - along * up[2]) * share};
@@ -124,7 +124,7 @@ DiskWindow vertex_disk(const TriangleMesh& mesh, const GridLayout& g, std::int32
             const auto a = g.vertex_near(col - j * dc, row - j * dr),
                        b = g.vertex_near(col + j * dc, row + j * dr);
             if (a < 0 || b < 0) continue;
-            const Vec3 d = sub(mesh.positions[std::size_t(b)], mesh.positions[std::size_t(a)]);
+            const Vec3 d = sub(mesh.positions()[std::size_t(b)], mesh.positions()[std::size_t(a)]);
             return dot(d, s.up) / (2.0 * j);
         }
         return std::nullopt;
@@ -195,7 +195,7 @@ MongeFrame tile_frame(const TriangleMesh& mesh, const GridLayout& g, int col, in
     for (int r = r0; r < r1; ++r)
         for (int c = c0; c < c1; ++c)
             if (const auto v = g.vertex_at(c, r); v >= 0) {
-                const auto& p = mesh.positions[std::size_t(v)];
+                const auto& p = mesh.positions()[std::size_t(v)];
                 f.up = normalized(
                     {mesh.origin[0] + p[0], mesh.origin[1] + p[1], mesh.origin[2] + p[2]});
                 const auto [t1, t2] = tangent_frame(f.up);
@@ -288,9 +288,9 @@ bool disk_mesh_fit(const TriangleMesh& mesh, const GridLayout& g, std::int32_t v
     gather_disk(mesh, g, v, vertex_disk(mesh, g, v, normal, frame.up, radius), s);
     double m[kMonge] = {};
     double mono[kMonge];
-    const auto& centre = mesh.positions[std::size_t(v)];
+    const auto& centre = mesh.positions()[std::size_t(v)];
     for (const auto w : s.gathered) {
-        monge_monomials(frame, sub(mesh.positions[std::size_t(w)], centre), mono);
+        monge_monomials(frame, sub(mesh.positions()[std::size_t(w)], centre), mono);
         for (int i = 0; i < kMonge; ++i) m[i] += mono[i];
     }
     const auto e = monge_equations(m);
@@ -363,7 +363,7 @@ void disk_tile(const TriangleMesh& mesh, const GridLayout& g, const Normals& nor
             const auto& b = d.band[std::size_t(k)];
             add_rectangle(moments, lr + b.row_lo, lr + b.row_hi, lc + b.col_lo, lc + b.col_hi);
         }
-        const auto& p = mesh.positions[std::size_t(v)];
+        const auto& p = mesh.positions()[std::size_t(v)];
         const Vec3 t{p[0] - region.ref[0], p[1] - region.ref[1], p[2] - region.ref[2]};
         monge_shift(moments, dot(t, frame.e1), dot(t, frame.e2), dot(t, frame.up));
         PrincipalCurvatures k;

@@ -307,7 +307,7 @@ RegionStatus region_sums(const TriangleMesh& mesh, const GridLayout& g, int r0, 
     for (int row = r0; row < r1 && !any; ++row)
         for (int col = c0; col < c1 && !any; ++col)
             if (const auto v = g.vertex_at(col, row); v >= 0) {
-                const auto& p = mesh.positions[std::size_t(v)];
+                const auto& p = mesh.positions()[std::size_t(v)];
                 ref = {p[0], p[1], p[2]}, any = true;
             }
     if (!any) return RegionStatus::empty;
@@ -323,7 +323,7 @@ RegionStatus region_sums(const TriangleMesh& mesh, const GridLayout& g, int r0, 
             if (v < 0) {
                 std::copy_n(running, N, next);
             } else {
-                const auto& q = mesh.positions[std::size_t(v)];
+                const auto& q = mesh.positions()[std::size_t(v)];
                 p = {q[0], q[1], q[2]};
                 double mono[N];
                 fill(Vec3{p[0] - ref[0], p[1] - ref[1], p[2] - ref[2]}, mono);

@@ -44,12 +44,12 @@ GridLayout grid_layout(const TriangleMesh& mesh, double tile_angle) {
             for (int c = 0; c + 1 < g.width; c += col_step) {
                 const auto v = g.vertex_at(c, r);
                 if (v < 0) continue;
-                const auto& p = mesh.positions[std::size_t(v)];
+                const auto& p = mesh.positions()[std::size_t(v)];
                 const Vec3 q{mesh.origin[0] + p[0], mesh.origin[1] + p[1], mesh.origin[2] + p[2]};
                 radius = std::max(radius, std::sqrt(dot(q, q)));
                 for (const auto w : {g.vertex_at(c + 1, r), g.vertex_at(c, r + 1)})
                     if (w >= 0) {
-                        const Vec3 d = sub(mesh.positions[std::size_t(w)], p);
+                        const Vec3 d = sub(mesh.positions()[std::size_t(w)], p);
                         spacing = std::max(spacing, std::sqrt(dot(d, d)));
                     }
             }
@@ -103,7 +103,7 @@ int tile_reach(const TriangleMesh& mesh, const GridLayout& g, double radius, int
         for (int col = c0; col + dc < c1; ++col) {
             const auto a = g.vertex_at(col, row), b = g.vertex_at(col + dc, row + dr);
             if (a < 0 || b < 0) continue;
-            const Vec3 d = sub(mesh.positions[std::size_t(a)], mesh.positions[std::size_t(b)]);
+            const Vec3 d = sub(mesh.positions()[std::size_t(a)], mesh.positions()[std::size_t(b)]);
             spacing.push_back(std::sqrt(dot(d, d)));
         }
     if (spacing.empty()) return kMaxReach + 1;

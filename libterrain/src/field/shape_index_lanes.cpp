@@ -38,7 +38,7 @@ __attribute__((target_clones("avx2", "default"))) void fit_curvatures_batch(
         Lanes t1[3] = {}, t2[3] = {}, n[3] = {}, c[3] = {};
         for (int l = 0; l < kFitLanes; ++l) {
             const auto frame = tangent_frame(batch.normal[std::size_t(l)]);
-            const auto& centre = mesh.positions[std::size_t(batch.vertex[std::size_t(l)])];
+            const auto& centre = mesh.positions()[std::size_t(batch.vertex[std::size_t(l)])];
             for (int i = 0; i < 3; ++i) {
                 t1[i][l] = frame[0][std::size_t(i)];
                 t2[i][l] = frame[1][std::size_t(i)];
@@ -55,7 +55,7 @@ __attribute__((target_clones("avx2", "default"))) void fit_curvatures_batch(
                 in[l] = has ? -1 : 0;
                 const auto w =
                     has ? batch.neighbours[std::size_t(l)][j] : batch.vertex[std::size_t(l)];
-                const auto& q = mesh.positions[std::size_t(w)];
+                const auto& q = mesh.positions()[std::size_t(w)];
                 for (int i = 0; i < 3; ++i) d[i][l] = double(q[std::size_t(i)]);
             }
             for (int i = 0; i < 3; ++i) d[i] = d[i] - c[i];

@@ -21,7 +21,7 @@ namespace {
 template <class Take>
 void add_normal(const TriangleMesh& mesh, const std::array<std::int32_t, 3>& t, std::size_t first,
                 std::vector<Vec3>& normals, const Take& take) {
-    const auto& p = mesh.positions;
+    const auto& p = mesh.positions();
     const Vec3 n = cross(sub(p[t[1]], p[t[0]]), sub(p[t[2]], p[t[0]]));
     for (auto v : t)
         if (take(v))

@@ -170,9 +170,9 @@ TriangleMesh read_mesh(const std::string& path, const ReadMeshOptions& options,
     xyz.reserve(points.size());
     for (const auto& p : points) xyz.push_back({p.x(), p.y(), p.z()});
     set_positions(mesh, xyz);
-    mesh.triangles.reserve(polygons.size());
+    mesh.edit_triangles().reserve(polygons.size());
     for (const auto& poly : polygons)
-        mesh.triangles.push_back(
+        mesh.edit_triangles().push_back(
             {std::int32_t(poly[0]), std::int32_t(poly[1]), std::int32_t(poly[2])});
     mesh.isolated_vertices = remove_unreferenced_vertices(mesh);
     // A vertex where fans meet only at a point.

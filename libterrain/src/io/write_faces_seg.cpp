@@ -11,7 +11,7 @@ std::vector<std::uint32_t> face_labels(const TriangleMesh& mesh,
         throw Error("write", "face labels need one label per mesh vertex");
     std::vector<std::uint32_t> out;
     out.reserve(mesh.triangle_count());
-    for (const auto& t : mesh.triangles) {
+    for (const auto& t : mesh.triangles()) {
         const auto a = labels[std::size_t(t[0])], b = labels[std::size_t(t[1])],
                    c = labels[std::size_t(t[2])];
         // Two equal labels are the majority; three different ones go to the lowest.

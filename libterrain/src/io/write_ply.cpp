@@ -77,7 +77,7 @@ void write_ply(const TriangleMesh& mesh, const std::string& path, bool overwrite
                     put(out, (*property.values)[v]);
             }
         }
-        for (const auto& t : mesh.triangles) {
+        for (const auto& t : mesh.triangles()) {
             put(out, std::uint8_t{3});
             for (auto v : t) put(out, v);
         }

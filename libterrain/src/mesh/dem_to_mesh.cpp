@@ -321,7 +321,7 @@ void triangulate_blocks(const Dem& dem, const std::vector<std::int32_t>& vertex_
             std::uint64_t* bits = mesh.block_diagonals.data() + std::size_t(row) * words;
             const auto split = [&](int col, std::int32_t v00, std::int32_t v10, std::int32_t v01,
                                    std::int32_t v11) {
-                const bool across = detail::split_top_right(mesh.positions, v00, v10, v01, v11);
+                const bool across = detail::split_top_right(mesh.positions(), v00, v10, v01, v11);
                 if (across) bits[unsigned(col) / 64] |= std::uint64_t{1} << (unsigned(col) % 64);
                 return across;
             };
@@ -336,11 +336,11 @@ void triangulate_blocks(const Dem& dem, const std::vector<std::int32_t>& vertex_
     if (offsets.back() == 0)
         throw Error("mesh",
                     "'" + dem.source + "' gives no triangle: no 2x2 block has three valid pixels");
-    detail::assign_in_slices(mesh.triangles, offsets.back(), Triangle{},
+    detail::assign_in_slices(mesh.edit_triangles(), offsets.back(), Triangle{},
                              detail::PassProgress(progress, 0.6, 0.7, "mesh"));
     detail::parallel_slices(block_rows, 16, progress, 0.7, 1, "mesh", [&](const auto& rows) {
         for (int row = rows.begin(); row < rows.end(); ++row) {
-            Triangle* out = mesh.triangles.data() + offsets[std::size_t(row)];
+            Triangle* out = mesh.edit_triangles().data() + offsets[std::size_t(row)];
             detail::block_row_triangles(row_top(row), row_top(row) + W, W, mesh.seam_closed,
                                         mesh.triangles_flipped, detail::recorded_split(mesh, row),
                                         [&](const Triangle& t) { *out++ = t; });
@@ -382,7 +382,7 @@ TriangleMesh dem_to_mesh(const Dem& dem, const DemToMeshOptions& options,
     // Leave out valid pixels in no triangle (isolated, or only in degenerate blocks).
     mesh.isolated_vertices =
         remove_unreferenced_vertices(mesh, scaled_progress(progress, 0.5, 0.6));
-    const auto before_split = static_cast<std::int32_t>(mesh.positions.size());
+    const auto before_split = static_cast<std::int32_t>(mesh.positions().size());
     // Only a vertex next to a missing pixel, or on the grid's first or last two rows or
     // columns (the grid's edge, the poles, the seam), can be pinched: the fan of a vertex
     // whose 8 neighbouring pixels are valid is the full disk of its four complete blocks, and
@@ -400,12 +400,12 @@ TriangleMesh dem_to_mesh(const Dem& dem, const DemToMeshOptions& options,
         split_pinched_vertices(mesh, nullptr, scaled_progress(progress, 0.6, 0.7), may_pinch);
     // The triangles naming a copy, which the grid alone would not make again.
     if (mesh.pinched_vertices > 0)
-        for (std::size_t i = 0; i < mesh.triangles.size(); ++i) {
-            const auto& c = mesh.triangles[i];
+        for (std::size_t i = 0; i < mesh.triangles().size(); ++i) {
+            const auto& c = mesh.triangles()[i];
             if (std::max({c[0], c[1], c[2]}) >= before_split)
                 mesh.pinch_triangles.emplace_back(i, c);
         }
-    mesh.positions.shrink_to_fit();
+    mesh.edit_positions().shrink_to_fit();
     mesh.vertex_pixel.shrink_to_fit();
     // The pixels' vertices after those changes, in the same memory.
     fill_pixel_to_vertex(mesh, dem, vertex_of);

@@ -30,12 +30,12 @@ using detail::set_grid_vertex_areas;
 using detail::set_vertex_areas;
 
 void finish_mesh(TriangleMesh& mesh, const ProgressFn& progress) {
-    const std::size_t n = mesh.positions.size();
+    const std::size_t n = mesh.positions().size();
     // Its passes: areas (0 to 0.25), the corners' lists (counted, made, filled: to 0.6),
     // sorted (to 0.9), copied at their size (to 1).
     const detail::PassProgress counts(progress, 0.25, 0.35, "mesh"),
         lists(progress, 0.45, 0.6, "mesh");
-    const std::size_t nt = mesh.triangles.size();
+    const std::size_t nt = mesh.triangles().size();
     mesh.release_adjacency();
     set_vertex_areas(mesh, detail::PassProgress(progress, 0, 0.25, "mesh"));
     report_progress(progress, 0.25, "mesh");
@@ -43,11 +43,11 @@ void finish_mesh(TriangleMesh& mesh, const ProgressFn& progress) {
     // CSR adjacency from the triangles' edges, each list sorted and without repeats. Before
     // the repeats go there are two entries per triangle corner (12 per vertex of a grid,
     // past 2^31 at 179 M vertices): 32-bit unsigned offsets, checked.
-    check_adjacency_size(6 * std::uint64_t{mesh.triangles.size()}, "triangle corners");
+    check_adjacency_size(6 * std::uint64_t{mesh.triangles().size()}, "triangle corners");
     std::vector<std::uint32_t> offsets(n + 1, 0);
     for (std::size_t i = 0; i < nt; ++i) {
         counts.at(i, nt);
-        for (int k = 0; k < 3; ++k) offsets[mesh.triangles[i][k] + 1] += 2;
+        for (int k = 0; k < 3; ++k) offsets[mesh.triangles()[i][k] + 1] += 2;
     }
     std::partial_sum(offsets.begin(), offsets.end(), offsets.begin());
     std::vector<std::int32_t> all;
@@ -56,7 +56,7 @@ void finish_mesh(TriangleMesh& mesh, const ProgressFn& progress) {
     std::vector<std::uint32_t> fill(offsets.begin(), offsets.end() - 1);
     for (std::size_t i = 0; i < nt; ++i) {
         lists.at(i, nt);
-        const auto& t = mesh.triangles[i];
+        const auto& t = mesh.triangles()[i];
         for (int k = 0; k < 3; ++k) {
             all[fill[t[k]]++] = t[(k + 1) % 3];
             all[fill[t[k]]++] = t[(k + 2) % 3];
@@ -134,7 +134,7 @@ int grid_direction(std::int64_t W, std::int64_t dp) {
 void mark_grid_directions(const TriangleMesh& mesh, bool by_rows, const ProgressFn& progress,
                           std::vector<std::uint8_t>& bits, std::vector<std::uint8_t>& irregular) {
     const std::int64_t W = mesh.grid_width;
-    const std::size_t n = mesh.positions.size(), nt = mesh.triangles.size();
+    const std::size_t n = mesh.positions().size();
     detail::assign_in_slices(bits, n, std::uint8_t{0},
                              detail::PassProgress(progress, 0.3, 0.35, "mesh"));
     irregular.assign(n, 0);
@@ -160,11 +160,11 @@ void mark_grid_directions(const TriangleMesh& mesh, bool by_rows, const Progress
     if (by_rows)
         detail::for_each_triangle_by_bands(mesh, progress, 0.35, 0.6, "mesh", mark);
     else
-        detail::parallel_slices(nt, std::size_t{4096}, progress, 0.35, 0.6, "mesh",
-                                [&](const tbb::blocked_range<std::size_t>& r) {
-                                    for (std::size_t i = r.begin(); i < r.end(); ++i)
-                                        mark(mesh.triangles[i]);
-                                });
+        detail::parallel_slices(
+            mesh.triangle_count(), std::size_t{4096}, progress, 0.35, 0.6, "mesh",
+            [&, &triangles = mesh.triangles()](const tbb::blocked_range<std::size_t>& r) {
+                for (std::size_t i = r.begin(); i < r.end(); ++i) mark(triangles[i]);
+            });
 }
 
 // Marks irregular the vertices whose neighbours, read off the grid in the directions' order,
@@ -174,7 +174,7 @@ std::uint64_t mark_unordered_vertices(const TriangleMesh& mesh, const ProgressFn
                                       std::vector<std::uint8_t>& irregular) {
     std::atomic<std::uint64_t> regular_degrees{0};
     detail::parallel_slices(
-        mesh.positions.size(), std::size_t{4096}, progress, 0.6, 0.8, "mesh",
+        mesh.positions().size(), std::size_t{4096}, progress, 0.6, 0.8, "mesh",
         [&](const tbb::blocked_range<std::size_t>& r) {
             std::uint64_t sum = 0;
             for (std::size_t v = r.begin(); v < r.end(); ++v) {
@@ -194,7 +194,7 @@ std::uint64_t mark_unordered_vertices(const TriangleMesh& mesh, const ProgressFn
 // triangles, sorted and without repeats. Returns the lists' length.
 std::size_t set_irregular_lists(TriangleMesh& mesh, bool by_rows, const ProgressFn& progress,
                                 std::vector<std::uint8_t>& irregular) {
-    const std::size_t n = mesh.positions.size(), nt = mesh.triangles.size();
+    const std::size_t n = mesh.positions().size();
     for (std::size_t v = 0; v < n; ++v)
         if (irregular[v]) {
             mesh.neighbor_directions[v] = 0;
@@ -214,15 +214,16 @@ std::size_t set_irregular_lists(TriangleMesh& mesh, bool by_rows, const Progress
                 out.push_back(
                     {static_cast<std::int32_t>(rank(t[k])), t[(k + 1) % 3], t[(k + 2) % 3]});
     };
-    auto corners = by_rows
-                       ? gather_by_slices<std::array<std::int32_t, 3>>(
-                             std::size_t(mesh.grid_height - 1),
-                             [&](std::size_t row, auto& out) {
-                                 detail::for_each_row_triangle(
-                                     mesh, int(row), [&](const auto& t) { gather(t, out); });
-                             })
-                       : gather_by_slices<std::array<std::int32_t, 3>>(
-                             nt, [&](std::size_t i, auto& out) { gather(mesh.triangles[i], out); });
+    auto corners = by_rows ? gather_by_slices<std::array<std::int32_t, 3>>(
+                                 std::size_t(mesh.grid_height - 1),
+                                 [&](std::size_t row, auto& out) {
+                                     detail::for_each_row_triangle(
+                                         mesh, int(row), [&](const auto& t) { gather(t, out); });
+                                 })
+                           : gather_by_slices<std::array<std::int32_t, 3>>(
+                                 mesh.triangle_count(), [&](std::size_t i, auto& out) {
+                                     gather(mesh.triangles()[i], out);
+                                 });
     report_progress(progress, 0.95, "mesh");
     std::vector<std::uint32_t> offsets(ni + 1, 0);
     for (const auto& list : corners)
@@ -256,7 +257,7 @@ std::size_t set_irregular_lists(TriangleMesh& mesh, bool by_rows, const Progress
 
 void finish_grid_mesh(TriangleMesh& mesh, const ProgressFn& progress) {
     const std::int64_t W = mesh.grid_width;
-    const std::size_t n = mesh.positions.size();
+    const std::size_t n = mesh.positions().size();
     // Triangles released (dem_to_mesh's release_triangles, no split pinch): each pass walks
     // them from the grid, a row of blocks at a time.
     const bool by_rows = detail::rows_of_triangles(mesh);

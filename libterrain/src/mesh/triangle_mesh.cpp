@@ -38,8 +38,8 @@ const char* to_string(MeshFrame frame) {
 }
 
 std::size_t TriangleMesh::memory_bytes() const {
-    return positions.capacity() * sizeof(positions[0]) +
-           triangles.capacity() * sizeof(triangles[0]) + vertex_areas.capacity() * sizeof(float) +
+    return positions_.capacity() * sizeof(positions_[0]) +
+           triangles_.capacity() * sizeof(triangles_[0]) + vertex_areas.capacity() * sizeof(float) +
            neighbor_offsets.capacity() * sizeof(std::int32_t) +
            neighbors.capacity() * sizeof(std::int32_t) +
            vertex_pixel.capacity() * sizeof(std::int32_t) +
@@ -50,6 +50,11 @@ std::size_t TriangleMesh::memory_bytes() const {
            pinch_triangles.capacity() * sizeof(pinch_triangles[0]) +
            block_diagonals.capacity() * sizeof(std::uint64_t) +
            uniform_ranges.capacity() * sizeof(uniform_ranges[0]);
+}
+
+void TriangleMesh::drop_geometry() {
+    detail::release(positions_);
+    detail::release(triangles_);
 }
 
 void TriangleMesh::release_adjacency() {
@@ -72,14 +77,14 @@ bool TriangleMesh::grid_describes_it() const {
 }
 
 bool TriangleMesh::triangles_releasable() const {
-    return !triangles.empty() && grid_describes_it();
+    return !triangles_.empty() && grid_describes_it();
 }
 
 bool TriangleMesh::release_triangles() {
     if (triangles_released()) return true;
     if (!triangles_releasable()) return false;
-    released_triangles_ = triangles.size();
-    detail::release(triangles);
+    released_triangles_ = triangles_.size();
+    detail::release(triangles_);
     return true;
 }
 
@@ -90,23 +95,33 @@ void TriangleMesh::restore_triangles() {
     detail::for_each_triangle(*this, [&](std::size_t, const auto& t) { made.push_back(t); });
     if (made.size() != released_triangles_)
         throw Error("mesh", "internal: the triangles made again are not those released");
-    triangles = std::move(made);
+    triangles_ = std::move(made);
     released_triangles_ = 0;
 }
 
 bool TriangleMesh::release_positions() {
     if (positions_released()) return true;
-    if (positions.empty() || !grid_describes_it()) return false;
-    released_vertices_ = positions.size();
-    detail::release(positions);
+    if (positions_.empty() || !grid_describes_it()) return false;
+    released_vertices_ = positions_.size();
+    detail::release(positions_);
     return true;
 }
 
 void TriangleMesh::set_restored_positions(std::vector<std::array<float, 3>>&& placed) {
     if (!positions_released() || placed.size() != released_vertices_)
         throw Error("mesh", "internal: the positions placed again are not one a vertex");
-    positions = std::move(placed);
+    positions_ = std::move(placed);
     released_vertices_ = 0;
+}
+
+void TriangleMesh::away(const char* what) {
+    throw Error("mesh", std::string("internal: the mesh's ") + what +
+                            " were read while released (read them through the grid)");
+}
+
+void TriangleMesh::for_each_triangle(
+    const std::function<void(std::size_t, const Triangle&)>& f) const {
+    detail::for_each_triangle(*this, f);
 }
 
 VertexNeighbors TriangleMesh::irregular_neighbors_of(std::size_t v) const {
@@ -149,15 +164,15 @@ void set_positions(TriangleMesh& mesh, const std::vector<std::array<double, 3>>&
         for (int k = 0; k < 3; ++k)
             lo[k] = std::min(lo[k], b.lo[k]), hi[k] = std::max(hi[k], b.hi[k]);
     for (int k = 0; k < 3; ++k) mesh.origin[k] = points.empty() ? 0.0 : 0.5 * (lo[k] + hi[k]);
-    detail::assign_in_slices(mesh.positions, n, std::array<float, 3>{},
+    detail::assign_in_slices(mesh.edit_positions(), n, std::array<float, 3>{},
                              detail::PassProgress(progress, 0.3, 0.6, "mesh"));
-    detail::parallel_slices(n, std::size_t{4096}, progress, 0.6, 1, "mesh",
-                            [&](const tbb::blocked_range<std::size_t>& r) {
-                                for (std::size_t v = r.begin(); v < r.end(); ++v)
-                                    for (int k = 0; k < 3; ++k)
-                                        mesh.positions[v][k] =
-                                            static_cast<float>(points[v][k] - mesh.origin[k]);
-                            });
+    detail::parallel_slices(
+        n, std::size_t{4096}, progress, 0.6, 1, "mesh",
+        [&, &positions = mesh.edit_positions()](const tbb::blocked_range<std::size_t>& r) {
+            for (std::size_t v = r.begin(); v < r.end(); ++v)
+                for (int k = 0; k < 3; ++k)
+                    positions[v][k] = static_cast<float>(points[v][k] - mesh.origin[k]);
+        });
 }
 
 std::vector<std::uint32_t> first_edge_slots(const TriangleMesh& mesh) {

@@ -20,9 +20,9 @@ namespace terrain::detail {
 namespace {
 
 double triangle_area(const TriangleMesh& m, const std::array<std::int32_t, 3>& t) {
-    const auto& a = m.positions[t[0]];
-    const auto& b = m.positions[t[1]];
-    const auto& c = m.positions[t[2]];
+    const auto& a = m.positions()[t[0]];
+    const auto& b = m.positions()[t[1]];
+    const auto& c = m.positions()[t[2]];
     const double u[3] = {double(b[0]) - a[0], double(b[1]) - a[1], double(b[2]) - a[2]};
     const double v[3] = {double(c[0]) - a[0], double(c[1]) - a[1], double(c[2]) - a[2]};
     const double n[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2],
@@ -45,7 +45,7 @@ void add_areas_by_bands(TriangleMesh& mesh, int rows, const EmitRow& emit_row,
     constexpr int kBandRows = 16;
     const int bands = (rows + kBandRows - 1) / kBandRows;
     const double zeroed = begin + (end - begin) * 0.1, middle = begin + (end - begin) * 0.8;
-    detail::assign_in_slices(mesh.vertex_areas, mesh.positions.size(), 0.0f,
+    detail::assign_in_slices(mesh.vertex_areas, mesh.positions().size(), 0.0f,
                              detail::PassProgress(progress, begin, zeroed, "mesh"));
     const auto pixel_of = [&](std::int32_t v) {
         return static_cast<std::size_t>(mesh.vertex_pixel[std::size_t(v)]);
@@ -104,11 +104,11 @@ void add_areas_by_bands(TriangleMesh& mesh, int rows, const EmitRow& emit_row,
 
 // Vertex areas: one third of each incident triangle (serial: the same sums every run).
 void set_vertex_areas(TriangleMesh& mesh, const detail::PassProgress& areas) {
-    const std::size_t nt = mesh.triangles.size();
-    std::vector<double> area(mesh.positions.size(), 0.0);
+    const std::size_t nt = mesh.triangles().size();
+    std::vector<double> area(mesh.positions().size(), 0.0);
     for (std::size_t i = 0; i < nt; ++i) {
         areas.at(i, nt);
-        const auto& t = mesh.triangles[i];
+        const auto& t = mesh.triangles()[i];
         const double third = triangle_area(mesh, t) / 3.0;
         for (int k = 0; k < 3; ++k) area[t[k]] += third;
     }
@@ -121,7 +121,6 @@ void set_vertex_areas(TriangleMesh& mesh, const detail::PassProgress& areas) {
 bool set_grid_vertex_areas(TriangleMesh& mesh, const ProgressFn& progress, double begin,
                            double end) {
     const std::int64_t W = mesh.grid_width;
-    const std::size_t nt = mesh.triangles.size();
     const int rows = mesh.grid_height - 1;
     // Triangles released (dem_to_mesh's release_triangles): made again row by row from the
     // grid, in the order they had, which has no split pinch.
@@ -132,11 +131,13 @@ bool set_grid_vertex_areas(TriangleMesh& mesh, const ProgressFn& progress, doubl
             begin, end);
         return true;
     }
+    const auto& triangles = mesh.triangles();
+    const std::size_t nt = triangles.size();
     const auto pixel_row = [&](std::int32_t v) {
         return static_cast<std::int64_t>(mesh.vertex_pixel[std::size_t(v)]) / W;
     };
     const auto block_row = [&](std::size_t i) {
-        const auto& t = mesh.triangles[i];
+        const auto& t = triangles[i];
         return std::min({pixel_row(t[0]), pixel_row(t[1]), pixel_row(t[2])});
     };
     // Block rows in order, each corner on its block row or the next.
@@ -146,8 +147,7 @@ bool set_grid_vertex_areas(TriangleMesh& mesh, const ProgressFn& progress, doubl
                           for (std::size_t i = r.begin(); i < r.end(); ++i) {
                               const std::int64_t b = block_row(i);
                               bool ok = b < rows && (i == 0 || block_row(i - 1) <= b);
-                              for (const auto v : mesh.triangles[i])
-                                  ok = ok && pixel_row(v) - b <= 1;
+                              for (const auto v : triangles[i]) ok = ok && pixel_row(v) - b <= 1;
                               if (!ok) grid_like = false;
                           }
                       });
@@ -165,18 +165,18 @@ bool set_grid_vertex_areas(TriangleMesh& mesh, const ProgressFn& progress, doubl
             [&](int row, const auto& f) {
                 for (std::size_t i = row_first[std::size_t(row)];
                      i < row_first[std::size_t(row) + 1]; ++i)
-                    f(mesh.triangles[i]);
+                    f(triangles[i]);
             },
             progress, begin, end);
         return true;
     }
-    std::vector<double> area(mesh.positions.size(), 0.0);
+    std::vector<double> area(mesh.positions().size(), 0.0);
     detail::add_in_order_by_bands(
         rows, pixel_row,
         [&](int row, const auto& f) {
             for (std::size_t i = row_first[std::size_t(row)]; i < row_first[std::size_t(row) + 1];
                  ++i)
-                f(mesh.triangles[i]);
+                f(triangles[i]);
         },
         [&](const std::array<std::int32_t, 3>& t, auto&& take) {
             const double third = triangle_area(mesh, t) / 3.0;

@@ -50,7 +50,7 @@ struct IncidentTriangles {
 // The triangles incident to each vertex looked at; progress 0 to 0.5.
 IncidentTriangles incident_triangles(const TriangleMesh& mesh, const ProgressFn& progress,
                                      const std::function<bool(std::size_t)>& may_pinch) {
-    const std::size_t n = mesh.positions.size();
+    const std::size_t n = mesh.positions().size();
     const detail::PassProgress counted(progress, 0, 0.1, "mesh");
     IncidentTriangles out;
     out.every_vertex = !may_pinch;
@@ -72,12 +72,12 @@ IncidentTriangles incident_triangles(const TriangleMesh& mesh, const ProgressFn&
     // large grid) gathered by slices of triangles on every thread, in triangle order within
     // each, then counted and listed slice by slice; else (every vertex: a mesh file) counted
     // and listed in two passes over the triangles.
-    const std::size_t nt = mesh.triangles.size();
+    const std::size_t nt = mesh.triangles().size();
     std::vector<std::vector<std::pair<std::int32_t, std::int32_t>>> corners;
     if (may_pinch)
         corners = gather_by_slices<std::pair<std::int32_t, std::int32_t>>(
             nt, [&](std::size_t t, auto& list) {
-                for (auto v : mesh.triangles[t])
+                for (auto v : mesh.triangles()[t])
                     if (const std::int32_t k = out.rank(v); k >= 0)
                         list.emplace_back(k, std::int32_t(t));
             });
@@ -89,7 +89,7 @@ IncidentTriangles incident_triangles(const TriangleMesh& mesh, const ProgressFn&
             for (const auto& c : list) ++offsets[std::size_t(c.first) + 1];
     } else {
         for (std::size_t t = 0; t < nt; ++t)
-            for (auto v : mesh.triangles[t]) ++offsets[std::size_t(v) + 1];
+            for (auto v : mesh.triangles()[t]) ++offsets[std::size_t(v) + 1];
     }
     for (std::size_t r = 0; r < out.looked_at; ++r) offsets[r + 1] += offsets[r];
     detail::assign_in_slices(out.incident, offsets.back(), 0,
@@ -102,7 +102,8 @@ IncidentTriangles incident_triangles(const TriangleMesh& mesh, const ProgressFn&
         }
     } else {
         for (std::size_t t = 0; t < nt; ++t)
-            for (auto v : mesh.triangles[t]) out.incident[fill[std::size_t(v)]++] = std::int32_t(t);
+            for (auto v : mesh.triangles()[t])
+                out.incident[fill[std::size_t(v)]++] = std::int32_t(t);
     }
     return out;
 }
@@ -120,7 +121,7 @@ void join_fans(const TriangleMesh& mesh, std::int32_t v, const std::int32_t* aro
         std::array<std::int32_t, 2 * kPairwise> oc{};
         for (std::int32_t i = 0; i < k; ++i) {
             int j = 0;
-            for (auto w : mesh.triangles[around[i]])
+            for (auto w : mesh.triangles()[around[i]])
                 if (w != v && j < 2) oc[2 * i + j++] = w;
         }
         for (std::int32_t i = 0; i < k; ++i)
@@ -131,7 +132,7 @@ void join_fans(const TriangleMesh& mesh, std::int32_t v, const std::int32_t* aro
     } else {
         others.clear();  // (other vertex, local index)
         for (std::int32_t i = 0; i < k; ++i)
-            for (auto w : mesh.triangles[around[i]])
+            for (auto w : mesh.triangles()[around[i]])
                 if (w != v) others.emplace_back(w, i);
         std::sort(others.begin(), others.end());
         for (std::size_t i = 1; i < others.size(); ++i)
@@ -148,10 +149,10 @@ void join_fans(const TriangleMesh& mesh, std::int32_t v, const std::int32_t* aro
 std::size_t split_pinched_vertices(TriangleMesh& mesh, std::int32_t* first_pinched,
                                    const ProgressFn& progress,
                                    const std::function<bool(std::size_t)>& may_pinch) {
-    const std::size_t n = mesh.positions.size();
+    const std::size_t n = mesh.positions().size();
     // Its passes: the incident triangles (counted, made, listed: 0 to 0.5), the fans (to 1).
     const detail::PassProgress each_vertex(progress, 0.5, 1, "mesh");
-    check_adjacency_size(3 * std::uint64_t{mesh.triangles.size()}, "triangle corners");
+    check_adjacency_size(3 * std::uint64_t{mesh.triangles().size()}, "triangle corners");
     const IncidentTriangles around = incident_triangles(mesh, progress, may_pinch);
     report_progress(progress, 0.5, "mesh");
     std::size_t split = 0;
@@ -181,12 +182,12 @@ std::size_t split_pinched_vertices(TriangleMesh& mesh, std::int32_t* first_pinch
         if (split++ == 0 && first_pinched) *first_pinched = std::int32_t(v);
         for (std::int32_t root = 0; root < k; ++root) {
             if (size[root] == 0 || root == keep) continue;
-            const auto copy = std::int32_t(mesh.positions.size());
-            mesh.positions.push_back(mesh.positions[v]);
+            const auto copy = std::int32_t(mesh.positions().size());
+            mesh.edit_positions().push_back(mesh.edit_positions()[v]);
             if (!mesh.vertex_pixel.empty()) mesh.vertex_pixel.push_back(mesh.vertex_pixel[v]);
             for (std::int32_t i = 0; i < k; ++i)
                 if (fans_of.find(i) == root)
-                    for (auto& w : mesh.triangles[triangles[i]])
+                    for (auto& w : mesh.edit_triangles()[triangles[i]])
                         if (w == std::int32_t(v)) w = copy;
         }
     }
@@ -197,7 +198,7 @@ std::size_t remove_unreferenced_vertices(TriangleMesh& mesh, const ProgressFn& p
     // Its passes: the corners (0 to 0.4), the vertices (to 0.6), the corners again (to 1).
     const detail::PassProgress kept(progress, 0.4, 0.6, "mesh"),
         renumbered(progress, 0.6, 1, "mesh");
-    const std::size_t nt = mesh.triangles.size(), nv = mesh.positions.size();
+    const std::size_t nt = mesh.triangles().size(), nv = mesh.positions().size();
     // The corners marked in a bitmap on every thread (an OR, the same in any order), then
     // counted: a whole grid has no vertex to remove, and is left as it is. A vertex's new
     // number is the count of marked vertices before it: the marks before its word (counted
@@ -208,7 +209,7 @@ std::size_t remove_unreferenced_vertices(TriangleMesh& mesh, const ProgressFn& p
     detail::parallel_slices(nt, std::size_t{4096}, progress, 0, 0.4, "mesh",
                             [&](const tbb::blocked_range<std::size_t>& r) {
                                 for (std::size_t i = r.begin(); i < r.end(); ++i)
-                                    for (auto v : mesh.triangles[i])
+                                    for (auto v : mesh.triangles()[i])
                                         std::atomic_ref<std::uint64_t>(words[std::size_t(v) / 64])
                                             .fetch_or(std::uint64_t{1} << (std::size_t(v) % 64),
                                                       std::memory_order_relaxed);
@@ -228,15 +229,15 @@ std::size_t remove_unreferenced_vertices(TriangleMesh& mesh, const ProgressFn& p
     for (std::size_t v = 0; v < nv; ++v) {
         kept.at(v, nv);
         if (!marked(v)) continue;
-        mesh.positions[next] = mesh.positions[v];
+        mesh.edit_positions()[next] = mesh.edit_positions()[v];
         if (pixels) mesh.vertex_pixel[next] = mesh.vertex_pixel[v];
         ++next;
     }
-    mesh.positions.resize(next);
+    mesh.edit_positions().resize(next);
     if (pixels) mesh.vertex_pixel.resize(next);
     for (std::size_t i = 0; i < nt; ++i) {
         renumbered.at(i, nt);
-        for (auto& v : mesh.triangles[i]) v = remap(v);
+        for (auto& v : mesh.edit_triangles()[i]) v = remap(v);
     }
     // (A pole vertex in no triangle is removed too: it names none then.)
     for (auto& pv : mesh.pole_vertices)

@@ -5,9 +5,9 @@
 #include <cstddef>
 #include <vector>
 
-#include "parked_arrays.hpp"
 #include "terrain/core/dem.hpp"
 #include "terrain/core/progress.hpp"
+#include "terrain/internal/core/parked_arrays.hpp"
 #include "terrain/internal/core/pass_progress.hpp"
 #include "terrain/internal/core/release.hpp"
 
@@ -18,20 +18,13 @@ namespace terrain::pipeline::internal {
 // of them): 4 bytes a pixel less. They are doubles again, the same numbers, where they are
 // read (the placing of the positions, the region graph's points); a DEM with a value no float
 // holds keeps its doubles. Packed again later, the values are not checked again.
+// Packing an array already packed does nothing.
 class PackedHeights {
   public:
     void pack(Dem& dem, const ProgressFn& progress) {
         const std::size_t n = dem.values.size();
-        const detail::PassProgress checked(progress, 0, 0.4, "mesh"),
-            packed(progress, 0.4, 1, "mesh");
-        if (!exact_) {
-            for (std::size_t i = 0; i < n; ++i) {
-                checked.at(i, n);
-                const double v = dem.values[i];
-                if (!std::isnan(v) && static_cast<double>(static_cast<float>(v)) != v) return;
-            }
-            exact_ = true;
-        }
+        if (packed_ || !exact(dem, scaled_progress(progress, 0, 0.4))) return;
+        const detail::PassProgress packed(progress, 0.4, 1, "mesh");
         values_.reserve(n);
         for (std::size_t i = 0; i < n; ++i) {
             packed.at(i, n);
@@ -40,15 +33,34 @@ class PackedHeights {
         detail::release(dem.values);
         packed_ = true;
     }
+    bool packed() const { return packed_; }
+    // Whether every value is a float (checked once).
+    bool exact(const Dem& dem, const ProgressFn& progress = {}) {
+        if (checked_) return exact_;
+        const std::size_t n = dem.values.size();
+        const detail::PassProgress checked(progress, 0, 1, "mesh");
+        checked_ = true;
+        for (std::size_t i = 0; i < n; ++i) {
+            checked.at(i, n);
+            const double v = dem.values[i];
+            if (!std::isnan(v) && static_cast<double>(static_cast<float>(v)) != v) return false;
+        }
+        return exact_ = true;
+    }
+    // The bytes of the values once packed (when they can be).
+    std::size_t packed_bytes(const Dem& dem) {
+        if (packed_) return values_.size() * sizeof(float);
+        return dem.values.size() * (exact(dem) ? sizeof(float) : sizeof(double));
+    }
     // The bytes of the DEM's values as held now.
     std::size_t bytes(const Dem& dem) const {
         return packed_ ? values_.size() * sizeof(float) : dem.values.size() * sizeof(double);
     }
     // The floats parked (parked_arrays.hpp) and read back.
-    bool park(internal::ParkedArrays& parked, const ProgressFn& progress) {
+    bool park(detail::ParkedArrays& parked, const ProgressFn& progress) {
         return packed_ && parked.park(values_, progress, 0, 1);
     }
-    void restore(internal::ParkedArrays& parked, const ProgressFn& progress) {
+    void restore(detail::ParkedArrays& parked, const ProgressFn& progress) {
         if (packed_) parked.restore(values_, progress, 0, 1);
     }
     void unpack(Dem& dem, const ProgressFn& progress) {
@@ -67,7 +79,7 @@ class PackedHeights {
   private:
     std::vector<float> values_;
     bool packed_ = false;
-    bool exact_ = false;  // every value is a float
+    bool checked_ = false, exact_ = false;  // every value is a float
 };
 
 }  // namespace terrain::pipeline::internal

@@ -65,8 +65,7 @@ void release_large_data(SegmentResult& result) {
     // (`v = {}` would keep a vector's capacity: it is the initializer-list assignment.)
     auto drop = [](auto& v) { std::decay_t<decltype(v)>().swap(v); };
     auto& m = result.input.mesh;
-    drop(m.positions);
-    drop(m.triangles);
+    m.drop_geometry();
     drop(m.vertex_areas);
     m.release_adjacency();
     drop(m.pixel_vertex);

@@ -37,24 +37,26 @@ ReebGraph build_reeb_graph(const TriangleMesh& mesh, const std::vector<float>& f
     if (mesh.vertex_count() >= static_cast<std::size_t>(INT32_MAX / 4))
         throw Error("reeb", "the mesh is too large (more than 500 million vertices)");
     ReebGraph g;
+    Residency& memory = options.memory ? *options.memory : all_resident();
+    memory.enter(Stage::reeb_events);
     if (options.algorithm == ReebAlgorithm::sweep) {
+        memory.enter(Stage::reeb_loops);
         internal::contour_sweep(mesh, field, g, progress, false);
         return g;
     }
     internal::order_events(mesh, field, g, scaled_progress(progress, 0, 0.2));
-    const bool given_away = options.known_tree && options.field_read;
-    if (given_away) options.field_read();  // (the contour tree does not read the field)
-    if (internal::contour_tree(mesh, g, progress, options.sweeps)) {
+    if (internal::contour_tree(mesh, g, progress, memory)) {
         report_progress(progress, 1.0, "reeb");
         return g;
     }
-    if (given_away)
+    if (options.known_tree)
         throw Error("reeb", "the mesh was said to be a tree (known_tree) but has handles or holes");
     if (options.algorithm == ReebAlgorithm::contour_tree)
         throw Error("reeb",
                     "the contour-tree algorithm needs a mesh whose components are disks "
                     "or spheres; this one has handles or holes");
     // Handles or holes: the sweep, on the same events.
+    memory.enter(Stage::reeb_loops);
     const ProgressFn rest = [&](double f, std::string_view message) {
         return progress ? progress(0.3 + 0.7 * f, message) : true;
     };

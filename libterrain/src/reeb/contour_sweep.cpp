@@ -87,7 +87,7 @@ class Sweep {
 
     bool processed(i32 v, i32 e) const { return g_.vertex_nodes[idx(v)] <= e; }
     bool in_event(i32 t, i32 e) const {
-        const auto& tri = mesh_.triangles[idx(t)];
+        const auto& tri = mesh_.triangles()[idx(t)];
         return g_.vertex_nodes[idx(tri[0])] == e || g_.vertex_nodes[idx(tri[1])] == e ||
                g_.vertex_nodes[idx(tri[2])] == e;
     }
@@ -183,7 +183,7 @@ bool Sweep::try_regular(i32 e, i32 v) {
     bool first = true;
     for (;;) {
         const i32 t = h / 3;
-        const i32 a = mesh_.triangles[idx(t)][idx((h + 1) % 3)];
+        const i32 a = mesh_.triangles()[idx(t)][idx((h + 1) % 3)];
         const bool lower = g_.vertex_nodes[idx(a)] < e;
         if (first) {
             first_lower = lower;
@@ -198,7 +198,7 @@ bool Sweep::try_regular(i32 e, i32 v) {
         const i32 in = prev_he(h);
         const i32 tw = half_edges_.twin[idx(in)];
         if (tw == kNone) {  // boundary: the last link vertex is the far corner of this triangle
-            const i32 b = mesh_.triangles[idx(t)][idx((h + 2) % 3)];
+            const i32 b = mesh_.triangles()[idx(t)][idx((h + 2) % 3)];
             const bool bl = g_.vertex_nodes[idx(b)] < e;
             if (bl != last_lower) {
                 ++changes;
@@ -222,7 +222,7 @@ bool Sweep::try_regular(i32 e, i32 v) {
     h = h0;
     for (;;) {
         const i32 t = h / 3;
-        const auto& tri = mesh_.triangles[idx(t)];
+        const auto& tri = mesh_.triangles()[idx(t)];
         if (g_.vertex_nodes[idx(tri[0])] > e || g_.vertex_nodes[idx(tri[1])] > e ||
             g_.vertex_nodes[idx(tri[2])] > e)
             tri_label_[idx(t)] = c;
@@ -245,7 +245,7 @@ i32 Sweep::end_at(i32 s_he) const {
 int Sweep::step(i32 i, i32 e) {
     End& en = ends_[idx(i)];
     const i32 t = en.cur / 3;
-    const auto& tri = mesh_.triangles[idx(t)];
+    const auto& tri = mesh_.triangles()[idx(t)];
     walks_[idx(en.walk)].push_back(t);
     i32 out = kNone;
     for (i32 k = 1; k <= 2; ++k) {
@@ -308,7 +308,7 @@ void Sweep::event_star(i32 e, i32 begin, i32 end) {
             const i32 t = h / 3;
             // Keep the triangle only from its lowest-numbered corner in the event.
             i32 owner = v;
-            for (const i32 c : mesh_.triangles[idx(t)])
+            for (const i32 c : mesh_.triangles()[idx(t)])
                 if (g_.vertex_nodes[idx(c)] == e) owner = std::min(owner, c);
             if (owner == v) star_.push_back(t);
             const i32 tw = half_edges_.twin[idx(prev_he(h))];
@@ -325,7 +325,7 @@ void Sweep::incoming_contours(i32 e) {
     d_in_.clear();
     label_counts_.clear();
     for (const i32 t : star_) {
-        const auto& tri = mesh_.triangles[idx(t)];
+        const auto& tri = mesh_.triangles()[idx(t)];
         bool has_lower = false;
         for (const i32 c : tri) has_lower |= g_.vertex_nodes[idx(c)] < e;
         if (!has_lower) continue;
@@ -358,7 +358,7 @@ void Sweep::event_segments(i32 e) {
     seg_bnd_.assign(ns, 0);
     auto in_segment = [&](std::size_t i) { return segments_.contains(static_cast<i32>(i)); };
     for (std::size_t i = 0; i < ns; ++i) {
-        const auto& tri = mesh_.triangles[idx(star_[i])];
+        const auto& tri = mesh_.triangles()[idx(star_[i])];
         if (g_.vertex_nodes[idx(tri[0])] > e || g_.vertex_nodes[idx(tri[1])] > e ||
             g_.vertex_nodes[idx(tri[2])] > e)
             segments_.make_set(static_cast<i32>(i));
@@ -369,7 +369,7 @@ void Sweep::event_segments(i32 e) {
     for (std::size_t i = 0; i < ns; ++i) {
         if (!in_segment(i)) continue;
         const i32 t = star_[i];
-        const auto& tri = mesh_.triangles[idx(t)];
+        const auto& tri = mesh_.triangles()[idx(t)];
         for (i32 j = 0; j < 3; ++j) {
             if (processed(tri[idx(j)], e) == processed(tri[idx((j + 1) % 3)], e)) continue;
             const i32 h = 3 * t + j;

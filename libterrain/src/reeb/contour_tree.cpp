@@ -510,7 +510,8 @@ void arcs_from_edges(ReebGraph& g, std::vector<i32>& below, std::vector<i32>& up
 }  // namespace
 
 bool contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& progress,
-                  const ArrayParking& parking) {
+                  Residency& memory) {
+    memory.enter(Stage::reeb_links);
     const std::size_t nn = g.node_count();
     g.node_lower_links.assign(nn, 1);
     g.node_upper_links.assign(nn, 1);
@@ -518,27 +519,21 @@ bool contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& prog
     std::vector<LinkReps> reps = link_components(mesh, g, g.node_lower_links, g.node_upper_links,
                                                  general, scaled_progress(progress, 0.2, 0.3));
     NodesAround around = nodes_around(mesh, g, reps);
-    const bool park_floats = parking.park_floats && parking.restore_floats,
-               park_own = parking.park_own && parking.restore_own;
-    if (parking.on()) {
-        parking.park(g.node_vertices);
-        parking.park(g.node_vertex_offsets);
-        parking.park(g.vertex_nodes);
-        if (park_floats) parking.park_floats(g.node_values);
-        if (park_own) parking.park_own();
-    }
+    memory.stash(g.node_vertices);
+    memory.stash(g.node_vertex_offsets);
+    memory.stash(g.vertex_nodes);
+    memory.stash(g.node_values);
+    memory.enter(Stage::reeb_sweeps);
 
     JoinSplitTrees trees = join_and_split_trees(reps, around, progress);
     detail::release(reps);  // (16 bytes a node: what the arcs below are made beside)
     detail::release(around.nodes);
     detail::release(around.offsets);
-    if (parking.on()) {
-        if (park_own) parking.restore_own();
-        if (park_floats) parking.restore_floats(g.node_values);
-        parking.restore(g.vertex_nodes);
-        parking.restore(g.node_vertex_offsets);
-        parking.restore(g.node_vertices);
-    }
+    memory.enter(Stage::reeb_arcs);
+    memory.take_back(g.node_values);
+    memory.take_back(g.vertex_nodes);
+    memory.take_back(g.node_vertex_offsets);
+    memory.take_back(g.node_vertices);
     const auto components = std::count(trees.join_parent.begin(), trees.join_parent.end(), kNone);
     if (components == 1 ? !one_component_loop_free(mesh) : !loop_free_by_components(mesh))
         return false;

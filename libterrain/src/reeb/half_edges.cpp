@@ -30,7 +30,7 @@ HalfEdges build_half_edges(const TriangleMesh& mesh) {
     std::vector<i32> at_slot(first.back(), kNone);
     he.twin.assign(n_he, kNone);
     for (std::size_t h = 0; h < n_he; ++h) {
-        const auto& tri = mesh.triangles[h / 3];
+        const auto& tri = mesh.triangles()[h / 3];
         const i32 a = tri[h % 3], b = tri[(h + 1) % 3];
         const i32 s = slot(a, b);
         if (s == kNone) throw Error("reeb", "the mesh adjacency does not match its triangles");
@@ -42,7 +42,7 @@ HalfEdges build_half_edges(const TriangleMesh& mesh) {
     }
     he.vertex_out.assign(mesh.vertex_count(), kNone);
     for (std::size_t h = 0; h < n_he; ++h) {
-        const auto& tri = mesh.triangles[h / 3];
+        const auto& tri = mesh.triangles()[h / 3];
         const i32 a = tri[h % 3], b = tri[(h + 1) % 3];
         const i32 t = at_slot[idx(slot(b, a))];
         he.twin[h] = t;
@@ -52,7 +52,7 @@ HalfEdges build_half_edges(const TriangleMesh& mesh) {
     // A boundary vertex must start at its boundary half-edge: prefer it over interior ones.
     for (std::size_t h = 0; h < n_he; ++h)
         if (he.twin[h] == kNone)
-            he.vertex_out[idx(mesh.triangles[h / 3][h % 3])] = static_cast<i32>(h);
+            he.vertex_out[idx(mesh.triangles()[h / 3][h % 3])] = static_cast<i32>(h);
     return he;
 }
 

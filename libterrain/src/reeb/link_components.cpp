@@ -24,7 +24,7 @@ std::pair<int, int> LinkCounter::count(const TriangleMesh& mesh, const ReebGraph
                                        const std::vector<i32>& star) {
     return count_star(
         g, e,
-        star.size(), [&](std::size_t i) -> const auto& { return mesh.triangles[idx(star[i])]; });
+        star.size(), [&](std::size_t i) -> const auto& { return mesh.triangles()[idx(star[i])]; });
 }
 
 std::pair<int, int> LinkCounter::count(const ReebGraph& g, i32 e,

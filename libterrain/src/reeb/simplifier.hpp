@@ -27,13 +27,13 @@ class Simplifier : WorkingGraph {
   public:
     // The copy into the working graph reports through `progress` as 0 to 1 of the whole
     // simplification's first quarter (run() reports the rest).
-    // `owned`, `areas_read`, `parking`, `wave`: see WorkingGraph.
+    // `owned`, `memory`, `wave`: see WorkingGraph.
     Simplifier(const TriangleMesh& mesh, const ReebGraph& g, const SimplifyOptions& options,
                i32 big_degree = kBigDegree, const ProgressFn& progress = {},
-               ReebGraph* owned = nullptr, const std::function<void()>& areas_read = {},
-               const VertexNodesParking& parking = {}, std::size_t wave = kCopyWave)
-        : WorkingGraph(mesh, g, big_degree, scaled_progress(progress, 0, kSeedStart), owned,
-                       areas_read, parking, wave),
+               ReebGraph* owned = nullptr, Residency* memory = nullptr,
+               std::size_t wave = kCopyWave)
+        : WorkingGraph(mesh, g, big_degree, scaled_progress(progress, 0, kSeedStart), owned, memory,
+                       wave),
           options_(options) {
         queue_.init(arcs_.size());
         waiting_.assign(arcs_.size(), false);

@@ -164,8 +164,7 @@ SimplifyResult simplify(const TriangleMesh& mesh, const ReebGraph& graph,
 }
 
 SimplifyResult simplify(const TriangleMesh& mesh, ReebGraph&& graph, const SimplifyOptions& options,
-                        const ProgressFn& progress, const std::function<void()>& areas_read,
-                        const VertexNodesParking& vertex_nodes) {
+                        const ProgressFn& progress, Residency& memory) {
     check_simplify_options(options);
     if (graph.vertex_nodes.size() != mesh.vertex_count())
         throw Error("simplify", "the graph was not built on this mesh");
@@ -174,7 +173,7 @@ SimplifyResult simplify(const TriangleMesh& mesh, ReebGraph&& graph, const Simpl
     // the peak of the simplification's memory); the output reads only the vertex lists and
     // links, and frees them too.
     internal::Simplifier simplifier(mesh, graph, options, internal::kBigDegree, progress, &graph,
-                                    areas_read, vertex_nodes);
+                                    &memory);
     simplifier.own_input(graph);
     simplifier.run(progress, result);  // (which leaves the graph empty)
     return result;

@@ -294,6 +294,7 @@ void WorkingGraph::write_vertices(SimplifyResult& result, bool rewrite_field,
 void WorkingGraph::write_result(SimplifyResult& result, bool rewrite_field,
                                 const ProgressFn& progress) {
     const std::size_t nn = input_nodes_, nl = regular_.size();
+    if (memory_) memory_->enter(Stage::simplify_output);
     // Its passes: the fates (0 to 0.2), the arcs (to 0.3), the new numbers (to 0.4), the
     // input's vertex lists made again (to 0.5), the vertices and their values (to 1).
     std::vector<i32> code = final_codes(progress);
@@ -309,8 +310,8 @@ void WorkingGraph::write_result(SimplifyResult& result, bool rewrite_field,
         }
     }
     detail::release(regular_);
-    if (map_parked_.on()) {
-        map_parked_.restore(node_map_);
+    if (memory_) {
+        memory_->take_back(node_map_);
         if (node_map_.size() != nn)
             throw Error("simplify", "the new numbers came back with the wrong size");
     }
@@ -327,8 +328,8 @@ void WorkingGraph::write_result(SimplifyResult& result, bool rewrite_field,
     detail::release(remains.live_offsets);
     detail::release(remains.live_nodes);
     const std::size_t nv = input_vertices_;
-    if (parked_.restore) {
-        parked_.restore(owned_->vertex_nodes);
+    if (memory_ && lists_from_vertex_nodes_) {
+        memory_->take_back(owned_->vertex_nodes);
         if (owned_->vertex_nodes.size() != nv)
             throw Error("simplify", "the vertices' nodes came back with the wrong size");
     }

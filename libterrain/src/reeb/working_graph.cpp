@@ -318,8 +318,7 @@ bool WorkingGraph::copy_nodes(const TriangleMesh& mesh, const ReebGraph& g,
     return sorted;
 }
 
-void WorkingGraph::release_copied_nodes(ReebGraph& owned, bool sorted,
-                                        const VertexNodesParking& parking) {
+void WorkingGraph::release_copied_nodes(ReebGraph& owned, bool sorted) {
     detail::release(owned.node_values);
     detail::release(owned.node_kinds);
     // The vertex lists or the vertices' nodes, whichever write_result will not read.
@@ -332,10 +331,7 @@ void WorkingGraph::release_copied_nodes(ReebGraph& owned, bool sorted,
         detail::release(owned.vertex_nodes);
     }
     // Read again only by write_result: they may wait elsewhere through the peak.
-    if (lists_from_vertex_nodes_ && parking.on()) {
-        parked_ = parking;
-        parked_.park(owned.vertex_nodes);
-    }
+    if (lists_from_vertex_nodes_ && memory_) memory_->stash(owned.vertex_nodes);
 }
 
 void WorkingGraph::copy_arcs(const ReebGraph& g, const detail::RankedBits& critical_nodes,
@@ -415,9 +411,8 @@ void WorkingGraph::copy_arcs(const ReebGraph& g, const detail::RankedBits& criti
 }
 
 WorkingGraph::WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big_degree,
-                           const ProgressFn& progress, ReebGraph* owned,
-                           const std::function<void()>& areas_read,
-                           const VertexNodesParking& parking, std::size_t wave)
+                           const ProgressFn& progress, ReebGraph* owned, Residency* memory,
+                           std::size_t wave)
     : g_(g),
       input_nodes_(g.node_count()),
       input_vertices_(g.vertex_nodes.size()),
@@ -427,6 +422,8 @@ WorkingGraph::WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big
     using detail::PassProgress;
     const std::size_t nn = g.node_count(), na = g.arc_count();
     owned_ = owned;
+    memory_ = owned ? memory : nullptr;
+    if (memory) memory->enter(Stage::simplify_nodes);
     if (owned) detail::release(owned->node_arcs);  // not read here
     number_listed_nodes(g, progress);
     // The critical nodes (arc ends, and critical nodes in lists) as a bit each: a critical
@@ -439,14 +436,12 @@ WorkingGraph::WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big
     critical_count_ = static_cast<i32>(critical_nodes.members());
     wave = std::max<std::size_t>(1, wave);
     const bool sorted = copy_nodes(mesh, g, critical_nodes, owned, wave, progress);
-    if (areas_read) areas_read();  // (before the arcs: their copy's end is the peak)
+    // The mesh's areas are read no more (before the arcs: their copy's end is the peak).
+    if (memory) memory->enter(Stage::simplify_arcs);
     // The new numbers are read again only by write_result, once the working graph is freed:
     // they may wait elsewhere through the arcs' copy (the peak) and the cancellations.
-    if (owned && parking.on()) {
-        map_parked_ = parking;
-        map_parked_.park(node_map_);
-    }
-    if (owned) release_copied_nodes(*owned, sorted, parking);  // the nodes are copied
+    if (memory_) memory_->stash(node_map_);
+    if (owned) release_copied_nodes(*owned, sorted);  // the nodes are copied
     copy_arcs(g, critical_nodes, owned, wave, progress);
     // The lists' sets, made once the input's arcs are freed (the copy's end is the peak of
     // the simplification's memory), with room for as many new sets again, reserved and not

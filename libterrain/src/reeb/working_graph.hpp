@@ -63,15 +63,15 @@ class WorkingGraph {
     // `owned` (g itself, handed over: simplify(ReebGraph&&)) the copy frees g's arrays as it
     // reads them for the last time (its values, kinds, vertex nodes and arcs), so that they
     // are not held beside the working graph at the peak of the simplification's memory; the
-    // vertex lists and links stay for write_result. `areas_read` is called once the nodes'
-    // areas are summed, before the arcs are copied: the mesh's areas are read no more.
-    // `parking` (simplify(ReebGraph&&)): owned's vertex nodes, when write_result makes the
-    // vertex lists again from them, are parked then too and restored in write_result.
+    // vertex lists and links stay for write_result. `memory` (simplify(ReebGraph&&)) enters
+    // Stage::simplify_nodes before the nodes' areas are summed and Stage::simplify_arcs after
+    // (the mesh's areas are read no more), and with `owned` stashes the new numbers of the
+    // nodes and owned's vertex nodes (when write_result makes the vertex lists again from
+    // them) until write_result, which enters Stage::simplify_output.
     // The copy goes `wave` nodes, then `wave` arcs, at a time (tests make it small).
     WorkingGraph(const TriangleMesh& mesh, const ReebGraph& g, i32 big_degree = kBigDegree,
                  const ProgressFn& progress = {}, ReebGraph* owned = nullptr,
-                 const std::function<void()>& areas_read = {},
-                 const VertexNodesParking& parking = {}, std::size_t wave = kCopyWave);
+                 Residency* memory = nullptr, std::size_t wave = kCopyWave);
 
     // The simplified graph and the rewritten field (simplify_output.cpp). The working graph is
     // freed as it goes: nothing else may be asked of it after.
@@ -366,7 +366,7 @@ class WorkingGraph {
     bool copy_nodes(const TriangleMesh& mesh, const ReebGraph& g,
                     const detail::RankedBits& critical_nodes, ReebGraph* owned, std::size_t wave,
                     const ProgressFn& progress);
-    void release_copied_nodes(ReebGraph& owned, bool sorted, const VertexNodesParking& parking);
+    void release_copied_nodes(ReebGraph& owned, bool sorted);
     void copy_arcs(const ReebGraph& g, const detail::RankedBits& critical_nodes, ReebGraph* owned,
                    std::size_t wave, const ProgressFn& progress);
 
@@ -464,8 +464,7 @@ class WorkingGraph {
     // vertex_nodes (4 bytes a vertex): write_result makes the same lists again from them, once
     // the working graph is freed.
     bool lists_from_vertex_nodes_ = false;
-    VertexNodesParking parked_;      // set when owned's vertex nodes are parked
-    VertexNodesParking map_parked_;  // set when node_map_ is parked (after the copy)
+    Residency* memory_ = nullptr;  // stashed: node_map_, owned's vertex nodes (after the copy)
     // Frees the records, runs, arcs, sets and big nodes (write_result, once the arcs are out).
     void release_working_graph();  // all but regular_ (the output reads it after)
     std::size_t moves_ = 0;        // link() calls

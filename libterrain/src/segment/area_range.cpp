@@ -90,7 +90,7 @@ Folded fold(reeb::ReebGraph&& graph, const std::vector<float>& vertex_areas) {
     out.node_vertex_offsets.resize(folded + 1);
     std::iota(out.node_vertex_offsets.begin(), out.node_vertex_offsets.end(), 0);
     f.mesh.vertex_areas.assign(sums.begin(), sums.end());
-    f.mesh.positions.assign(folded, {0.0f, 0.0f, 0.0f});
+    f.mesh.edit_positions().assign(folded, {0.0f, 0.0f, 0.0f});
     return f;
 }
 

@@ -118,8 +118,8 @@ std::vector<std::uint32_t> finer_to_here(const std::vector<std::uint32_t>& finer
 }
 
 double edge_length(const TriangleMesh& mesh, std::size_t a, std::size_t b) {
-    const auto& p = mesh.positions[a];
-    const auto& q = mesh.positions[b];
+    const auto& p = mesh.positions()[a];
+    const auto& q = mesh.positions()[b];
     return std::sqrt(double(p[0] - q[0]) * (p[0] - q[0]) + double(p[1] - q[1]) * (p[1] - q[1]) +
                      double(p[2] - q[2]) * (p[2] - q[2]));
 }
@@ -249,7 +249,7 @@ class Flooding {
     float reach(const Step& s) const { return s.cost + least_[idx(s.vertex) >> kBlockShift]; }
 
     void prefetch(const Step& s) const {
-        detail::prefetch_around(mesh_, idx(s.vertex), sites_, field_, mesh_.positions);
+        detail::prefetch_around(mesh_, idx(s.vertex), sites_, field_, mesh_.positions());
     }
 
   private:
@@ -474,38 +474,34 @@ DivideCounts divide_absorbed(const TriangleMesh& mesh, const reeb::ReebGraph& gr
                              const std::vector<float>& field,
                              const std::vector<std::uint8_t>& absorbed, Segmentation& segmentation,
                              const std::vector<std::uint32_t>* finer, const ProgressFn& progress,
-                             std::size_t parallel_batch, const DivideHooks& hooks) {
+                             std::size_t parallel_batch, Residency& memory) {
     const std::size_t n = mesh.vertex_count();
     if (finer && finer->size() != n)
         throw Error("segment", "divide_absorbed: the finer labels do not match the mesh");
     auto& labels = segmentation.labels;  // as grown until the end, then as divided
-    // (With a hook the field may come only from it: checked after it.)
-    const bool hooked = static_cast<bool>(hooks.seed_parts_kept);
+    // (The field may be away until Stage::flood: checked after it.)
     const auto disagree = [] {
         return Error("segment", "divide_absorbed: the field, flags, labels and mesh disagree");
     };
-    if ((!hooked && field.size() != n) || absorbed.size() != n || labels.size() != n ||
-        graph.vertex_nodes.size() != n)
+    if (absorbed.size() != n || labels.size() != n || graph.vertex_nodes.size() != n)
         throw disagree();
     DivideCounts counts;
     for (std::size_t v = 0; v < n; ++v) counts.absorbed += absorbed[v] != 0;
     if (counts.absorbed == 0) {
-        if (hooked) hooks.seed_parts_kept(progress);
-        if (hooks.flooded) hooks.flooded();
+        memory.enter(Stage::flood, progress);
+        memory.enter(Stage::relabel);
+        if (field.size() != n) throw disagree();
         report_progress(progress, 1, "divide");
         return counts;
     }
     std::vector<Site> sites = leave_regions(absorbed, labels, finer, progress);
     counts.detached = keep_seed_parts(mesh, graph, segmentation, sites);
     report_progress(progress, 0.2, "divide");
-    // The graph and the flags are read no more. With a hook, it takes 0.2 to 0.4 of the
+    // The graph and the flags are read no more: the flooding's stage takes 0.2 to 0.4 of the
     // progress and the steps after 0.4 to 1 (their fractions 0.2 to 1 mapped there).
-    ProgressFn later = progress;
-    if (hooked) {
-        hooks.seed_parts_kept(scaled_progress(progress, 0.2, 0.4));
-        if (field.size() != n) throw disagree();
-        later = scaled_progress(progress, 0.25, 1);
-    }
+    memory.enter(Stage::flood, scaled_progress(progress, 0.2, 0.4));
+    if (field.size() != n) throw disagree();
+    const ProgressFn later = scaled_progress(progress, 0.25, 1);
     // 3. Flooding from the regions' edges: the shortest paths in the metric where a step
     // into u for region r costs |field(u) - mean(r)| plus a constant per mean edge length.
     const float step = kStepShare * field_spread(field);
@@ -521,10 +517,8 @@ DivideCounts divide_absorbed(const TriangleMesh& mesh, const reeb::ReebGraph& gr
     const Flooding flooding(mesh, field, sites, mean, step, lengths);
     flood(mesh, flooding, sites, to_label, parallel_batch, later);
     report_progress(later, 1, "divide");
-    if (hooks.flooded) {
-        hooks.flooded();
-        if (labels.size() != n) throw disagree();
-    }
+    memory.enter(Stage::relabel);
+    if (labels.size() != n) throw disagree();
     for (std::size_t v = 0; v < n; ++v) {
         if (!is_final(sites[v]))
             throw Error("segment", "divide_absorbed: vertex " + std::to_string(v) +
@@ -542,9 +536,9 @@ DivideCounts divide_absorbed(const TriangleMesh& mesh, const reeb::ReebGraph& gr
                              const std::vector<float>& field,
                              const std::vector<std::uint8_t>& absorbed, Segmentation& segmentation,
                              const std::vector<std::uint32_t>* finer, const ProgressFn& progress,
-                             const DivideHooks& hooks) {
+                             Residency& memory) {
     return internal::divide_absorbed(mesh, graph, field, absorbed, segmentation, finer, progress,
-                                     internal::kParallelBatch, hooks);
+                                     internal::kParallelBatch, memory);
 }
 
 }  // namespace terrain::segment

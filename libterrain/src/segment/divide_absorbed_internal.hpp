@@ -17,6 +17,6 @@ DivideCounts divide_absorbed(const TriangleMesh& mesh, const reeb::ReebGraph& gr
                              const std::vector<float>& field,
                              const std::vector<std::uint8_t>& absorbed, Segmentation& segmentation,
                              const std::vector<std::uint32_t>* finer, const ProgressFn& progress,
-                             std::size_t parallel_batch, const DivideHooks& hooks = {});
+                             std::size_t parallel_batch, Residency& memory = all_resident());
 
 }  // namespace terrain::segment::internal

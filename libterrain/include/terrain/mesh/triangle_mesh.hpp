@@ -38,12 +38,40 @@ enum class MeshFrame { body, map, file };
 const char* to_string(MeshFrame frame);
 
 struct TriangleMesh {
-    // Position of vertex v in metres = origin + positions[v]; floats keep ~0.1 m on a
+    using Triangle = std::array<std::int32_t, 3>;
+    // Position of vertex v in metres = origin + positions()[v]; floats keep ~0.1 m on a
     // whole planet and sub-millimetre on a tile.
     std::array<double, 3> origin{0, 0, 0};
-    std::vector<std::array<float, 3>> positions;
-    // Counter-clockwise seen from outside the body (or from above, for a map frame).
-    std::vector<std::array<std::int32_t, 3>> triangles;
+    // The positions and the triangles (counter-clockwise seen from outside the body, or from
+    // above for a map frame). A DEM mesh may release them while no stage reads them (below):
+    // positions() and triangles() then throw terrain::Error, and the stages that run meanwhile
+    // walk the triangles in order through detail::for_each_triangle
+    // (terrain/internal/mesh/grid_triangles.hpp), which makes them again from the grid, or
+    // through for_each_triangle below. edit_positions() and edit_triangles() are for the code
+    // that makes a mesh; they throw the same.
+    const std::vector<std::array<float, 3>>& positions() const {
+        if (released_vertices_ > 0) [[unlikely]]
+            away("positions");
+        return positions_;
+    }
+    std::vector<std::array<float, 3>>& edit_positions() {
+        if (released_vertices_ > 0) [[unlikely]]
+            away("positions");
+        return positions_;
+    }
+    const std::vector<Triangle>& triangles() const {
+        if (released_triangles_ > 0) [[unlikely]]
+            away("triangles");
+        return triangles_;
+    }
+    std::vector<Triangle>& edit_triangles() {
+        if (released_triangles_ > 0) [[unlikely]]
+            away("triangles");
+        return triangles_;
+    }
+    // f(index, triangle) for each triangle in order, held or released (made again from the
+    // grid, no position read): the triangle source for code outside the library's layers.
+    void for_each_triangle(const std::function<void(std::size_t, const Triangle&)>& f) const;
     // One third of the incident triangles' areas, m^2 (their sum is the surface area).
     std::vector<float> vertex_areas;
     // The adjacency; read it through neighbors_of(v). Meshes from files: a CSR, the
@@ -100,7 +128,7 @@ struct TriangleMesh {
     std::array<std::int32_t, 2> pole_vertices{-1, -1};
 
     std::size_t vertex_count() const {
-        return positions_released() ? released_vertices_ : positions.size();
+        return positions_released() ? released_vertices_ : positions_.size();
     }
     // A DEM mesh may also free its positions (12 bytes a vertex) while the stages that do not
     // read them run (the Reeb graph and the simplification): mesh::restore_positions(dem, mesh)
@@ -112,7 +140,7 @@ struct TriangleMesh {
     // For mesh::restore_positions: the positions placed again (one a vertex).
     void set_restored_positions(std::vector<std::array<float, 3>>&& placed);
     std::size_t triangle_count() const {
-        return triangles_released() ? released_triangles_ : triangles.size();
+        return triangles_released() ? released_triangles_ : triangles_.size();
     }
     // A DEM mesh may free its triangles once no stage needs them at random (after the Reeb
     // graph): detail::for_each_triangle (src/mesh/grid_triangles.hpp) makes them again from the
@@ -125,7 +153,7 @@ struct TriangleMesh {
     // Whether release_triangles would free them (a DEM mesh that holds them).
     bool triangles_releasable() const;
     std::array<double, 3> position(std::size_t v) const {
-        const auto& p = positions[v];
+        const auto& p = positions()[v];
         return {origin[0] + p[0], origin[1] + p[1], origin[2] + p[2]};
     }
     bool grid_adjacency() const { return !neighbor_directions.empty(); }
@@ -158,10 +186,16 @@ struct TriangleMesh {
     std::size_t edge_count() const { return grid_adjacency() ? grid_edges : neighbors.size() / 2; }
     // Bytes held by the arrays above (capacity, not size).
     std::size_t memory_bytes() const;
+    // Frees the positions and the triangles for good, held or released (what is written after
+    // the growing reads neither).
+    void drop_geometry();
     // Frees the adjacency (both forms).
     void release_adjacency();
 
   private:
+    [[noreturn]] static void away(const char* what);
+    std::vector<std::array<float, 3>> positions_;
+    std::vector<Triangle> triangles_;
     VertexNeighbors irregular_neighbors_of(std::size_t v) const;
     bool in_uniform_range(std::size_t v) const {
         for (const auto& r : uniform_ranges)

@@ -194,14 +194,9 @@ struct SegmentResult {
 void compute_field(SegmentResult& result, const SegmentOptions& options,
                    const ProgressFn& progress = {});
 // The unsimplified Reeb graph of result.field (stage "reeb"); sets critical_before. A DEM
-// mesh's triangles are released after it (TriangleMesh::release_triangles). `known_tree`:
-// the caller has found the mesh a tree (reeb::reeb_is_tree); then, or when this finds it,
-// `field_read` is called once the graph reads result.field no more (reeb::ReebOptions), and
-// the caller may take the field away until this returns. `sweeps`: the graph's vertex lists
-// and vertices' nodes may be parked through the contour tree's sweeps (reeb::ReebOptions).
-reeb::ReebGraph compute_reeb(SegmentResult& result, const ProgressFn& progress = {},
-                             bool known_tree = false, const std::function<void()>& field_read = {},
-                             const reeb::ArrayParking& sweeps = {});
+// mesh's triangles are released before it when it is a tree (reeb::reeb_is_tree: the contour
+// tree makes the graph from the grid), else after it (TriangleMesh::release_triangles).
+reeb::ReebGraph compute_reeb(SegmentResult& result, const ProgressFn& progress = {});
 
 // One scale: the graph simplified with options.simplify and the regions grown on it.
 struct ScaleResult {

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "terrain/core/progress.hpp"
+#include "terrain/core/residency.hpp"
 #include "terrain/mesh/triangle_mesh.hpp"
 
 namespace terrain::reeb {
@@ -109,34 +110,15 @@ enum class ReebAlgorithm {
     contour_tree,  // join and split trees merged: only for disks and spheres (no loops)
 };
 
-// Arrays a caller may take away while a stage does not read them: `park(v)` may take v's
-// values away (to disk: pipeline::segment), `restore(v)` must put back the same values before
-// they are read again. Used only when both are given.
-struct ArrayParking {
-    std::function<void(std::vector<std::int32_t>&)> park, restore;
-    // The same for arrays of floats (the graph's node values), when both are given.
-    std::function<void(std::vector<float>&)> park_floats, restore_floats;
-    // The caller's own arrays that the stage does not read either (the mesh's pixel maps),
-    // when both are given: taken away with the stage's arrays and put back with them.
-    std::function<void()> park_own, restore_own;
-    bool on() const { return park && restore; }
-};
-
 struct ReebOptions {
     ReebAlgorithm algorithm = ReebAlgorithm::automatic;
-    // For a caller that would rather not hold the field while the graph is made: when the mesh
-    // is known to be a tree (`known_tree`: reeb_is_tree said so) and the contour tree makes the
-    // graph, `field_read` is called once the field will be read no more (the events ordered).
-    // The caller may then take the field's values away until build_reeb_graph returns. A mesh
-    // said to be a tree that has handles or holes is then an error.
+    // The caller has found the mesh a tree (reeb_is_tree): one with handles or holes is then
+    // an error.
     bool known_tree = false;
-    std::function<void()> field_read;
-    // The contour tree's join and split sweeps (side by side, the Reeb graph's peak of
-    // memory) read neither the graph's vertex lists and offsets, its vertices' nodes nor its
-    // node values (16 bytes a vertex): they are handed to `sweeps.park` (the values to
-    // `sweeps.park_floats`, and `sweeps.park_own` is called) before the sweeps, and back to
-    // the restoring functions after.
-    ArrayParking sweeps;
+    // Told the stages entered (Stage::reeb_events to reeb_loops) and given the graph's vertex
+    // lists, vertices' nodes and node values to stash through the contour tree's join and
+    // split sweeps (its peak of memory), which do not read them. Null: all stay in memory.
+    Residency* memory = nullptr;
 };
 
 // True when every connected component of the mesh is a disk or a sphere, so that the Reeb

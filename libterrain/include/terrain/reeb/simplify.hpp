@@ -65,23 +65,15 @@ SimplifyResult simplify(const TriangleMesh& mesh, const ReebGraph& graph,
 // made (less memory at the peak), and the rest (its nodes' values, vertex lists and links)
 // once the result is written: the graph is left empty, and what follows the simplification
 // (growing, dividing, the region graph) runs without it.
-// `areas_read`, when given, is called once, as soon as the mesh's vertex areas have been read
-// for the last time (once the working copy has summed its nodes' areas, before it copies the
-// arcs: the copy's end is the simplification's peak of memory): the caller may set them
-// aside, parked or freed, until this returns (pipeline::segment parks them).
-// `vertex_nodes`, when both its functions are given: the graph's vertices' nodes (4 bytes a
-// vertex), which the output reads to make the nodes' vertex lists again (when the graph's lists
-// were ascending, as build_reeb_graph makes them), wait unread from the working copy's nodes to
-// the output. `park` is called with them then (before the copy of the arcs, the peak) and may
-// take them away; `restore` is called with that vector before they are read again and must put
-// back the same values (pipeline::segment parks them on disk). The working copy's own new
-// numbers of the graph's nodes (4 bytes a node) wait the same way through the cancellations,
-// to the output, which reads them once the working copy is freed.
-using VertexNodesParking = ArrayParking;
+// `memory`: told the stages entered (Stage::simplify_nodes while the working copy sums the
+// nodes' areas, the last read of the mesh's vertex areas; Stage::simplify_arcs for the copy of
+// the arcs, the peak of its memory, and the cancellations; Stage::simplify_output), and given
+// to stash from the copy to the output, which reads them again: the graph's vertices' nodes (4
+// bytes a vertex, from which the output makes the nodes' vertex lists again when the graph's
+// lists were ascending, as build_reeb_graph makes them) and the working copy's new numbers of
+// the graph's nodes (4 bytes a node).
 SimplifyResult simplify(const TriangleMesh& mesh, ReebGraph&& graph, const SimplifyOptions& options,
-                        const ProgressFn& progress = {},
-                        const std::function<void()>& areas_read = {},
-                        const VertexNodesParking& vertex_nodes = {});
+                        const ProgressFn& progress = {}, Residency& memory = all_resident());
 
 // Persistence and area ratio (a fraction, not percent) of each arc of a graph on its mesh.
 struct ArcMetrics {

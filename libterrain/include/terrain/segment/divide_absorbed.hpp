@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "terrain/core/progress.hpp"
+#include "terrain/core/residency.hpp"
 #include "terrain/mesh/triangle_mesh.hpp"
 #include "terrain/reeb/reeb_graph.hpp"
 #include "terrain/segment/grow_regions.hpp"
@@ -23,21 +24,6 @@ struct DivideCounts {
     std::size_t absorbed = 0;    // vertices the simplification had absorbed
     std::size_t detached = 0;    // region vertices cut off from their seed once those left
     std::size_t relabelled = 0;  // of both, those that ended in another region than before
-};
-
-// What divide_absorbed calls between its steps, for a caller that holds large arrays
-// elsewhere while they are not read (pipeline::segment parks them on disk).
-struct DivideHooks {
-    // Called once, after step 2 (or before returning when no vertex was absorbed), with a
-    // slice of the progress: from then on the graph and the absorbed flags are read no more
-    // (the caller may free or consume them), and the field and the mesh's positions are read:
-    // they must be held when it returns (they need not be before; the field's size is
-    // checked after it).
-    std::function<void(const ProgressFn&)> seed_parts_kept;
-    // Called once, after the flooding (or right after seed_parts_kept when no vertex was
-    // absorbed): the labels as grown (segmentation.labels) are read no more between the two
-    // calls, and are read and rewritten after this one: they must be held when it returns.
-    std::function<void()> flooded;
 };
 
 // `segmentation` was grown on `graph` (the simplified graph); `field` is the field before the
@@ -53,10 +39,13 @@ struct DivideHooks {
 // flooding, the absorbed vertices of each finer region go to the region most of that finer
 // region's other vertices are in here (then the connectivity rule above applies), so that
 // regions nest in those of coarser scales where the graph allows it.
+// `memory` is told Stage::flood once the graph and the absorbed flags are read no more (the
+// caller may free them; the field and the mesh's positions are read from then on, the labels
+// as grown not until Stage::relabel, after the flooding).
 DivideCounts divide_absorbed(const TriangleMesh& mesh, const reeb::ReebGraph& graph,
                              const std::vector<float>& field,
                              const std::vector<std::uint8_t>& absorbed, Segmentation& segmentation,
                              const std::vector<std::uint32_t>* finer = nullptr,
-                             const ProgressFn& progress = {}, const DivideHooks& hooks = {});
+                             const ProgressFn& progress = {}, Residency& memory = all_resident());
 
 }  // namespace terrain::segment

@@ -149,7 +149,8 @@ void add_in_order_by_bands(int rows, const PixelRow& pixel_row, const EmitRow& e
 template <class F>
 void for_each_triangle(const TriangleMesh& mesh, F&& f) {
     if (!mesh.triangles_released()) {
-        for (std::size_t i = 0; i < mesh.triangles.size(); ++i) f(i, mesh.triangles[i]);
+        const auto& triangles = mesh.triangles();
+        for (std::size_t i = 0; i < triangles.size(); ++i) f(i, triangles[i]);
         return;
     }
     const std::size_t W = static_cast<std::size_t>(mesh.grid_width);

@@ -1,5 +1,5 @@
 // Arrays parked on disk while the Reeb graph and the simplification run
-// (libterrain/src/pipeline/parked_arrays.hpp): the same bytes back, nothing left behind, and a
+// (terrain/internal/core/parked_arrays.hpp): the same bytes back, nothing left behind, and a
 // file that cannot be written leaves them in memory.
 #include <fcntl.h>
 #include <signal.h>
@@ -13,11 +13,11 @@
 #include <numeric>
 #include <vector>
 
-#include "../../libterrain/src/pipeline/parked_arrays.hpp"
 #include "support/test_support.hpp"
+#include "terrain/internal/core/parked_arrays.hpp"
 
 namespace fs = std::filesystem;
-using terrain::pipeline::internal::ParkedArrays;
+using terrain::detail::ParkedArrays;
 
 namespace {
 

@@ -1,6 +1,6 @@
 // Arrays parked in an unlinked temporary file (parked_arrays.hpp).
 
-#include "parked_arrays.hpp"
+#include "terrain/internal/core/parked_arrays.hpp"
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -16,7 +16,7 @@
 
 #include "terrain/core/error.hpp"
 
-namespace terrain::pipeline::internal {
+namespace terrain::detail {
 
 namespace {
 
@@ -199,4 +199,4 @@ std::size_t ParkedArrays::parked_bytes() const {
     return bytes;
 }
 
-}  // namespace terrain::pipeline::internal
+}  // namespace terrain::detail

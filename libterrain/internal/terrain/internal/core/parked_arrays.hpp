@@ -30,7 +30,7 @@
 #include "terrain/core/progress.hpp"
 #include "terrain/internal/core/pass_progress.hpp"
 
-namespace terrain::pipeline::internal {
+namespace terrain::detail {
 
 class ParkedArrays {
   public:
@@ -116,4 +116,4 @@ class ParkedArrays {
     std::vector<Entry> entries_;  // by offset
 };
 
-}  // namespace terrain::pipeline::internal
+}  // namespace terrain::detail
