@@ -299,7 +299,16 @@ TEST_CASE("dem_to_mesh: a lon/lat grid has the same shape in the body and map fr
 
 namespace {
 
-// The positions freed and placed again from the DEM: the same floats, every vertex.
+// Whether two meshes hold the same position floats, byte for byte.
+bool same_positions(const TriangleMesh& a, const TriangleMesh& b) {
+    if (a.positions().size() != b.positions().size()) return false;
+    return std::memcmp(a.positions().data(), b.positions().data(),
+                       a.positions().size() * sizeof(a.positions()[0])) == 0;
+}
+
+// The positions freed and placed again from the DEM: the same floats, every vertex; and,
+// when every value of the DEM is a float, from its values as floats (the run's packed
+// heights) with the DEM's own values freed.
 void check_positions_placed_again(const TriangleMesh& mesh, const Dem& dem) {
     TriangleMesh copy = mesh;
     REQUIRE(copy.release_positions());
@@ -308,12 +317,29 @@ void check_positions_placed_again(const TriangleMesh& mesh, const Dem& dem) {
     CHECK(copy.vertex_count() == mesh.vertex_count());
     mesh::restore_positions(dem, copy);
     CHECK_FALSE(copy.positions_released());
-    REQUIRE(copy.positions().size() == mesh.positions().size());
-    std::size_t differ = 0;
-    for (std::size_t v = 0; v < mesh.vertex_count(); ++v)
-        differ += std::memcmp(copy.positions()[v].data(), mesh.positions()[v].data(),
-                              sizeof(mesh.positions()[v])) != 0;
-    CHECK(differ == 0);
+    CHECK(same_positions(copy, mesh));
+
+    std::vector<float> heights(dem.values.begin(), dem.values.end());
+    for (std::size_t i = 0; i < heights.size(); ++i)
+        if (!std::isnan(dem.values[i]) && double(heights[i]) != dem.values[i]) return;
+    TriangleMesh from_floats = mesh;
+    REQUIRE(from_floats.release_positions());
+    Dem without_values = dem;
+    without_values.values.clear();
+    heights.pop_back();
+    CHECK_THROWS_WITH(mesh::restore_positions(without_values, heights, from_floats),
+                      Catch::Contains("not one a pixel"));
+    heights.push_back(static_cast<float>(dem.values.back()));
+    mesh::restore_positions(without_values, heights, from_floats);
+    CHECK(same_positions(from_floats, mesh));
+}
+
+// The same for `given` with its values rounded to floats (as a DEM whose values the run packs
+// holds them), meshed with `options`.
+void check_positions_placed_again(const Dem& given, const mesh::DemToMeshOptions& options = {}) {
+    Dem dem = given;
+    for (double& v : dem.values) v = static_cast<float>(v);
+    check_positions_placed_again(mesh::dem_to_mesh(dem, options), dem);
 }
 
 // The grid's adjacency against the CSR finish_mesh makes from the same triangles: the same
@@ -638,16 +664,16 @@ TEST_CASE("dem_to_mesh: the same hill on a lon/lat grid and on a UTM grid has th
     mesh::DemToMeshOptions body;
     body.frame = MeshFrame::body;
     SECTION("lon/lat, tangent plane") {
-        check_positions_placed_again(mesh::dem_to_mesh(lonlat, tangent_plane), lonlat);
+        check_positions_placed_again(lonlat, tangent_plane);
     }
     SECTION("lon/lat, body") {
-        check_positions_placed_again(mesh::dem_to_mesh(lonlat, body), lonlat);
+        check_positions_placed_again(lonlat, body);
     }
     SECTION("UTM, map metres") {
-        check_positions_placed_again(mesh::dem_to_mesh(utm), utm);
+        check_positions_placed_again(utm);
     }
     SECTION("UTM, body") {
-        check_positions_placed_again(mesh::dem_to_mesh(utm, body), utm);
+        check_positions_placed_again(utm, body);
     }
     SECTION("another grid is refused") {
         TriangleMesh m = mesh::dem_to_mesh(utm);

@@ -105,8 +105,10 @@ std::vector<std::int32_t> number_vertices(const Dem& dem, std::array<bool, 2> po
 // numbers, for a mesh that freed them (TriangleMesh::release_positions).
 class VertexPlacer {
   public:
-    VertexPlacer(const Dem& dem, const GridGeoref& geo, MeshFrame frame)
-        : dem_(dem), frame_(frame), unit_(geo.linear_unit_m) {
+    // `heights`: the DEM's values, when not read from dem.values (restore_positions).
+    VertexPlacer(const Dem& dem, const GridGeoref& geo, MeshFrame frame,
+                 const float* heights = nullptr)
+        : dem_(dem), heights_(heights), frame_(frame), unit_(geo.linear_unit_m) {
         const bool geographic_crs = geo.kind == CrsKind::geographic;
         const bool need_lonlat = frame == MeshFrame::body || geographic_crs;
         if (need_lonlat && !geographic_crs) {
@@ -207,7 +209,7 @@ class VertexPlacer {
         double sum = 0;
         int n = 0;
         for (int col = 0; col < dem_.width; ++col)
-            if (dem_.valid(col, row)) sum += dem_.at(col, row), ++n;
+            if (const double v = value(col, row); !std::isnan(v)) sum += v, ++n;
         const double value = sum / n, lat = which == 0 ? 90.0 : -90.0;
         std::array<double, 3> out;
         if (dem_.elevation == ElevationKind::radius)
@@ -218,6 +220,15 @@ class VertexPlacer {
     }
 
   private:
+    // The DEM's value at a pixel (as Dem::at), and its height (as Dem::height_at).
+    double value(int col, int row) const {
+        const std::size_t i = dem_.index(col, row);
+        return heights_ ? static_cast<double>(heights_[i]) : dem_.values[i];
+    }
+    double height(int col, int row) const {
+        const double v = value(col, row);
+        return dem_.elevation == ElevationKind::radius ? v - dem_.body.semi_major_axis : v;
+    }
     bool on_body(double lon, double lat) const {
         return std::isfinite(lon) && std::isfinite(lat) && std::abs(lat) <= max_latitude_;
     }
@@ -246,8 +257,8 @@ class VertexPlacer {
                 failed[std::size_t(row)] = 1;
                 continue;
             }
-            const auto p = along_radius(dem_.values[dem_.index(col, row)], cl, sl,
-                                        cos_lon[std::size_t(col)], sin_lon[std::size_t(col)]);
+            const auto p = along_radius(value(col, row), cl, sl, cos_lon[std::size_t(col)],
+                                        sin_lon[std::size_t(col)]);
             if (!finite(p)) {
                 failed[std::size_t(row)] = 1;
                 continue;
@@ -257,24 +268,25 @@ class VertexPlacer {
     }
 
     std::array<double, 3> point(int col, int row, double lon, double lat) const {
-        const double value = dem_.values[dem_.index(col, row)];
+        const double v = value(col, row);
         std::array<double, 3> out;
         if (frame_ == MeshFrame::body) {
             if (dem_.elevation == ElevationKind::radius) {
-                out = along_radius(value, std::cos(lat * kDegree), std::sin(lat * kDegree),
+                out = along_radius(v, std::cos(lat * kDegree), std::sin(lat * kDegree),
                                    std::cos(lon * kDegree), std::sin(lon * kDegree));
             } else {
-                earth_->Forward(lat, lon, value, out[0], out[1], out[2]);
+                earth_->Forward(lat, lon, v, out[0], out[1], out[2]);
             }
         } else if (tangent_) {
-            tangent_->Forward(lat, lon, dem_.height_at(col, row), out[0], out[1], out[2]);
+            tangent_->Forward(lat, lon, height(col, row), out[0], out[1], out[2]);
         } else {
-            out = {lon * unit_, lat * unit_, dem_.height_at(col, row)};
+            out = {lon * unit_, lat * unit_, height(col, row)};
         }
         return out;
     }
 
     const Dem& dem_;
+    const float* heights_;
     MeshFrame frame_;
     double unit_;
     const LonLatMapping* lonlat_ = nullptr;  // null: map coordinates are lon/lat already
@@ -419,11 +431,14 @@ TriangleMesh dem_to_mesh(const Dem& dem, const DemToMeshOptions& options,
     return mesh;
 }
 
-void restore_positions(const Dem& dem, TriangleMesh& mesh, const ProgressFn& progress) {
+namespace {
+
+void place_again(const Dem& dem, const float* heights, TriangleMesh& mesh,
+                 const ProgressFn& progress) {
     if (!mesh.positions_released()) return;
     if (dem.width != mesh.grid_width || dem.height != mesh.grid_height)
         throw Error("mesh", "the positions are placed again from the DEM the mesh was made of");
-    const VertexPlacer placer(dem, georef_of(dem), mesh.frame);
+    const VertexPlacer placer(dem, georef_of(dem), mesh.frame, heights);
     const std::size_t n = mesh.vertex_count();
     // The same points as dem_to_mesh's, less the same origin, as floats.
     std::vector<std::array<float, 3>> positions;
@@ -447,6 +462,19 @@ void restore_positions(const Dem& dem, TriangleMesh& mesh, const ProgressFn& pro
     }
     mesh.set_restored_positions(std::move(positions));
     report_progress(progress, 1.0, "mesh");
+}
+
+}  // namespace
+
+void restore_positions(const Dem& dem, TriangleMesh& mesh, const ProgressFn& progress) {
+    place_again(dem, nullptr, mesh, progress);
+}
+
+void restore_positions(const Dem& dem, const std::vector<float>& heights, TriangleMesh& mesh,
+                       const ProgressFn& progress) {
+    if (heights.size() != std::size_t(dem.width) * std::size_t(dem.height))
+        throw Error("mesh", "the heights to place the positions from are not one a pixel");
+    place_again(dem, heights.data(), mesh, progress);
 }
 
 void fill_pixel_to_vertex(const TriangleMesh& mesh, const Dem& dem,

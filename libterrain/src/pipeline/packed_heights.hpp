@@ -34,6 +34,8 @@ class PackedHeights {
         packed_ = true;
     }
     bool packed() const { return packed_; }
+    // The values as floats, while packed (and not parked).
+    const std::vector<float>& values() const { return values_; }
     // Whether every value is a float (checked once).
     bool exact(const Dem& dem, const ProgressFn& progress = {}) {
         if (checked_) return exact_;

@@ -244,15 +244,20 @@ void bind_arrays(ResidencyPlan& plan, SegmentResult& result, PackedHeights& pack
         };
         values.bytes = [&dem, &packed] { return packed.packed_bytes(dem); };
         plan.bind(Held::dem, std::move(values));
-        // Placed again from the DEM: the same floats (docs/mesh.md).
+        // Placed again from the DEM: the same floats (docs/mesh.md). From its values packed as
+        // floats, read back for the while and parked again, when they are (not 8 bytes a
+        // pixel of doubles beside the positions made); else from the DEM brought back.
         ResidencyPlan::Holder positions;
         positions.hold = [&mesh](detail::ParkedArrays&, const ProgressFn&) {
             return mesh.release_positions();
         };
-        positions.back = [&dem, &mesh](detail::ParkedArrays&, const ProgressFn& p) {
-            mesh::restore_positions(dem, mesh, p);
+        positions.back = [&dem, &mesh, &packed](detail::ParkedArrays& store, const ProgressFn& p) {
+            if (!packed.packed()) return mesh::restore_positions(dem, mesh, p);
+            packed.restore(store, scaled_progress(p, 0, 0.2));
+            mesh::restore_positions(dem, packed.values(), mesh, scaled_progress(p, 0.2, 0.8));
+            packed.park(store, scaled_progress(p, 0.8, 1));
         };
-        positions.needs = Held::dem;
+        if (!packed.exact(dem)) positions.needs = Held::dem;
         plan.bind(Held::positions, std::move(positions));
     }
     ResidencyPlan::Holder triangles;

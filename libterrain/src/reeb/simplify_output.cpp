@@ -77,35 +77,43 @@ WorkingGraph::Remains WorkingGraph::take_remains(const std::vector<i32>& code,
     const detail::PassProgress arcs(progress, 0.2, 0.3, "simplify");
     const auto code_of = [&](std::size_t i) { return i < nc ? code[i] : regular_[i - nc].forward; };
     Remains out;
-    std::vector<Remaining>& remaining = out.nodes;
     // (Counted first, the arrays made at their size: with a low area threshold half the
     // vertices remain, and growing them by doubling held the old array beside the new at
     // the simplification's peak of memory. The listed nodes are those that remain regular.)
-    std::size_t count = 0, critical = 0;
+    std::size_t count = 0, low = 0, critical = 0;
     for (std::size_t i = 0; i < nc + nl; ++i)
         if (code_of(i) == kNone) {
             ++count;
+            low += i < nc;
             critical += i < nc && (critical_[i].flags & kCritical);
         }
-    remaining.reserve(count);
+    out.nodes = detail::RankedBits(nc + nl);
+    out.values.reserve(count);
+    out.critical.reserve(low);
     out.live_nodes.reserve(count - critical);
     for (std::size_t i = 0; i < nc + nl; ++i) {
         if (code_of(i) != kNone) continue;
-        Remaining r;
-        r.index = static_cast<i32>(i);
-        r.value = value(r.index);
-        if (i < idx(critical_count_) && (critical_[i].flags & kCritical)) {
-            const i32 d = down(r.index), u = up(r.index);
+        out.nodes.set(i);
+        out.values.push_back(value(static_cast<i32>(i)));
+        if (i >= nc) continue;
+        RemainingCritical r;
+        if (critical_[i].flags & kCritical) {
+            const i32 d = down(static_cast<i32>(i)), u = up(static_cast<i32>(i));
             r.kind = d == 0 ? NodeKind::minimum : u == 0 ? NodeKind::maximum : NodeKind::saddle;
             r.changed = (critical_[i].flags & kModified) != 0;
             r.lower = static_cast<std::uint8_t>(std::min(d, 255));
             r.upper = static_cast<std::uint8_t>(std::min(u, 255));
         }
-        remaining.push_back(r);
+        out.critical.push_back(r);
     }
+    out.nodes.count();
     auto& live_ends = out.live_ends;  // the arcs that live, in order
     auto& live_offsets = out.live_offsets;
     auto& live_nodes = out.live_nodes;
+    const auto live = static_cast<std::size_t>(
+        std::count_if(arcs_.begin(), arcs_.end(), [](const Arc& arc) { return arc.set != kNone; }));
+    live_ends.reserve(live);
+    live_offsets.reserve(live + 1);
     live_offsets.assign(1, 0);
     for (std::size_t a = 0; a < arcs_.size(); ++a) {
         arcs.at(a, arcs_.size());
@@ -151,7 +159,6 @@ std::vector<std::array<i32, 2>> WorkingGraph::renumber(std::vector<i32>& code,
 void WorkingGraph::write_nodes_and_arcs(ReebGraph& out, const std::vector<std::array<i32, 2>>& kept,
                                         const Remains& remains, const std::vector<i32>& code) {
     const std::size_t count = kept.size();
-    const std::vector<Remaining>& remaining = remains.nodes;
     const auto& live_ends = remains.live_ends;
     const auto& live_offsets = remains.live_offsets;
     const auto& live_nodes = remains.live_nodes;
@@ -162,14 +169,14 @@ void WorkingGraph::write_nodes_and_arcs(ReebGraph& out, const std::vector<std::a
     out.node_arcs.assign(count, kNone);
     for (std::size_t nid = 0; nid < count; ++nid) {
         const auto [n, i] = kept[nid];
-        const auto at =
-            std::lower_bound(remaining.begin(), remaining.end(), i,
-                             [](const Remaining& r, i32 index) { return r.index < index; });
-        out.node_values[nid] = at->value;
-        if (at->kind == NodeKind::regular) continue;
-        out.node_kinds[nid] = at->kind;
-        out.node_lower_links[nid] = at->changed ? at->lower : g_.node_lower_links[idx(n)];
-        out.node_upper_links[nid] = at->changed ? at->upper : g_.node_upper_links[idx(n)];
+        const std::size_t rank = remains.nodes.rank(idx(i));
+        out.node_values[nid] = remains.values[rank];
+        if (rank >= remains.critical.size()) continue;  // (a regular node's record)
+        const RemainingCritical& at = remains.critical[rank];
+        if (at.kind == NodeKind::regular) continue;
+        out.node_kinds[nid] = at.kind;
+        out.node_lower_links[nid] = at.changed ? at.lower : g_.node_lower_links[idx(n)];
+        out.node_upper_links[nid] = at.changed ? at.upper : g_.node_upper_links[idx(n)];
     }
     if (owned_) {  // a graph handed over: what is read no more goes
         detail::release(owned_->node_lower_links);
@@ -318,12 +325,14 @@ void WorkingGraph::write_result(SimplifyResult& result, bool rewrite_field,
     std::vector<std::uint8_t> gone;  // old nodes absorbed by another
     auto kept = renumber(code, gone, progress);
     const std::size_t count = kept.size();
-    if (count != remains.nodes.size())
+    if (count != remains.values.size())
         throw Error("simplify", "internal: the remaining nodes are not one an old node");
     write_nodes_and_arcs(result.graph, kept, remains, code);
     detail::release(code);
     detail::release(kept);
-    detail::release(remains.nodes);
+    remains.nodes = detail::RankedBits();
+    detail::release(remains.values);
+    detail::release(remains.critical);
     detail::release(remains.live_ends);
     detail::release(remains.live_offsets);
     detail::release(remains.live_nodes);

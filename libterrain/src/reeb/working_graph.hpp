@@ -30,11 +30,8 @@
 #include "terrain/core/error.hpp"
 #include "terrain/core/progress.hpp"
 #include "terrain/internal/core/indices.hpp"
+#include "terrain/internal/core/ranked_bits.hpp"
 #include "terrain/reeb/simplify.hpp"
-
-namespace terrain::detail {
-class RankedBits;
-}  // namespace terrain::detail
 
 namespace terrain::reeb::internal {
 
@@ -315,21 +312,24 @@ class WorkingGraph {
     // A run with room for kInline << shift arcs: a freed one, or a new one at the arena's end.
     i32 take_run(std::uint8_t shift);
 
-    // What the output reads of the working graph, taken out: the nodes that remain (by their
-    // index here, in order) and the arcs that live, with their lists (a few thousand nodes on
-    // a grid simplified at a single scale; with the landform defaults' low area threshold,
-    // half the vertices). The working graph then goes, before the new numbers come back
-    // (parked through the cancellations) and the arrays of every node and vertex are made:
-    // the peak of the simplification's memory.
-    struct Remaining {
-        i32 index = kNone;  // here
-        float value = 0;
+    // What the output reads of the working graph, taken out: the nodes that remain (a bit by
+    // their index here, with their values by rank) and the arcs that live, with their lists (a
+    // few thousand nodes on a grid simplified at a single scale; with the landform defaults'
+    // low area threshold, half the vertices). The working graph then goes, before the new
+    // numbers come back (parked through the cancellations) and the arrays of every node and
+    // vertex are made. Taking them out is the peak of the simplification's memory, beside the
+    // whole working graph: a remaining node costs its value (4 bytes) and, among the first
+    // critical_count_ indices only, its kind and links (4 bytes).
+    struct RemainingCritical {
         NodeKind kind = NodeKind::regular;
         std::uint8_t lower = 1, upper = 1;  // link counts, for a critical node changed
         bool changed = false;
     };
+    static_assert(sizeof(RemainingCritical) == 4);
     struct Remains {
-        std::vector<Remaining> nodes;
+        detail::RankedBits nodes;                   // the indices here that remain
+        std::vector<float> values;                  // their values, by rank
+        std::vector<RemainingCritical> critical;    // those below critical_count_, by rank
         std::vector<std::array<i32, 2>> live_ends;  // the arcs that live, in order
         std::vector<i32> live_offsets, live_nodes;
     };

@@ -36,6 +36,11 @@ TriangleMesh dem_to_mesh(const Dem& dem, const DemToMeshOptions& options = {},
 // (TriangleMesh::release_positions): the same floats, from the same computation. Nothing to
 // do when the mesh holds them. Throws terrain::Error (stage "mesh") for another grid.
 void restore_positions(const Dem& dem, TriangleMesh& mesh, const ProgressFn& progress = {});
+// The same, with the DEM's values read from `heights` (row-major, one a pixel; `dem`'s own
+// values are not read and may be freed): the DEM's values held as floats, every one exactly
+// (pipeline::segment's packed heights), give the same positions as the doubles.
+void restore_positions(const Dem& dem, const std::vector<float>& heights, TriangleMesh& mesh,
+                       const ProgressFn& progress = {});
 
 // For each pixel (row-major), the vertex made from it, or -1 (NoData, isolated). The pixels
 // of a collapsed pole row all map to the pole vertex; a split pinch maps to its first copy.
