@@ -19,8 +19,9 @@ bool loop_free_by_components(const TriangleMesh& mesh, const ProgressFn& progres
 
 // The Reeb graph of the field whose events order_events put in g, when the mesh has no loops
 // (then it is the contour tree). Returns false, leaving the graph half made, when the mesh
-// has handles or holes. Enters Stage::reeb_links (which reads no field), Stage::reeb_sweeps, with g's vertex lists, offsets, vertices'
-// nodes and node values stashed (the sweeps do not read them), then Stage::reeb_arcs.
+// has handles or holes. Enters Stage::reeb_links (which reads no field), Stage::reeb_sweeps, with
+// g's vertex lists, offsets, vertices' nodes and node values stashed (the sweeps do not read them),
+// then Stage::reeb_arcs.
 bool contour_tree(const TriangleMesh& mesh, ReebGraph& g, const ProgressFn& progress,
                   Residency& memory = all_resident());
 
