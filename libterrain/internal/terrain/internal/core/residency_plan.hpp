@@ -79,8 +79,6 @@ class ResidencyPlan final : public Residency {
     void stash(std::vector<float>& v) override { park_stashed(v); }
     void take_back(std::vector<std::int32_t>& v) override { store_.restore(v, {}, 0, 0); }
     void take_back(std::vector<float>& v) override { store_.restore(v, {}, 0, 0); }
-    // Every bound array back in memory (after the last stage).
-    void finish(const ProgressFn& progress = {});
 
     bool resident(Held array) const { return bound_[index(array)].resident; }
     // The stage entered last (Stage::count before the first).
