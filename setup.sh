@@ -28,7 +28,7 @@ packages=(
   libgdal-dev gdal-bin libproj-dev
   libgeographiclib-dev
   libcgal-dev libgmp-dev libmpfr-dev
-  libopenimageio-dev
+  libfreetype-dev
   libboost-program-options-dev
   libeigen3-dev libtbb-dev
   catch2

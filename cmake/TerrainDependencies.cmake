@@ -18,11 +18,11 @@ terrain_require(CGAL libcgal-dev CONFIG)
 terrain_require(Boost libboost-program-options-dev 1.71 COMPONENTS program_options)
 terrain_require(Eigen3 libeigen3-dev 3.3 NO_MODULE)
 terrain_require(TBB libtbb-dev CONFIG)
+terrain_require(Freetype libfreetype-dev)
 find_package(Threads REQUIRED)
 
 include(TerrainFindLibraries)
-foreach(pair "terrain_geographiclib|GeographicLib|libgeographiclib-dev"
-             "terrain_openimageio|OpenImageIO|libopenimageio-dev")
+foreach(pair "terrain_geographiclib|GeographicLib|libgeographiclib-dev")
   string(REPLACE "|" ";" parts "${pair}")
   list(GET parts 0 target)
   list(GET parts 1 name)

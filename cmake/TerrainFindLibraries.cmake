@@ -1,7 +1,6 @@
 # Imported targets for libraries whose Debian CMake packages are missing or unusable:
-# GeographicLib ships only a find module, and OpenImageIO's package config names optional
-# tools and OpenCV paths that a plain libopenimageio-dev install does not have. Each target
-# is found from its header and library, which is all terrain needs.
+# GeographicLib ships only a find module. Each target is found from its header and library,
+# which is all terrain needs.
 
 function(terrain_import_library target header library_names)
   if(TARGET ${target})
@@ -19,9 +18,3 @@ function(terrain_import_library target header library_names)
 endfunction()
 
 terrain_import_library(terrain_geographiclib GeographicLib/Geocentric.hpp "GeographicLib;Geographic")
-terrain_import_library(terrain_openimageio_util OpenImageIO/imageio.h OpenImageIO_Util)
-terrain_import_library(terrain_openimageio OpenImageIO/imageio.h OpenImageIO)
-if(TARGET terrain_openimageio AND TARGET terrain_openimageio_util)
-  set_property(TARGET terrain_openimageio APPEND PROPERTY
-    INTERFACE_LINK_LIBRARIES terrain_openimageio_util)
-endif()

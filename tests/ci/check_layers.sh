@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Proves .ci/check-layers works: it passes on this tree, and fails, naming each file, on a
 # copy of the tree with violations planted in algorithm layers (a GDAL header, an io/ header,
-# an OpenImageIO header in a public header, a private geo/ header, a relative include of
+# a FreeType header in a public header, a private geo/ header, a relative include of
 # another folder's file in any layer), while GDAL and geo's shared headers in io/ and geo/
 # stay allowed.
 #   tests/ci/check_layers.sh SOURCE_DIR WORK_DIR
@@ -40,7 +40,7 @@ plant src/segment/regions.cpp '#include "../io/lonlat_frame.hpp"'
 plant src/field/vertex_field.cpp '#include "terrain/io/read_dem.hpp"'
 plant src/core/dem.cpp '  #  include <cpl_conv.h>'
 plant src/reeb/simplify.cpp '#include <proj.h>'
-plant include/terrain/segment/regions.hpp '#include <OpenImageIO/imageio.h>'
+plant include/terrain/segment/regions.hpp '#include <ft2build.h>'
 plant src/segment/pixel_areas.cpp '#include "../geo/ogr_support.hpp"'
 plant include/terrain/mesh/dem_to_mesh.hpp '#include "terrain/geo/georeference.hpp"'
 plant src/mesh/dem_to_mesh.cpp '#include "terrain/internal/geo/iau_crs.hpp"'

@@ -1,4 +1,4 @@
-#include <OpenImageIO/imageio.h>
+#include <gdal_priv.h>
 #include <catch2/catch.hpp>
 
 #include <cmath>
@@ -29,15 +29,17 @@ struct Png {
 };
 
 Png read_png(const std::string& path) {
-    auto in = OIIO::ImageInput::open(path);
+    GDALDatasetUniquePtr in(GDALDataset::Open(path.c_str(), GDAL_OF_RASTER));
     REQUIRE(in);
     Png png;
-    png.width = in->spec().width;
-    png.height = in->spec().height;
-    png.channels = in->spec().nchannels;
+    png.width = in->GetRasterXSize();
+    png.height = in->GetRasterYSize();
+    png.channels = in->GetRasterCount();
     png.pixels.resize(std::size_t(png.width) * png.height * png.channels);
-    REQUIRE(in->read_image(0, 0, 0, png.channels, OIIO::TypeDesc::UINT8, png.pixels.data()));
-    in->close();
+    // Pixel-interleaved, as the file stores them.
+    REQUIRE(in->RasterIO(GF_Read, 0, 0, png.width, png.height, png.pixels.data(), png.width,
+                         png.height, GDT_Byte, png.channels, nullptr, png.channels,
+                         GSpacing(png.width) * png.channels, 1, nullptr) == CE_None);
     return png;
 }
 

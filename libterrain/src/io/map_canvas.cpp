@@ -8,7 +8,7 @@
 #include <mutex>
 #include <utility>
 
-#include "image_module.hpp"
+#include "image_files.hpp"
 #include "terrain/core/error.hpp"
 #include "terrain/io/output_file.hpp"
 #include "terrain/io/write_preview.hpp"
@@ -148,12 +148,11 @@ void Canvas::image(const std::uint8_t* rgba, int w, int h, int x, int y) {
         }
 }
 
-// Debian 12's OpenImageIO (2.4.7) decodes UTF-8 wrongly in render_text: a character of two or
-// more bytes comes out as the code of its last byte's low six bits ("°" as "0"). The text is
-// therefore cut into ASCII runs, rendered by OpenImageIO, and the few other characters the
-// figures use, drawn as shapes: the degree sign (a ring), the middle dot (a disc), "²" (a small
-// raised 2); "×" is written "x", any other character "?". Spaces at the ends of a run are added as
-// DejaVu Sans's advance, 0.318 of the size, since the rendered mask ends at the last ink.
+// The text is cut into ASCII runs, rendered by FreeType (render_text_mask), and the few other
+// characters the figures use, drawn as shapes: the degree sign (a ring), the middle dot (a
+// disc), "²" (a small raised 2); "×" is written "x", any other character "?". Spaces at the
+// ends of a run are added as DejaVu Sans's advance, 0.318 of the size, since the rendered mask
+// ends at the last ink.
 struct Canvas::Run {
     enum Kind { ascii, degree, dot, space, squared } kind = ascii;
     TextMask mask;

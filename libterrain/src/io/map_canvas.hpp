@@ -1,8 +1,7 @@
 #pragma once
 // Private: an 8-bit RGBA canvas for the figures io writes (preview.png's map frame, sweep.png):
-// rectangles, lines, images and text. Text is drawn by FreeType through OpenImageIO
-// (image_module.hpp) in a font found at run time (map_font); without one the figure is drawn
-// without text. Not installed.
+// rectangles, lines, images and text. Text is drawn by FreeType (image_files.hpp) in a font
+// found at run time (map_font); without one the figure is drawn without text. Not installed.
 
 #include <array>
 #include <cstdint>

@@ -15,7 +15,7 @@
 #include <optional>
 #include <string>
 
-#include "image_module.hpp"
+#include "image_files.hpp"
 #include "terrain/core/error.hpp"
 #include "terrain/io/describe_dem.hpp"
 #include "terrain/io/output_file.hpp"

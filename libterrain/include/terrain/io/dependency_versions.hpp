@@ -7,7 +7,7 @@
 
 namespace terrain {
 
-// (library, version) pairs: GDAL, PROJ, CGAL, GeographicLib, OpenImageIO, Boost, Eigen, TBB.
+// (library, version) pairs: GDAL, PROJ, CGAL, GeographicLib, FreeType, Boost, Eigen, TBB.
 std::vector<std::pair<std::string, std::string>> dependency_versions();
 
 }  // namespace terrain

@@ -57,9 +57,8 @@ struct MapFrame {
 };
 
 // The preview in two steps: the map's pixels (8-bit RGBA, row-major) and its frame, then the
-// PNG, on which the frame is drawn around the map. Writing goes through OpenImageIO, loaded on
-// first use (its libraries take memory and time to load): a program low on memory renders
-// first, frees its large data, then writes.
+// PNG, on which the frame is drawn around the map. A program low on memory renders first,
+// frees its large data, then writes (the frame and the PNG's buffers come after).
 struct PreviewImage {
     int width = 0, height = 0;
     std::vector<std::uint8_t> rgba;

@@ -229,7 +229,7 @@ void release_large_data(SegmentResult& result);
 
 struct WriteOptions {
     // Frees the large data once the files that need it are written, before preview.png is
-    // encoded (OpenImageIO, loaded for it, then does not add to the peak memory).
+    // encoded (its frame and PNG buffers then do not add to the peak memory).
     bool release_memory = false;
 };
 
