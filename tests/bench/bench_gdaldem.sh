@@ -3,7 +3,8 @@
 # synthetic 1000 x 1000 Vesta tile, or the DEM given), run in turn (gdaldem, the defaults,
 # the paper's single scale, gdaldem, ...) so that the machine's drift falls on all three;
 # prints each round's wall times, the median ratio of each segment run to gdaldem's in its
-# round, and the median share of the write stage (run.json's timings).
+# round, and the median share of the write stage (run.json's timings); then the medians of
+# the two segment runs on a 64 x 64 synthetic tile: what a run costs whatever its size.
 #   tests/bench/bench_gdaldem.sh [build-dir] [rounds] [DEM]
 set -euo pipefail
 build="${1:-build}"
@@ -47,3 +48,15 @@ done
 median() { printf "%s\n" "$@" | sort -g | awk '{ v[NR] = $1 } END { print v[int((NR + 1) / 2)] }'; }
 echo "median ratio to gdaldem slope: defaults $(median "${default_ratios[@]}"), paper's single scale $(median "${paper_ratios[@]}")"
 echo "median share of the write stage: defaults $(median "${default_writes[@]}"), paper's single scale $(median "${paper_writes[@]}")"
+
+# A run's cost whatever the DEM's size: the same commands on a 64 x 64 synthetic tile.
+"$terrain" synth -q --width 64 --height 64 -o "$work/small.lbl" > /dev/null
+small_default=() small_paper=()
+for ((k = 1; k <= rounds; k++)); do
+  rm -rf "$work/out"
+  small_default+=("$(seconds "$terrain" segment -q "$work/small.lbl" -o "$work/out")")
+  rm -rf "$work/out"
+  small_paper+=("$(seconds "$terrain" segment -q "$work/small.lbl" -o "$work/out" \
+    --area-ratio 0.5 --persistence 10)")
+done
+echo "64 x 64 tile, median wall seconds: defaults $(median "${small_default[@]}"), paper's single scale $(median "${small_paper[@]}")"
