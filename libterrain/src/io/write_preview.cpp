@@ -360,6 +360,20 @@ PreviewImage render_preview(const Dem& dem, const std::vector<float>& field_pixe
                 std::lround(std::clamp(f[std::size_t(k)] * light, 0.0, 255.0)));
         return rgba;
     };
+    // An enlarged tile shows each source pixel enlarge^2 times: its colours are made once.
+    std::vector<std::array<std::uint8_t, 4>> colours;
+    if (enlarge > 1) {
+        colours.resize(dem.size());
+        tbb::parallel_for(tbb::blocked_range<int>(0, H, 8),
+                          [&](const tbb::blocked_range<int>& rows) {
+                              for (int r = rows.begin(); r < rows.end(); ++r)
+                                  for (int c = 0; c < W; ++c)
+                                      colours[dem.index(c, r)] = colour(c, r);
+                          });
+    }
+    const auto colour_at = [&](int c, int r) {
+        return colours.empty() ? colour(c, r) : colours[dem.index(c, r)];
+    };
     std::vector<std::uint8_t> image(static_cast<std::size_t>(OW) * OH * 4);
     auto label_at = [&](int x, int y) {
         return pixels[dem.index(src_col[std::size_t(x)], src_row[std::size_t(y)])];
@@ -368,7 +382,7 @@ PreviewImage render_preview(const Dem& dem, const std::vector<float>& field_pixe
         for (int y = rows.begin(); y < rows.end(); ++y)
             for (int x = 0; x < OW; ++x) {
                 const int c = src_col[std::size_t(x)], r = src_row[std::size_t(y)];
-                auto rgba = colour(c, r);
+                auto rgba = colour_at(c, r);
                 // Region boundaries: a labelled pixel whose right or lower neighbour (in the
                 // output) is in another region; 1 output pixel wide.
                 const auto l = pixels[dem.index(c, r)];
