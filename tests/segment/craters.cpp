@@ -204,6 +204,23 @@ TEST_CASE("Craters: a bowl a few pixels wide is listed", "[craters]") {
     }
 }
 
+TEST_CASE("Craters: a small bowl's whole rim reads as whole", "[craters]") {
+    // A rim of a few pixels' radius has fewer pixels than 36 directions: the directions are
+    // one a pixel of the floor's circle, so a complete rim still fills most of them.
+    for (const double R : {4.0, 5.0, 6.0}) {
+        const double cx = 30.3, cy = 29.6;
+        auto result = segment_dem(bowl_dem(60, cx, cy, R, 0.2 * R, 0.04 * R));
+        REQUIRE(result.craters);
+        const auto& table = result.craters->craters;
+        INFO("R = " << R << " px, " << table.size() << " craters");
+        const auto k = std::find_if(table.begin(), table.end(), [&](const auto& c) {
+            return std::hypot(c.col - cx, c.row - cy) < 0.5 * R;
+        });
+        REQUIRE(k != table.end());
+        CHECK(k->rim_fraction >= 0.8);
+    }
+}
+
 TEST_CASE("Craters: a floor round a central peak is one crater", "[craters]") {
     // A complex crater: the bowl with a peak at its centre; the floor is a ring round it,
     // inside the rim.

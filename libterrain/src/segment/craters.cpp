@@ -21,6 +21,7 @@ namespace {
 
 using V3 = std::array<double, 3>;
 constexpr int kSectors = 36;
+constexpr int kMinSectors = 12;
 // Two adjacent concave regions are also tried as one floor when the smaller has at least
 // this share of the larger's area.
 constexpr double kPairAreaRatio = 0.25;
@@ -114,7 +115,8 @@ struct Floor {
     V3 sum{};
     std::size_t count = 0;
     V3 centre{}, e1{}, e2{};
-    double radius = 0;  // of a disk of the floor's area
+    double radius = 0;       // of a disk of the floor's area
+    int sectors = kSectors;  // directions looked in: kSectors, fewer on a small floor
     double lowest = kInf;
     int first_col = -1;      // columns unwrapped around this one on a closed grid
     LeastSquares3 col, row;  // pixel column and row from the frame's x, y (affine)
@@ -230,6 +232,11 @@ void find_centres(const TriangleMesh& mesh, const Dem& dem,
         fl.e1 = unit(cross(axis, up));
         fl.e2 = cross(up, fl.e1);
         fl.h.fill(-kInf);
+        // A direction a pixel of the circle of the floor's radius: a small floor's rim has
+        // fewer pixels than kSectors directions, which would leave some empty whatever the rim.
+        const double pixel = std::sqrt(fl.area / c);
+        const double around = pixel > 0 ? 2 * std::numbers::pi * fl.radius / pixel : kSectors;
+        fl.sectors = std::clamp(int(around), kMinSectors, kSectors);
     }
 }
 
@@ -268,7 +275,7 @@ void find_crests(const TriangleMesh& mesh, const Dem& dem, const std::vector<std
             const double x = dot(d, fl.e1), y = dot(d, fl.e2), r = std::hypot(x, y);
             if (r < options.crest_from * fl.radius || r > options.crest_to * fl.radius) continue;
             const double turn = (std::atan2(y, x) + std::numbers::pi) / (2 * std::numbers::pi);
-            const auto s = std::size_t(std::min(kSectors - 1, int(turn * kSectors)));
+            const auto s = std::size_t(std::min(fl.sectors - 1, int(turn * fl.sectors)));
             if (h > fl.h[s]) {
                 fl.h[s] = h;
                 fl.x[s] = x;
@@ -306,7 +313,7 @@ std::vector<std::size_t> fit_rims(const CraterOptions& options, std::vector<Floo
         for (int s = 0; s < kSectors; ++s)
             if (fl.kept[std::size_t(s)]) crest += fl.h[std::size_t(s)];
         fl.crest = crest / c.points;
-        const double fraction = double(c.points) / kSectors;
+        const double fraction = double(c.points) / fl.sectors;
         if (fraction < options.min_rim_fraction || c.r < 0.8 * options.crest_from * fl.radius ||
             c.r > options.crest_to * fl.radius || !(fl.crest > fl.lowest))
             continue;
@@ -358,7 +365,7 @@ bool make_crater(const TriangleMesh& mesh, const Dem& dem, const RegionGraph& gr
     k.floor_region = fl.members[0];
     k.diameter_m = 2 * c.r;
     k.depth_m = fl.crest - fl.lowest;
-    k.rim_fraction = double(c.points) / kSectors;
+    k.rim_fraction = double(c.points) / fl.sectors;
     k.fit_rms_m = c.rms;
     k.field_scale_m = graph.regions[fl.members[0] - 1].field_scale_m;
     k.circularity = std::min(1.0, 4 * std::numbers::pi * fl.area / (fl.perimeter * fl.perimeter));

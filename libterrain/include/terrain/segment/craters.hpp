@@ -23,7 +23,7 @@ struct Crater {
     double depth_m = 0;        // mean rim crest height minus the floor's lowest height
     double rim_height_m = 0;   // mean rim crest height minus the mean height 1.5-2 R out
     double circularity = 0;    // of the floor region: 4 pi area / perimeter^2
-    double rim_fraction = 0;   // share of the 36 directions with a rim crest on the circle
+    double rim_fraction = 0;   // share of the directions with a rim crest on the circle
     double fit_rms_m = 0;      // the crest points' RMS distance to the circle
     double field_scale_m = 0;  // the floor region's field scale (0 without one)
     std::uint32_t floor_region = 0;
@@ -62,7 +62,7 @@ struct CraterOptions {
 
 // What a crater's confidence is made of (CraterOptions for the constants):
 struct CraterEvidence {
-    double rim_fraction = 0;  // share of the 36 directions with a crest point on the circle
+    double rim_fraction = 0;  // share of the directions with a crest point on the circle
     double fit_rms_m = 0;     // the crest points' RMS distance to the circle
     double radius_m = 0;      // the circle's
     double pixel_m = 0;       // the grid's spacing at the floor (square root of a vertex's area)
@@ -82,7 +82,8 @@ double crater_confidence(const CraterEvidence& evidence, const CraterOptions& op
 // concave region with convex neighbours, or two adjacent concave regions of comparable areas
 // rounder together than one of them (a floor the segmentation cut in two; the crater names
 // the larger as floor_region). For each floor: the highest vertex of its convex neighbours in each
-// of 36 directions from the floor's centroid (between crest_from and crest_to floor radii) is a rim
+// of 36 directions (fewer on a small floor: one a pixel of the circle of its radius, at least
+// 12) from the floor's centroid (between crest_from and crest_to floor radii) is a rim
 // crest point; a circle is fitted to them (twice, dropping points more than a quarter radius off);
 // kept when crest points are found in half the directions or more, the radius is between
 // 0.8 crest_from and crest_to floor radii, the floor within the circle (its RMS distance from
