@@ -87,9 +87,8 @@ build() {
 case "$mode" in
   run)
     install_packages "${packages[@]}"
-    # The main job needs the program alone (terrain_cli, which pulls in the library and the
-    # image module it loads); the tests, examples, benchmarks and Python module wait for
-    # `./setup.sh test`.
+    # The main job needs the program alone (terrain_cli, which pulls in the library); the
+    # tests, examples, benchmarks and Python module wait for `./setup.sh test`.
     build terrain_cli
     # The main job: the synthetic Vesta HAMO tile segmented with the defaults: landforms at
     # their own scale (the shape index at the radius chosen per pixel, regions down to 20
