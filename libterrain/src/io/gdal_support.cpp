@@ -3,6 +3,7 @@
 #include <gdal.h>
 
 #include <mutex>
+#include <string>
 
 #include "terrain/core/error.hpp"
 
@@ -43,6 +44,17 @@ void set_grid_georeference(GDALDataset& ds, const Dem& grid, bool with_transform
         if (srs.SetFromUserInput(geo::output_crs_wkt(grid.crs_wkt).c_str()) == OGRERR_NONE)
             ds.SetSpatialRef(&srs);
     }
+}
+
+bool add_band_in_place(GDALDataset& mem, GDALDataType type, const void* data,
+                       std::size_t pixel_offset, std::size_t line_offset) {
+    char pointer[64] = {};
+    CPLPrintPointer(pointer, const_cast<void*>(data), sizeof pointer);
+    CPLStringList options;
+    options.SetNameValue("DATAPOINTER", pointer);
+    options.SetNameValue("PIXELOFFSET", std::to_string(pixel_offset).c_str());
+    options.SetNameValue("LINEOFFSET", std::to_string(line_offset).c_str());
+    return mem.AddBand(type, options.List()) == CE_None;
 }
 
 void close_dataset(std::unique_ptr<GDALDataset>& ds, const std::string& path,

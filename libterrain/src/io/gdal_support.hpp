@@ -43,6 +43,12 @@ std::unique_ptr<GDALDataset> create_grid_tiff(const Dem& grid, bool with_transfo
                                               GDALDataType type, const char* const* options,
                                               const GdalErrorCapture& errors);
 
+// Adds to a MEM dataset a band of `type` over memory the caller keeps (no copy): its first
+// value at `data`, values `pixel_offset` bytes apart along a row, rows `line_offset` bytes
+// apart. Returns whether GDAL took it.
+bool add_band_in_place(GDALDataset& mem, GDALDataType type, const void* data,
+                       std::size_t pixel_offset, std::size_t line_offset);
+
 // Closes the dataset (writing what GDAL cached) and throws if that failed.
 void close_dataset(std::unique_ptr<GDALDataset>& ds, const std::string& path,
                    const GdalErrorCapture& errors);

@@ -102,24 +102,16 @@ void write_image(const std::string& path, const std::string& shown_path, int wid
     // The pixels as GDAL bands without a copy: band b starts at byte b, `channels` apart.
     std::unique_ptr<GDALDataset> mem(mem_driver->Create("", width, height, 0, GDT_Byte, nullptr));
     if (!mem) throw Error("write", "cannot write '" + shown_path + "'" + errors.suffix());
-    for (int b = 0; b < channels; ++b) {
-        char pointer[64] = {};
-        CPLPrintPointer(pointer, const_cast<std::uint8_t*>(pixels + b), sizeof pointer);
-        CPLStringList options;
-        options.SetNameValue("DATAPOINTER", pointer);
-        options.SetNameValue("PIXELOFFSET", std::to_string(channels).c_str());
-        options.SetNameValue("LINEOFFSET",
-                             std::to_string(static_cast<long long>(width) * channels).c_str());
-        if (mem->AddBand(GDT_Byte, options.List()) != CE_None)
+    for (int b = 0; b < channels; ++b)
+        if (!add_band_in_place(*mem, GDT_Byte, pixels + b, std::size_t(channels),
+                               std::size_t(width) * std::size_t(channels)))
             throw Error("write", "cannot write '" + shown_path + "'" + errors.suffix());
-    }
     CPLStringList options;
     if (png_compression >= 0)
         options.SetNameValue("ZLEVEL", std::to_string(std::clamp(png_compression, 1, 9)).c_str());
     std::unique_ptr<GDALDataset> png(
         png_driver->CreateCopy(path.c_str(), mem.get(), TRUE, options.List(), nullptr, nullptr));
     if (!png) throw Error("write", "writing '" + shown_path + "' failed" + errors.suffix());
-    png.reset();
 }
 
 TextMask render_text_mask(const std::string& font, int size, const std::string& text) {

@@ -150,14 +150,10 @@ std::unique_ptr<GDALDataset> labels_in_place(
     std::unique_ptr<GDALDataset> mem(GetGDALDriverManager()->GetDriverByName("MEM")->Create(
         "", dem.width, dem.height, 0, GDT_UInt32, nullptr));
     if (!mem) throw Error("write", "cannot create '" + path + "'" + errors.suffix());
-    for (const auto* values : bands) {
-        char pointer[64] = {};
-        CPLPrintPointer(pointer, const_cast<std::uint32_t*>(values->data()), sizeof pointer);
-        CPLStringList band_options;
-        band_options.SetNameValue("DATAPOINTER", pointer);
-        if (mem->AddBand(GDT_UInt32, band_options.List()) != CE_None)
+    for (const auto* values : bands)
+        if (!add_band_in_place(*mem, GDT_UInt32, values->data(), sizeof(std::uint32_t),
+                               sizeof(std::uint32_t) * std::size_t(dem.width)))
             throw Error("write", "cannot create '" + path + "'" + errors.suffix());
-    }
     set_grid_georeference(*mem, dem, true);
     return mem;
 }
