@@ -1,6 +1,7 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "support/test_meshes.hpp"
@@ -103,37 +104,66 @@ segment::CraterTable craters_of(const pipeline::SegmentResult& result,
     return segment::find_craters(result.input.mesh, *result.dem(), labels, graph);
 }
 
-}  // namespace
-
-TEST_CASE("Craters: a floor cut in two by the segmentation is one crater", "[craters]") {
-    const double cx = 80.3, cy = 79.6, R = 30, depth = 6, rim = 1.2;
-    auto result = segment_dem(bowl_dem(160, cx, cy, R, depth, rim));
+// The floor region of the most confident crater of a segmentation.
+std::uint32_t best_floor(const pipeline::SegmentResult& result) {
     REQUIRE(result.craters);
-    REQUIRE(!result.craters->craters.empty());
-    const auto floor =
-        std::max_element(result.craters->craters.begin(), result.craters->craters.end(),
-                         [](const auto& a, const auto& b) { return a.confidence < b.confidence; })
-            ->floor_region;
-    // The floor's east half becomes a region of its own.
-    auto labels = result.segmentation.labels;
-    const auto count = std::uint32_t(result.regions.regions.size()) + 1;
-    const auto width = std::size_t(result.dem()->width);
-    std::size_t east = 0;
-    for (std::size_t v = 0; v < labels.size(); ++v) {
-        const auto pixel = std::size_t(result.input.mesh.vertex_pixel[v]);
-        if (labels[v] == floor && double(pixel % width) + 0.5 > cx) {
-            labels[v] = count;
-            ++east;
-        }
-    }
-    REQUIRE(east > 100);
-    const auto table = craters_of(result, labels, count);
-    INFO(table.craters.size() << " craters");
-    const auto near = std::count_if(table.craters.begin(), table.craters.end(), [&](const auto& k) {
+    const auto& table = result.craters->craters;
+    REQUIRE(!table.empty());
+    return std::max_element(
+               table.begin(), table.end(),
+               [](const auto& a, const auto& b) { return a.confidence < b.confidence; })
+        ->floor_region;
+}
+
+// How many craters of `table` read the bowl of radius R at (cx, cy): the centre within R / 4,
+// the diameter within 10 %.
+std::ptrdiff_t count_near(const segment::CraterTable& table, double cx, double cy, double R) {
+    return std::count_if(table.craters.begin(), table.craters.end(), [&](const auto& k) {
         return std::hypot(k.col - cx, k.row - cy) < 0.25 * R &&
                k.diameter_m == Approx(2 * R).epsilon(0.1);
     });
-    CHECK(near == 1);
+}
+
+// The segmentation's labels with its most confident crater's floor cut at (cx, cy) into an
+// east and a west half (pieces 2) or four quarters (pieces 4), each piece but the north-west
+// one a new region after the segmentation's; `count` the regions then.
+std::vector<std::uint32_t> cut_floor(const pipeline::SegmentResult& result, double cx, double cy,
+                                     int pieces, std::uint32_t& count) {
+    const auto floor = best_floor(result);
+    auto labels = result.segmentation.labels;
+    const auto first = std::uint32_t(result.regions.regions.size()) + 1;
+    const auto width = std::size_t(result.dem()->width);
+    std::array<std::size_t, 3> moved{};
+    for (std::size_t v = 0; v < labels.size(); ++v) {
+        if (labels[v] != floor) continue;
+        const auto pixel = std::size_t(result.input.mesh.vertex_pixel[v]);
+        const bool east = double(pixel % width) + 0.5 > cx,
+                   south = pieces == 4 && double(pixel / width) + 0.5 > cy;
+        const int piece = (east ? 1 : 0) + (south ? 2 : 0);  // 0: the floor's own region
+        if (piece == 0) continue;
+        labels[v] = first + std::uint32_t(piece - 1);
+        ++moved[std::size_t(piece - 1)];
+    }
+    for (int k = 0; k + 1 < pieces; ++k) REQUIRE(moved[std::size_t(k)] > 100);
+    count = first + std::uint32_t(pieces - 2);
+    return labels;
+}
+
+}  // namespace
+
+TEST_CASE("Craters: a floor cut in pieces by the segmentation is one crater", "[craters]") {
+    // A floor cut in two halves, or in quarters round its centre (a large crater's small
+    // craters, terraces and peaks each an extremum: no quarter and no half is round, the four
+    // quarters are).
+    const double cx = 80.3, cy = 79.6, R = 30, depth = 6, rim = 1.2;
+    auto result = segment_dem(bowl_dem(160, cx, cy, R, depth, rim));
+    for (const int pieces : {2, 4}) {
+        std::uint32_t count = 0;
+        const auto labels = cut_floor(result, cx, cy, pieces, count);
+        const auto table = craters_of(result, labels, count);
+        INFO(pieces << " pieces, " << table.craters.size() << " craters");
+        CHECK(count_near(table, cx, cy, R) == 1);
+    }
 }
 
 TEST_CASE("Craters: two floors side by side stay two craters", "[craters]") {

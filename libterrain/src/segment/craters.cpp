@@ -14,6 +14,7 @@
 #include <limits>
 #include <numbers>
 
+#include "crater_floors.hpp"
 #include "terrain/core/error.hpp"
 
 namespace terrain::segment {
@@ -22,9 +23,6 @@ namespace {
 using V3 = std::array<double, 3>;
 constexpr int kSectors = 36;
 constexpr int kMinSectors = 12;
-// Two adjacent concave regions are also tried as one floor when the smaller has at least
-// this share of the larger's area.
-constexpr double kPairAreaRatio = 0.25;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
 V3 sub(const V3& a, const V3& b) {
@@ -110,7 +108,7 @@ bool fit_circle(const std::array<double, kSectors>& px, const std::array<double,
 
 // A possible floor and what the passes gather for it.
 struct Floor {
-    std::array<std::uint32_t, 2> members{};  // its regions: one, or two adjacent (0: none)
+    std::vector<std::uint32_t> members;  // its regions, the largest first
     double area = 0, perimeter = 0;
     V3 sum{};
     std::size_t count = 0;
@@ -135,61 +133,24 @@ struct Floors {
     std::vector<std::vector<std::int32_t>> rim;  // by convex region: the floors it borders
 };
 
-// The floors: each concave region with enough convex boundary, and each pair of adjacent
-// concave regions of comparable areas (a floor cut in two by the segmentation) that is
-// rounder than one of the two, with enough convex boundary around the two.
+// The possible floors (crater_floors.cpp) and the convex neighbours of each.
 Floors select_floors(const RegionGraph& graph, const CraterOptions& options) {
-    const auto& regions = graph.regions;
-    const std::size_t m = regions.size();
-    const auto mean = [&](std::uint32_t id) { return regions[id - 1].field_mean; };
-    const auto convex = [&](std::uint32_t id) { return mean(id) > options.convex_above; };
-    const auto concave = [&](std::uint32_t id) {
-        return mean(id) < options.concave_below && regions[id - 1].vertex_count >= 3;
-    };
-    // Perimeters and the length shared with convex neighbours.
-    std::vector<double> perimeter(m + 1, 0), rim(m + 1, 0);
-    for (const auto& e : graph.edges) {
-        perimeter[e.a] += e.boundary_length_m;
-        perimeter[e.b] += e.boundary_length_m;
-        if (convex(e.b)) rim[e.a] += e.boundary_length_m;
-        if (convex(e.a)) rim[e.b] += e.boundary_length_m;
-    }
     Floors out;
-    out.in.resize(m + 1);
-    out.rim.resize(m + 1);
-    const auto add = [&](std::uint32_t a, std::uint32_t b, double area, double length,
-                         double rim_length) {
-        if (!(length > 0) || rim_length < 0.5 * options.min_rim_fraction * length) return;
+    out.in.resize(graph.regions.size() + 1);
+    out.rim.resize(graph.regions.size() + 1);
+    for (auto& candidate : internal::floor_candidates(graph, options)) {
         const auto f = std::int32_t(out.floors.size());
+        for (const auto id : candidate.members) out.in[id].push_back(f);
         Floor fl;
-        fl.members = {a, b};
-        fl.area = area;
-        fl.perimeter = length;
-        fl.radius = std::sqrt(area / std::numbers::pi);
-        out.floors.push_back(fl);
-        out.in[a].push_back(f);
-        if (b != 0) out.in[b].push_back(f);
-    };
-    for (const auto& r : regions)
-        if (concave(r.id)) add(r.id, 0, r.area_m2, perimeter[r.id], rim[r.id]);
-    for (const auto& e : graph.edges) {
-        if (!concave(e.a) || !concave(e.b)) continue;
-        const double aa = regions[e.a - 1].area_m2, ab = regions[e.b - 1].area_m2;
-        if (std::min(aa, ab) < kPairAreaRatio * std::max(aa, ab)) continue;
-        // Two floors side by side are less round together than either alone; a floor cut in
-        // two is rounder whole than at least one of its pieces.
-        const double length = perimeter[e.a] + perimeter[e.b] - 2 * e.boundary_length_m;
-        const auto roundness = [](double area, double length_m) {
-            return length_m > 0 ? area / (length_m * length_m) : 0.0;
-        };
-        if (roundness(aa + ab, length) <=
-            std::min(roundness(aa, perimeter[e.a]), roundness(ab, perimeter[e.b])))
-            continue;
-        // The larger region first (the crater's floor_region).
-        const bool a_first = aa > ab || (aa == ab && e.a < e.b);
-        add(a_first ? e.a : e.b, a_first ? e.b : e.a, aa + ab, length, rim[e.a] + rim[e.b]);
+        fl.members = std::move(candidate.members);
+        fl.area = candidate.area_m2;
+        fl.perimeter = candidate.perimeter_m;
+        fl.radius = std::sqrt(fl.area / std::numbers::pi);
+        out.floors.push_back(std::move(fl));
     }
-    // The convex neighbours of each floor.
+    const auto convex = [&](std::uint32_t id) {
+        return graph.regions[id - 1].field_mean > options.convex_above;
+    };
     for (const auto& e : graph.edges)
         for (const auto& [inner, outer] : {std::pair{e.a, e.b}, std::pair{e.b, e.a}}) {
             if (!convex(outer)) continue;
@@ -370,12 +331,11 @@ bool make_crater(const TriangleMesh& mesh, const Dem& dem, const RegionGraph& gr
     k.field_scale_m = graph.regions[fl.members[0] - 1].field_scale_m;
     k.circularity = std::min(1.0, 4 * std::numbers::pi * fl.area / (fl.perimeter * fl.perimeter));
     double field = 0, area = 0;  // the floor's mean field, over its one or two regions
-    for (const auto id : fl.members)
-        if (id != 0) {
-            const auto& region = graph.regions[id - 1];
-            field += region.field_mean * region.area_m2;
-            area += region.area_m2;
-        }
+    for (const auto id : fl.members) {
+        const auto& region = graph.regions[id - 1];
+        field += region.field_mean * region.area_m2;
+        area += region.area_m2;
+    }
     CraterEvidence evidence;
     evidence.rim_fraction = k.rim_fraction;
     evidence.fit_rms_m = c.rms;
@@ -513,7 +473,8 @@ CraterTable find_craters(const TriangleMesh& mesh, const Dem& dem,
         floor_of.push_back(f);
     }
     const auto gone = duplicates(table, floors.floors, floor_of);
-    // The craters kept, by floor region (then by floor: a region alone before its pairs).
+    // The craters kept, by floor region (then by floor: a region alone before its pairs and
+    // groups).
     std::vector<std::size_t> order;
     for (std::size_t i = 0; i < table.craters.size(); ++i)
         if (!gone[i]) order.push_back(i);

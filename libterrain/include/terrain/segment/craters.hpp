@@ -79,9 +79,12 @@ double crater_confidence(const CraterEvidence& evidence, const CraterOptions& op
 
 // The craters of a DEM's segmentation: `labels` per mesh vertex (1..regions), `graph` its
 // region graph (segment::region_graph), `dem` the DEM the mesh was made from. A floor is a
-// concave region with convex neighbours, or two adjacent concave regions of comparable areas
-// rounder together than one of them (a floor the segmentation cut in two; the crater names
-// the larger as floor_region). For each floor: the highest vertex of its convex neighbours in each
+// concave region with convex neighbours, two adjacent concave regions of comparable areas
+// rounder together than one of them (a floor the segmentation cut in two), or a group of
+// three to twelve adjacent concave regions grown from its largest by the neighbour that
+// leaves the union roundest, the roundest union met when it is rounder than the largest
+// alone (a floor cut in several pieces); the crater names the largest as floor_region. For
+// each floor: the highest vertex of its convex neighbours in each
 // of 36 directions (fewer on a small floor: one a pixel of the circle of its radius, at least
 // 12) from the floor's centroid (between crest_from and crest_to floor radii) is a rim
 // crest point; a circle is fitted to them (twice, dropping points more than a quarter radius off);
