@@ -13,6 +13,12 @@ constexpr double kPairAreaRatio = 0.25;
 // The most regions a floor of several pieces is grown to.
 constexpr std::size_t kGroupMembers = 12;
 
+// How round a floor of this area and outer boundary is: area / perimeter^2 (1 / (4 pi) for a
+// disk), 0 without a boundary.
+double roundness(double area, double length) {
+    return length > 0 ? area / (length * length) : 0.0;
+}
+
 // Groups of three or more adjacent concave regions as one floor: a large crater's floor that
 // the segmentation cut into several pieces (its small craters, terraces and peaks each an
 // extremum of the field). From each concave region, as the largest of its group, the group
@@ -32,9 +38,6 @@ void add_groups(const RegionGraph& graph, const std::vector<double>& perimeter,
             next[e.b].push_back({e.a, e.boundary_length_m});
         }
     const auto area = [&](std::uint32_t id) { return regions[id - 1].area_m2; };
-    const auto roundness = [](double a, double length) {
-        return length > 0 ? a / (length * length) : 0.0;
-    };
     std::vector<double> shared(regions.size() + 1, 0);  // with the group, by region
     std::vector<std::uint32_t> touched;
     for (const auto& seed : regions) {
@@ -95,10 +98,10 @@ std::vector<FloorCandidate> floor_candidates(const RegionGraph& graph,
                                              const CraterOptions& options) {
     const auto& regions = graph.regions;
     const std::size_t m = regions.size();
-    const auto mean = [&](std::uint32_t id) { return regions[id - 1].field_mean; };
-    const auto convex = [&](std::uint32_t id) { return mean(id) > options.convex_above; };
+    const auto convex = [&](std::uint32_t id) { return convex_region(graph, id, options); };
     const auto concave = [&](std::uint32_t id) {
-        return mean(id) < options.concave_below && regions[id - 1].vertex_count >= 3;
+        return regions[id - 1].field_mean < options.concave_below &&
+               regions[id - 1].vertex_count >= 3;
     };
     // Perimeters and the length shared with convex neighbours.
     std::vector<double> perimeter(m + 1, 0), rim(m + 1, 0);
@@ -123,9 +126,6 @@ std::vector<FloorCandidate> floor_candidates(const RegionGraph& graph,
         // Two floors side by side are less round together than either alone; a floor cut in
         // two is rounder whole than at least one of its pieces.
         const double length = perimeter[e.a] + perimeter[e.b] - 2 * e.boundary_length_m;
-        const auto roundness = [](double area, double length_m) {
-            return length_m > 0 ? area / (length_m * length_m) : 0.0;
-        };
         if (roundness(aa + ab, length) <=
             std::min(roundness(aa, perimeter[e.a]), roundness(ab, perimeter[e.b])))
             continue;

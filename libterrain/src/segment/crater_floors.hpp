@@ -8,6 +8,13 @@
 
 namespace terrain::segment::internal {
 
+// Whether region `id` can rim a floor: its mean field (shape index x 100) above
+// options.convex_above.
+inline bool convex_region(const RegionGraph& graph, std::uint32_t id,
+                          const CraterOptions& options) {
+    return graph.regions[id - 1].field_mean > options.convex_above;
+}
+
 struct FloorCandidate {
     std::vector<std::uint32_t> members;  // its regions, the largest first
     double area_m2 = 0;

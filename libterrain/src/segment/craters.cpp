@@ -148,12 +148,9 @@ Floors select_floors(const RegionGraph& graph, const CraterOptions& options) {
         fl.radius = std::sqrt(fl.area / std::numbers::pi);
         out.floors.push_back(std::move(fl));
     }
-    const auto convex = [&](std::uint32_t id) {
-        return graph.regions[id - 1].field_mean > options.convex_above;
-    };
     for (const auto& e : graph.edges)
         for (const auto& [inner, outer] : {std::pair{e.a, e.b}, std::pair{e.b, e.a}}) {
-            if (!convex(outer)) continue;
+            if (!internal::convex_region(graph, outer, options)) continue;
             for (const auto f : out.in[inner]) {
                 auto& list = out.rim[outer];
                 if (std::find(list.begin(), list.end(), f) == list.end()) list.push_back(f);
@@ -330,7 +327,7 @@ bool make_crater(const TriangleMesh& mesh, const Dem& dem, const RegionGraph& gr
     k.fit_rms_m = c.rms;
     k.field_scale_m = graph.regions[fl.members[0] - 1].field_scale_m;
     k.circularity = std::min(1.0, 4 * std::numbers::pi * fl.area / (fl.perimeter * fl.perimeter));
-    double field = 0, area = 0;  // the floor's mean field, over its one or two regions
+    double field = 0, area = 0;  // the floor's mean field, over its regions
     for (const auto id : fl.members) {
         const auto& region = graph.regions[id - 1];
         field += region.field_mean * region.area_m2;
