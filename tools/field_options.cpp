@@ -25,7 +25,8 @@ void add_field_options(po::options_description& options, FieldOptionValues& valu
         "(DEMs; the default when no scale option is given)")(
         "radii", po::value(&values.radii),
         "with --radius auto: the ladder of radii in metres, R1,R2,... increasing (default: 2, "
-        "4, 8, 16, 32 and 64 pixels)")(
+        "4, 8, ..., 128 pixels, below half the grid's smaller side and half the body's "
+        "radius)")(
         "window", po::value(&values.window)->default_value("disk"),
         "shape index with --radius on a DEM: disk (the pixels within the radius on the ground; "
         "costs the same whatever the radius) or ball (the vertices within the radius in 3-D)")(

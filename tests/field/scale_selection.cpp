@@ -3,6 +3,7 @@
 #include <tbb/global_control.h>
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <functional>
@@ -12,6 +13,7 @@
 #include "terrain/core/error.hpp"
 #include "terrain/field/shape_index.hpp"
 #include "terrain/geo/body.hpp"
+#include "terrain/geo/georeference.hpp"
 #include "terrain/mesh/dem_to_mesh.hpp"
 
 using namespace terrain;
@@ -251,4 +253,62 @@ TEST_CASE("white noise reads planar, a crater under it keeps its scale", "[scale
                      [&](double x, double y) { return crater(x, y, 64, 64, 26) + values[next++]; });
     CHECK(s.radius_at(64, 64) >= 15.9);
     CHECK(s.field_at(64, 64) < 10);
+}
+
+namespace {
+
+// The whole Moon as a perfect sphere: a geographic grid of width x width / 2 pixels, every
+// height 0.
+Dem moon_sphere(int width) {
+    Dem dem;
+    dem.width = width;
+    dem.height = width / 2;
+    dem.crs_wkt = "IAU_2015:30100";
+    dem.transform = {-180, 360.0 / width, 0, 90, 0, -360.0 / width};
+    dem.has_transform = true;
+    geo::georeference(dem);
+    dem.values.assign(std::size_t(dem.width) * std::size_t(dem.height), 0.0);
+    return dem;
+}
+
+constexpr double kMoonRadius = 1737400;
+
+}  // namespace
+
+TEST_CASE("the disk fit's bias on a sphere is the one the ladder takes off", "[scale_selection]") {
+    const auto mesh = mesh::dem_to_mesh(moon_sphere(512));
+    for (double share : {0.25, 0.5}) {
+        field::ShapeIndexOptions options;
+        options.radius = share * kMoonRadius;
+        options.disk_tile_angle = 0.4;  // the ladder's tiles
+        const auto k = field::principal_curvatures(mesh, options);
+        double sum = 0;
+        std::size_t count = 0;
+        for (std::size_t v = 0; v < mesh.vertex_count(); ++v) {
+            const int row = mesh.vertex_pixel[v] / 512;
+            if (row < 64 || row >= 192) continue;  // within 45 degrees of the equator
+            sum += k[v].k1 + k[v].k2, count += 2;
+        }
+        REQUIRE(count > 0);
+        const double fitted = sum / double(count);
+        const double seen = field::sphere_curvature_in_fit(kMoonRadius, options.radius);
+        INFO("radius " << share << " r: fitted " << fitted * kMoonRadius << " / r, model "
+                       << seen * kMoonRadius << " / r");
+        CHECK(fitted * kMoonRadius - 1 > 0.01 * share * share);  // wider than the sphere's 1/r
+        CHECK(std::abs(fitted - seen) * kMoonRadius < 0.15 * (fitted * kMoonRadius - 1));
+    }
+}
+
+TEST_CASE("a body's own sphere reads planar at every rung", "[scale_selection]") {
+    const auto mesh = mesh::dem_to_mesh(moon_sphere(256));
+    const auto radii = field::default_radii(mesh);
+    // The ladder stops at half the body's radius: a window wider is no longer a local shape.
+    CHECK(radii.back() <= 0.5 * kMoonRadius);
+    CHECK(2 * radii.back() > 0.5 * kMoonRadius);
+    field::ShapeIndexOptions options;
+    options.auto_scale = true;
+    const auto out = field::scale_selected_shape_index(mesh, options);
+    float worst = 0;
+    for (const float f : out.field) worst = std::max(worst, std::abs(f - 50.0f));
+    CHECK(worst < 0.05f);
 }

@@ -25,6 +25,15 @@ constexpr float kTopContrast = 0.25f;
 constexpr double kNoiseSigmas = 3;
 // The most pixels pixel_noise samples.
 constexpr std::size_t kNoiseSamples = std::size_t(1) << 20;
+// The disk fit's bias on a sphere (sphere_curvature_in_fit): a quadratic fitted over a disk
+// of radius R to a sphere of radius r has the curvature 1/r (1 + k (R/r)^2). A uniform disk
+// in angle gives k = 3/16 from the sphere's quartic term; the grid's pixels and the tile's
+// tilt make it 0.13-0.16 within 45 degrees of the equator (tests/field/scale_selection.cpp).
+constexpr double kSphereFitBias = 0.14;
+// The ladder's largest radius on a body, as a share of its radius: a wider window is no
+// longer a local shape (the sphere departs from the fit's quadratic by more than it can
+// correct).
+constexpr double kLadderBodyShare = 0.5;
 // The ladder's tiles of sums may span this angle on the body (shape_index.hpp): the tilt of a
 // tile's frame is a slope, which the fit takes up, not a curvature.
 constexpr double kLadderTileAngle = 0.4;
@@ -84,13 +93,21 @@ double pixel_noise(const TriangleMesh& mesh) {
     return *mid / (6 * 0.674489750196082);
 }
 
+double sphere_curvature_in_fit(double sphere_radius, double window_radius) {
+    const double share = window_radius / sphere_radius;
+    return (1 + kSphereFitBias * share * share) / sphere_radius;
+}
+
 std::vector<double> default_radii(const TriangleMesh& mesh) {
     check_dem_mesh(mesh);
     const double spacing = std::sqrt(mean_vertex_area(mesh));
     if (!(spacing > 0) || !std::isfinite(spacing))
         throw Error("field", "--radius auto needs a mesh with a positive area");
-    // At least the first two rungs, so that even a small tile has a choice.
-    const double limit = std::max(4.0, 0.5 * std::min(mesh.grid_width, mesh.grid_height));
+    // At least the first two rungs, so that even a small tile has a choice; on a body, none
+    // wider than half its radius.
+    double limit = std::max(4.0, 0.5 * std::min(mesh.grid_width, mesh.grid_height));
+    if (mesh.frame == MeshFrame::body && mesh.body.semi_minor_axis() > 0)
+        limit = std::min(limit, kLadderBodyShare * mesh.body.semi_minor_axis() / spacing);
     std::vector<double> radii;
     for (double pixels = 2; pixels <= 128 && (pixels <= limit || radii.size() < 2); pixels *= 2)
         radii.push_back(pixels * spacing);
@@ -127,14 +144,15 @@ ScaleSelectedField scale_selected_shape_index(const TriangleMesh& mesh,
     const double tau2 = options.contrast_curvedness * options.contrast_curvedness;
     const double beta = options.peak_dominance;
     const double sig = options.contrast_curvedness;
-    // 1 / the distance from the body's centre on a body-fixed mesh; 0 on a map.
-    const auto body_curvature = [&](std::int32_t v) {
+    // The curvature the fit of `radius` gives the sphere through the vertex (its distance from
+    // the body's centre) on a body-fixed mesh; 0 on a map.
+    const auto body_curvature = [&](std::int32_t v, double radius) {
         if (mesh.frame != MeshFrame::body) return 0.0;
         const auto& p = mesh.positions()[std::size_t(v)];
         const double x = mesh.origin[0] + p[0], y = mesh.origin[1] + p[1],
                      z = mesh.origin[2] + p[2];
         const double r = std::sqrt(x * x + y * y + z * z);
-        return r > 0 ? 1.0 / r : 0.0;
+        return r > 0 ? sphere_curvature_in_fit(r, radius) : 0.0;
     };
     // Per vertex, as the rungs go up: the previous rung's curvedness and field value, whether
     // the curvedness rose into it, the previous rung itself, and the peak chosen so far (its
@@ -194,7 +212,7 @@ ScaleSelectedField scale_selected_shape_index(const TriangleMesh& mesh,
                 // Curvatures in 1/m relative to the body's sphere through the vertex (its own
                 // convex curvature would otherwise grow into every large window), times the
                 // radius: dimensionless, scale-normalised.
-                const double body = body_curvature(vi);
+                const double body = body_curvature(vi, radius);
                 const double k1 = (k.k1 / scale - body) * radius,
                              k2 = (k.k2 / scale - body) * radius;
                 double cd = std::sqrt(0.5 * (k1 * k1 + k2 * k2));

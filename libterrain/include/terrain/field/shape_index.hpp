@@ -48,7 +48,8 @@ struct ShapeIndexOptions {
     // The analysis scale chosen per vertex (`--radius auto`, DEM meshes only; docs/field.md,
     // "Scale chosen per vertex"): the disk window's fit is made over every radius of `radii`
     // (metres, increasing; empty: field::default_radii of the mesh), each vertex's
-    // curvatures taken relative to the body's sphere, and its scale-normalised curvedness c
+    // curvatures taken relative to the body's sphere as the fit sees it
+    // (sphere_curvature_in_fit), and its scale-normalised curvedness c
     // (curvedness x radius) followed up the ladder. Each local maximum of c over the ladder
     // is a peak; a vertex takes its first significant peak (c >= contrast_curvedness) unless
     // a later one is peak_dominance times as strong, or its strongest peak when none is
@@ -106,9 +107,14 @@ std::vector<float> shape_index_field(const TriangleMesh& mesh,
 
 // The ladder of radii `--radius auto` takes on a DEM mesh: 2, 4, 8, ..., 128 times the
 // mesh's pixel spacing (the square root of its mean vertex area), the largest kept below
-// half the grid's smaller side (a landform wider than the ladder's top reads nearly planar). Throws
-// terrain::Error for a mesh not made from a DEM.
+// half the grid's smaller side and, on a body, half the body's radius (a landform wider than
+// the ladder's top reads nearly planar). Throws terrain::Error for a mesh not made from a DEM.
 std::vector<double> default_radii(const TriangleMesh& mesh);
+
+// The mean curvature (1/m) the disk window's fit of radius `window_radius` gives a sphere of
+// radius `sphere_radius`: 1/r, and the bias of a quadratic fitted over a disk to the sphere's
+// quartic term, 1/r (1 + 3/16 (R/r)^2) (docs/field.md, "Scale chosen per vertex").
+double sphere_curvature_in_fit(double sphere_radius, double window_radius);
 
 struct ScaleSelectedField {
     std::vector<float> field;         // per vertex, in [0, 100] as shape_index_field's
