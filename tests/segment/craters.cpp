@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 
 #include "support/test_meshes.hpp"
 #include "terrain/core/error.hpp"
@@ -217,6 +218,44 @@ TEST_CASE("Craters: the confidence's terms", "[craters]") {
     for (const auto& [mean, share] : std::vector<std::pair<double, double>>{
              {43.75, 1}, {20, 1}, {46.875, 0.5}, {50, 0}, {60, 0}})
         CHECK(segment::crater_confidence({0.75, 0, 40, 10, 1, mean}) == Approx(0.75 * share));
+    // Level: a rim whose heights spread as much as the crater is deep keeps half, one that
+    // cannot be measured (off the grid, or a centre not below it) none.
+    e.floor_mean = 30;
+    e.rim_spread = 1;
+    CHECK(segment::crater_confidence(e) == Approx(0.375));
+    e.rim_spread = 0.5;
+    CHECK(segment::crater_confidence(e) == Approx(0.75 / 1.25));
+    e.rim_spread = std::numeric_limits<double>::infinity();
+    CHECK(segment::crater_confidence(e) == 0);
+}
+
+TEST_CASE("Craters: a low between uneven rims is less confident than a level crater", "[craters]") {
+    // The same bowl twice: once under a level rim, once under a rim that rises and falls
+    // three times round it by twice the bowl's depth, as the rims of other craters round a
+    // low between them do.
+    const double R = 14, cx = 60.3, cy = 59.6, depth = 0.2 * R, rim = 0.04 * R;
+    const auto ringed = [&](double swing) {
+        return test::grid_dem(120, 120, [=](int c, int r) {
+            const double x = c + 0.5 - cx, y = r + 0.5 - cy, d = std::hypot(x, y);
+            const double bowl = d < R ? depth * ((d / R) * (d / R) - 1) : 0.0;
+            const double w = (d - R) / (0.3 * R);
+            const double crest = rim + swing * std::cos(3 * std::atan2(y, x));
+            return bowl + crest * std::exp(-w * w);
+        });
+    };
+    const auto best = [&](double swing) {
+        auto result = segment_dem(ringed(swing));
+        REQUIRE(result.craters);
+        double confidence = 0;  // of the crater at the bowl, 0 when none is listed there
+        for (const auto& k : result.craters->craters)
+            if (std::hypot(k.col - cx, k.row - cy) < 0.5 * R)
+                confidence = std::max(confidence, k.confidence);
+        return confidence;
+    };
+    const double level = best(0), uneven = best(2 * depth);
+    INFO("level " << level << ", uneven " << uneven);
+    CHECK(level > 0.6);
+    CHECK(uneven < 0.5 * level);
 }
 
 TEST_CASE("Craters: a bowl a few pixels wide is listed", "[craters]") {

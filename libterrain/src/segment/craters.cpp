@@ -23,6 +23,8 @@ namespace {
 using V3 = std::array<double, 3>;
 constexpr int kSectors = 36;
 constexpr int kMinSectors = 12;
+// The points round a rim circle whose heights give its spread (rim_spread).
+constexpr int kLevelPoints = 24;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
 V3 sub(const V3& a, const V3& b) {
@@ -314,6 +316,37 @@ double surroundings_height(const TriangleMesh& mesh, const Dem& dem, const Floor
     return ring_n > 0 ? ring / double(ring_n) : std::numeric_limits<double>::quiet_NaN();
 }
 
+// The standard deviation of the DEM's heights at kLevelPoints points round the rim circle,
+// over their mean's height above the crater's centre: about 0 for a crater's rim, which is
+// level; 1 or more for a low between the rims of other craters. Infinity when under half the
+// points are on the grid or the centre is not below them.
+double rim_spread(const TriangleMesh& mesh, const Dem& dem, const Circle& c,
+                  const std::function<std::array<double, 2>(double, double)>& to_pixel) {
+    const auto height = [&](double x, double y, double& h) {
+        const auto q = to_pixel(x, y);
+        int col = int(std::floor(q[0]));
+        const int row = int(std::floor(q[1]));
+        if (mesh.seam_closed) col = ((col % dem.width) + dem.width) % dem.width;
+        if (col < 0 || col >= dem.width || row < 0 || row >= dem.height) return false;
+        if (mesh.pixel_vertex[std::size_t(row) * std::size_t(dem.width) + std::size_t(col)] < 0)
+            return false;
+        h = dem.height_at(col, row);
+        return std::isfinite(h);
+    };
+    double centre = 0, sum = 0, sum2 = 0;
+    int n = 0;
+    for (int i = 0; i < kLevelPoints; ++i) {
+        const double t = 2 * std::numbers::pi * i / kLevelPoints;
+        double h = 0;
+        if (!height(c.x + c.r * std::cos(t), c.y + c.r * std::sin(t), h)) continue;
+        sum += h, sum2 += h * h, ++n;
+    }
+    if (2 * n < kLevelPoints || !height(c.x, c.y, centre)) return kInf;
+    const double mean = sum / n, depth = mean - centre;
+    const double sd = std::sqrt(std::max(0.0, sum2 / n - mean * mean));
+    return depth > 0 ? sd / depth : kInf;
+}
+
 // A crater of a floor whose rim circle holds; false when its confidence is too low or its
 // frame has no map to the grid. `xy`: its centre in the DEM's map coordinates.
 bool make_crater(const TriangleMesh& mesh, const Dem& dem, const RegionGraph& graph,
@@ -333,6 +366,11 @@ bool make_crater(const TriangleMesh& mesh, const Dem& dem, const RegionGraph& gr
         field += region.field_mean * region.area_m2;
         area += region.area_m2;
     }
+    V3 ac, ar;
+    if (!fl.col.solve(ac) || !fl.row.solve(ar)) return false;
+    const auto to_pixel = [&](double x, double y) {
+        return std::array<double, 2>{ac[0] + ac[1] * x + ac[2] * y, ar[0] + ar[1] * x + ar[2] * y};
+    };
     CraterEvidence evidence;
     evidence.rim_fraction = k.rim_fraction;
     evidence.fit_rms_m = c.rms;
@@ -340,6 +378,7 @@ bool make_crater(const TriangleMesh& mesh, const Dem& dem, const RegionGraph& gr
     evidence.pixel_m = std::sqrt(fl.area / double(std::max<std::size_t>(fl.count, 1)));
     evidence.circularity = k.circularity;
     evidence.floor_mean = area > 0 ? field / area : options.concave_below;
+    evidence.rim_spread = rim_spread(mesh, dem, c, to_pixel);
     k.confidence = crater_confidence(evidence, options);
     if (k.confidence < options.min_confidence) return false;
     for (int s = 0; s < kSectors; ++s)
@@ -347,11 +386,6 @@ bool make_crater(const TriangleMesh& mesh, const Dem& dem, const RegionGraph& gr
     std::sort(k.rim_regions.begin(), k.rim_regions.end());
     k.rim_regions.erase(std::unique(k.rim_regions.begin(), k.rim_regions.end()),
                         k.rim_regions.end());
-    V3 ac, ar;
-    if (!fl.col.solve(ac) || !fl.row.solve(ar)) return false;
-    const auto to_pixel = [&](double x, double y) {
-        return std::array<double, 2>{ac[0] + ac[1] * x + ac[2] * y, ar[0] + ar[1] * x + ar[2] * y};
-    };
     const auto centre = to_pixel(c.x, c.y);
     k.col = centre[0];
     k.row = centre[1];
@@ -443,7 +477,9 @@ double crater_confidence(const CraterEvidence& e, const CraterOptions& options) 
     const double concavity =
         band > 0 ? std::clamp((options.concave_below - e.floor_mean) / band, 0.0, 1.0)
                  : (e.floor_mean < options.concave_below ? 1.0 : 0.0);
-    return std::clamp(e.rim_fraction, 0.0, 1.0) * quality * roundness * concavity;
+    const double spread = options.level_spread > 0 ? e.rim_spread / options.level_spread : 0.0;
+    const double level = std::isfinite(spread) ? 1 / (1 + spread * spread) : 0.0;
+    return std::clamp(e.rim_fraction, 0.0, 1.0) * quality * roundness * concavity * level;
 }
 
 CraterTable find_craters(const TriangleMesh& mesh, const Dem& dem,

@@ -28,7 +28,8 @@ struct Crater {
     double field_scale_m = 0;  // the floor region's field scale (0 without one)
     std::uint32_t floor_region = 0;
     std::vector<std::uint32_t> rim_regions;  // the convex regions the crest was found in
-    // In [0, 1]: crater_confidence(), rim fraction x fit quality x roundness x concavity.
+    // In [0, 1]: crater_confidence(), rim fraction x fit quality x roundness x concavity x
+    // level.
     double confidence = 0;
     // The rim circle as a closed ring of kRimPoints + 1 points, in the centre's coordinates
     // (lon, lat, longitudes kept within 180 degrees of the centre's; or map x, y).
@@ -46,7 +47,7 @@ struct CraterOptions {
     double concave_below = 50;  // a floor's mean field (shape index x 100) is below this
     double convex_above = 50;   // a rim region's mean field is above this
     double min_rim_fraction = 0.5;
-    double min_confidence = 0.35;
+    double min_confidence = 0.2;
     // A floor this round (4 pi area / perimeter^2) or rounder takes its whole confidence; a
     // less round one, in proportion.
     double round_floor = 0.4;
@@ -54,6 +55,9 @@ struct CraterOptions {
     // shape index -1/8) takes its whole confidence; one between this and concave_below, in
     // proportion to how far below concave_below it is.
     double concave_full = 43.75;
+    // A rim whose heights spread (their standard deviation round the circle) this much of the
+    // crater's depth keeps half its confidence (a level rim all of it).
+    double level_spread = 1.0;
 
     // The rim crest is looked for between these multiples of the floor's radius (of a disk
     // of its area) from its centroid.
@@ -68,13 +72,16 @@ struct CraterEvidence {
     double pixel_m = 0;       // the grid's spacing at the floor (square root of a vertex's area)
     double circularity = 0;   // the floor's, 4 pi area / perimeter^2
     double floor_mean = 0;    // the floor's mean field (shape index x 100)
+    double rim_spread = 0;    // the rim's heights' standard deviation over the crater's depth
 };
-// rim fraction x fit quality x roundness x concavity, in [0, 1]:
+// rim fraction x fit quality x roundness x concavity x level, in [0, 1]:
 // - fit quality 1 - 4 misfit / radius (at least 0), the misfit being the RMS beyond what the
 //   grid explains: a crest point is a vertex, up to half a pixel off the crest it samples, so
 //   misfit^2 = max(0, rms^2 - (pixel / 2)^2);
 // - roundness min(1, circularity / round_floor);
-// - concavity (concave_below - floor_mean) / (concave_below - concave_full), within [0, 1].
+// - concavity (concave_below - floor_mean) / (concave_below - concave_full), within [0, 1];
+// - level 1 / (1 + (rim_spread / level_spread)^2): a crater's rim is about level round its
+//   circle, a low between the rims of other craters is not.
 double crater_confidence(const CraterEvidence& evidence, const CraterOptions& options = {});
 
 // The craters of a DEM's segmentation: `labels` per mesh vertex (1..regions), `graph` its
