@@ -7,8 +7,9 @@ default, the concave landform classes; 50 for a mean shape index below 0).
 
   moon_craters.py SEGMENT_DIR [--concave-below 43.75] [--catalogue CSV]
 
-SEGMENT_DIR is `terrain segment`'s output on a global lon/lat grid of the Moon starting at
-0 E (labels.tif, regions.geojson, craters.csv). The positions and diameters are approximate
+SEGMENT_DIR is `terrain segment`'s output on a global grid of the Moon, geographic or
+equirectangular, whose left edge may be at any longitude (read from labels.tif's
+geotransform and CRS; labels.tif, regions.geojson, craters.csv). The positions and diameters are approximate
 (a few tenths of a degree, a few km): a look, not a catalogue.
 
 With --catalogue CSV (columns lon, lat, diameter_km; east-positive longitudes), the craters
@@ -71,12 +72,14 @@ def main():
             mean[p["id"]] = np.nan if p["field_mean"] is None else p["field_mean"]
     h, w = labels.shape
     pixel_km = 2 * np.pi * MOON_RADIUS_KM / w
+    origin = grid_origin(ds)
     if a.catalogue:
-        score_catalogue(a, labels, mean, pixel_km)
+        score_catalogue(a, labels, mean, pixel_km, origin)
         return
+    col, row = grid_position([c[2] for c in CRATERS], [c[1] for c in CRATERS], origin, w, h)
     craters = {
-        "col": np.array([(lon % 360) / 360 * w for _, _, lon, _ in CRATERS]),
-        "row": np.array([(90 - lat) / 180 * h for _, lat, _, _ in CRATERS]),
+        "col": col,
+        "row": row,
         "diameter_px": np.array([d / pixel_km for _, _, _, d in CRATERS]),
         "col_scale": np.array([np.cos(np.radians(lat)) for _, lat, _, _ in CRATERS]),
     }
@@ -85,6 +88,37 @@ def main():
     for (name, _, _, d), ok, k in zip(CRATERS, found, match):
         print(f"{name:14s} {d:4d} km  region {k:6d}  mean {mean[k]:5.1f}  {'found' if ok else 'missed'}")
     print(f"found {int(found.sum())} of {len(CRATERS)} (concave below {a.concave_below})")
+
+
+def grid_origin(ds):
+    """The longitude of a global grid's left edge and the latitude of its top edge (degrees),
+    from its geotransform and CRS (a geographic or an equirectangular one); 0 and 90 without
+    a CRS."""
+    from osgeo import osr
+    wkt = ds.GetProjection()
+    t = ds.GetGeoTransform()
+    if not wkt:
+        return 0.0, 90.0
+    srs = osr.SpatialReference()
+    srs.ImportFromWkt(wkt)
+    srs.SetAxisMappingStrategy(osr.OAMS_TRADITIONAL_GIS_ORDER)
+    if srs.IsGeographic():
+        return t[0], t[3]
+    geographic = srs.CloneGeogCS()
+    geographic.SetAxisMappingStrategy(osr.OAMS_TRADITIONAL_GIS_ORDER)
+    to_lonlat = osr.CoordinateTransformation(srs, geographic)
+    w, h = ds.RasterXSize, ds.RasterYSize
+    lon, _, _ = to_lonlat.TransformPoint(t[0], t[3] + 0.5 * h * t[5])
+    _, lat, _ = to_lonlat.TransformPoint(t[0] + 0.5 * w * t[1], t[3])
+    return lon, lat
+
+
+def grid_position(lon, lat, origin, w, h):
+    """Column and row (fractional) of lon/lat on a global grid of w x h pixels whose left and
+    top edges are at origin = (longitude, latitude)."""
+    col = ((np.asarray(lon, float) - origin[0]) % 360) / 360 * w
+    row = (origin[1] - np.asarray(lat, float)) / 180 * h
+    return col, row
 
 
 def read_catalogue(path, min_km, max_km, max_lat):
@@ -97,10 +131,11 @@ def read_catalogue(path, min_km, max_km, max_lat):
     return lon, lat, d
 
 
-def score_catalogue(a, labels, mean, pixel_km):
+def score_catalogue(a, labels, mean, pixel_km, origin):
     h, w = labels.shape
     lon, lat, d = read_catalogue(a.catalogue, a.min_km, a.max_km, a.max_lat)
-    craters = {"col": (lon % 360) / 360 * w, "row": (90 - lat) / 180 * h,
+    col, row = grid_position(lon, lat, origin, w, h)
+    craters = {"col": col, "row": row,
                "diameter_px": d / pixel_km, "col_scale": np.cos(np.radians(lat))}
     everything = np.arange(len(d))
     concave = mean < a.concave_below
@@ -151,7 +186,8 @@ def score_catalogue(a, labels, mean, pixel_km):
     t_lon = np.array([float(r["lon"]) for r in rows])
     t_lat = np.array([float(r["lat"]) for r in rows])
     t_d = np.array([float(r["diameter_m"]) for r in rows]) / 1000
-    table = {"col": (t_lon % 360) / 360 * w, "row": (90 - t_lat) / 180 * h}
+    t_col, t_row = grid_position(t_lon, t_lat, origin, w, h)
+    table = {"col": t_col, "row": t_row}
     hit = np.zeros(len(d), bool)
     for i in range(len(d)):
         sx = craters["col_scale"][i]
