@@ -16,13 +16,15 @@ namespace {
 
 // A paraboloid bowl of radius R and depth `depth` whose rim rises `rim` above a plane, centred
 // at (cx, cy) in pixel coordinates (1 m pixels, no CRS): the rim crest is the circle of radius
-// R, `depth + rim` above the bowl's bottom.
-Dem bowl_dem(int size, double cx, double cy, double R, double depth, double rim) {
+// R, `depth + rim` above the bowl's bottom. With a `swing`, the rim rises and falls by it three
+// times round the circle.
+Dem bowl_dem(int size, double cx, double cy, double R, double depth, double rim, double swing = 0) {
     return test::grid_dem(size, size, [=](int c, int r) {
-        const double d = std::hypot(c + 0.5 - cx, r + 0.5 - cy);
+        const double x = c + 0.5 - cx, y = r + 0.5 - cy, d = std::hypot(x, y);
         const double bowl = d < R ? depth * ((d / R) * (d / R) - 1) : 0.0;
         const double w = (d - R) / (0.3 * R);
-        return bowl + rim * std::exp(-w * w);
+        const double crest = rim + swing * std::cos(3 * std::atan2(y, x));
+        return bowl + crest * std::exp(-w * w);
     });
 }
 
@@ -234,17 +236,8 @@ TEST_CASE("Craters: a low between uneven rims is less confident than a level cra
     // three times round it by twice the bowl's depth, as the rims of other craters round a
     // low between them do.
     const double R = 14, cx = 60.3, cy = 59.6, depth = 0.2 * R, rim = 0.04 * R;
-    const auto ringed = [&](double swing) {
-        return test::grid_dem(120, 120, [=](int c, int r) {
-            const double x = c + 0.5 - cx, y = r + 0.5 - cy, d = std::hypot(x, y);
-            const double bowl = d < R ? depth * ((d / R) * (d / R) - 1) : 0.0;
-            const double w = (d - R) / (0.3 * R);
-            const double crest = rim + swing * std::cos(3 * std::atan2(y, x));
-            return bowl + crest * std::exp(-w * w);
-        });
-    };
     const auto best = [&](double swing) {
-        auto result = segment_dem(ringed(swing));
+        auto result = segment_dem(bowl_dem(120, cx, cy, R, depth, rim, swing));
         REQUIRE(result.craters);
         double confidence = 0;  // of the crater at the bowl, 0 when none is listed there
         for (const auto& k : result.craters->craters)

@@ -112,8 +112,9 @@ std::vector<float> shape_index_field(const TriangleMesh& mesh,
 std::vector<double> default_radii(const TriangleMesh& mesh);
 
 // The mean curvature (1/m) the disk window's fit of radius `window_radius` gives a sphere of
-// radius `sphere_radius`: 1/r, and the bias of a quadratic fitted over a disk to the sphere's
-// quartic term, 1/r (1 + 3/16 (R/r)^2) (docs/field.md, "Scale chosen per vertex").
+// radius `sphere_radius`: 1/r and the bias of a quadratic fitted over a disk to the sphere's
+// quartic term, 1/r (1 + k (R/r)^2), k = 0.14 as measured on the grid (3/16 for a disk
+// uniform in angle; docs/field.md, "Scale chosen per vertex").
 double sphere_curvature_in_fit(double sphere_radius, double window_radius);
 
 struct ScaleSelectedField {
