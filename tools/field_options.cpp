@@ -20,8 +20,9 @@ void add_field_options(po::options_description& options, FieldOptionValues& valu
         "rings", po::value(&si.rings)->default_value(2),
         "shape index: fit over the vertices within N mesh edges (1..10)")(
         "radius", po::value(&values.radius),
-        "shape index: fit over the vertices within M metres instead of rings (the ball window "
-        "at most 20 mean edge lengths), or auto: the radius chosen per vertex among --radii "
+        "shape index: fit over the vertices within M metres instead of rings (the disk window "
+        "at most 128 pixels, the ball at most 20 mean edge lengths), or auto: the radius chosen "
+        "per vertex among --radii "
         "(DEMs; the default when no scale option is given)")(
         "radii", po::value(&values.radii),
         "with --radius auto: the ladder of radii in metres, R1,R2,... increasing (default: 2, "
@@ -29,8 +30,8 @@ void add_field_options(po::options_description& options, FieldOptionValues& valu
         "radius)")(
         "window", po::value(&values.window)->default_value("disk"),
         "shape index with --radius on a DEM: disk (the pixels within the radius on the ground; "
-        "costs the same whatever the radius) or ball (the vertices within the radius in 3-D)")(
-        "rays", po::value(&sdf.rays)->default_value(25), "sdf: rays per face (1..1000)")(
+        "costs the same at any radius up to 128 pixels) or ball (the vertices within the radius in "
+        "3-D)")("rays", po::value(&sdf.rays)->default_value(25), "sdf: rays per face (1..1000)")(
         "cone-angle", po::value(&values.cone_angle_degrees)->default_value(120.0),
         "sdf: opening of each face's cone of rays, degrees")(
         "no-postprocess", po::bool_switch(&values.no_postprocess),
@@ -113,7 +114,8 @@ void check_field_limits(const field::FieldOptions& options, const TriangleMesh& 
         options.shape_index.radius <= 0)
         return;
     if (std::string(field::shape_index_window(mesh, options.shape_index)) == "disk") {
-        // Any radius costs the same; one wider than the grid sees nothing more.
+        // Any radius the tables hold costs the same (the field refuses one reaching further:
+        // field::detail::check_disk_reach); one wider than the grid sees nothing more.
         const double spacing = std::sqrt(mean_vertex_area(mesh));
         const double across = double(std::max(mesh.grid_width, mesh.grid_height)) * spacing;
         if (options.shape_index.radius > across)

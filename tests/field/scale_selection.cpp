@@ -312,3 +312,73 @@ TEST_CASE("a body's own sphere reads planar at every rung", "[scale_selection]")
     for (const float f : out.field) worst = std::max(worst, std::abs(f - 50.0f));
     CHECK(worst < 0.05f);
 }
+
+TEST_CASE("near a geographic grid's poles a wide disk window is cut to the tables' reach",
+          "[scale_selection]") {
+    // 1 degree pixels: a window of 10 rows spans 10 / cos(latitude) columns, past the tables'
+    // 128 within 4.5 degrees of a pole. Those windows are cut to 128 columns on each side
+    // (their cost no longer grows towards the pole), the same cut whether the tables sum
+    // them or the mesh gathers them; every vertex gets a value.
+    const auto mesh = mesh::dem_to_mesh(moon_sphere(360));
+    const double row = kMoonRadius * std::numbers::pi / 180;
+    auto options = [&](field::ShapeIndexMethod method) {
+        field::ShapeIndexOptions o;
+        o.radius = 10 * row;
+        o.method = method;
+        return o;
+    };
+    const auto grid = field::shape_index_field(mesh, options(field::ShapeIndexMethod::grid));
+    const auto gathered = field::shape_index_field(mesh, options(field::ShapeIndexMethod::mesh));
+    REQUIRE(grid.size() == gathered.size());
+    double worst = 0;
+    std::size_t polar = 0, bad = 0;
+    for (std::size_t v = 0; v < grid.size(); ++v) {
+        bad += !(std::isfinite(grid[v]) && grid[v] >= 0 && grid[v] <= 100);
+        const int r = mesh.vertex_pixel[v] / 360;
+        if (r >= 5 && r < 175) continue;
+        ++polar;
+        worst = std::max(worst, double(std::abs(grid[v] - gathered[v])));
+    }
+    CHECK(bad == 0);
+    REQUIRE(polar > 1000);
+    CHECK(worst < 0.01);
+}
+
+TEST_CASE("the ladder reaches a crater next to a pole", "[scale_selection]") {
+    // The Moon's sphere at 1 pixel a degree with a bowl of 240 km radius (8 rows) centred at
+    // 80 N: its tiles' tables touch the collapsed pole row, and the ladder must still see the
+    // bowl at its own scale (a rung above the first), concave, as at the equator.
+    auto dem = moon_sphere(360);
+    const double a = 240e3, depth = 0.1 * a;
+    const auto bowl_at = [&](double lat0) {
+        std::vector<double> z(dem.values.size(), 0.0);
+        const double deg = std::numbers::pi / 180;
+        for (int r = 0; r < dem.height; ++r)
+            for (int c = 0; c < dem.width; ++c) {
+                const double lat = (89.5 - r) * deg, lon = (-179.5 + c) * deg;
+                // Great-circle distance from (lat0, 0).
+                const double cosd = std::sin(lat) * std::sin(lat0 * deg) +
+                                    std::cos(lat) * std::cos(lat0 * deg) * std::cos(lon);
+                const double d = kMoonRadius * std::acos(std::clamp(cosd, -1.0, 1.0));
+                if (d < a)
+                    z[std::size_t(r) * std::size_t(dem.width) + std::size_t(c)] =
+                        -depth * (1 - (d / a) * (d / a));
+            }
+        return z;
+    };
+    field::ShapeIndexOptions options;
+    options.auto_scale = true;
+    for (double lat0 : {80.0, 0.0}) {
+        dem.values = bowl_at(lat0);
+        const auto mesh = mesh::dem_to_mesh(dem);
+        REQUIRE(mesh.pole_rows[0] == 0);
+        const auto out = field::scale_selected_shape_index(mesh, options);
+        const int row = int(std::lround(89.5 - lat0)), col = 180;
+        const auto v = mesh.pixel_vertex[std::size_t(row) * 360 + std::size_t(col)];
+        REQUIRE(v >= 0);
+        INFO("bowl at " << lat0 << " N: rung " << int(out.scale[std::size_t(v)]) << ", field "
+                        << out.field[std::size_t(v)]);
+        CHECK(out.scale[std::size_t(v)] >= 2);  // 8 pixels or wider, not the first 2
+        CHECK(out.field[std::size_t(v)] < 25);
+    }
+}

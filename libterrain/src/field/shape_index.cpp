@@ -107,7 +107,8 @@ bool mesh_fit(const TriangleMesh& mesh, std::int32_t v, const Vec3& normal,
               PrincipalCurvatures& k, double& scale) {
     const bool pole = v == mesh.pole_vertices[0] || v == mesh.pole_vertices[1];
     if (disk_grid && !pole)
-        return disk_mesh_fit(mesh, *disk_grid, v, normal, options.radius, s, k, scale);
+        return disk_mesh_fit(mesh, *disk_grid, v, normal, options.radius, !options.skip_wide, s, k,
+                             scale);
     gather(mesh, v, options, s);
     return fit_curvatures(mesh, v, normal, s.gathered.data() + 1, s.gathered.size() - 1, k, scale);
 }
@@ -171,6 +172,7 @@ void for_each_vertex(const TriangleMesh& mesh, const ShapeIndexOptions& options,
     // Normals 0 to 0.05 of the progress (the grid method's, when made by bands, with its
     // tiles), the grid's layout to 0.06, the vertices to 1.
     const bool grid = grid_applies(mesh, options), disk = disk_applies(mesh, options);
+    if (disk && !options.skip_wide) check_disk_reach(mesh, options.radius, "--radius");
     if (grid) return grid_method_for_each_vertex(mesh, options, progress, body);
     const auto normals = vertex_normals(mesh, scaled_progress(progress, 0, 0.05));
     GridLayout layout;

@@ -4,10 +4,14 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <numbers>
 #include <optional>
+#include <string>
+#include <vector>
 
 #include "shape_index_fit.hpp"
+#include "terrain/core/error.hpp"
 
 namespace terrain::field::detail {
 namespace {
@@ -31,7 +35,9 @@ int iceil(double x) {
 // weighs the two directions alike (a band's span taken elsewhere than on its own rows would
 // make a two-pixel disk three columns by five rows, and its curvature across the columns
 // three times as sensitive to pixel noise as along them).
-DiskWindow ellipse_window(double a, double b, double c) {
+// With `clip` > 0 the window is cut to `clip` rows and columns on each side (the grid
+// method's tables hold no more).
+DiskWindow ellipse_window(double a, double b, double c, int clip) {
     DiskWindow d;
     const double det = a * c - b * b;
     if (!(a > 0) || !(det > 0)) return d;
@@ -43,7 +49,8 @@ DiskWindow ellipse_window(double a, double b, double c) {
     for (int side : {1, -1}) {
         int previous = side > 0 ? -1 : 0;  // the row 0 band is on the + side
         for (int k = 0; k < 3; ++k) {
-            const int hi = ifloor(height * (k + 1) / 3);
+            int hi = ifloor(height * (k + 1) / 3);
+            if (clip > 0) hi = std::min(hi, clip);
             if (hi <= previous) continue;
             const double y = side * 0.5 * (previous + 1 + hi);
             const double centre = clamp(shear * y);
@@ -54,6 +61,9 @@ DiskWindow ellipse_window(double a, double b, double c) {
             band.row_hi = side > 0 ? hi : -(previous + 1);
             band.col_lo = iceil(clamp(centre - half));
             band.col_hi = ifloor(clamp(centre + half));
+            if (clip > 0)
+                band.col_lo = std::max(band.col_lo, -clip),
+                band.col_hi = std::min(band.col_hi, clip);
             previous = hi;
             if (band.col_lo > band.col_hi) continue;
             d.band[std::size_t(d.bands++)] = band;
@@ -109,8 +119,10 @@ GroundSpacing ground_spacing(const TriangleMesh& mesh, const GridLayout& g, std:
 // a vertex). The tangent plane it is lifted onto is the window's: the slope between the
 // pixels half the radius away on each side along columns and rows (clipped to the grid),
 // which on rough terrain follows the ball's footprint better than the vertex's own normal.
+// With `clip`, a window reaching beyond kMaxReach pixels (near the poles of a geographic
+// grid, where a row's pixels are narrow) is cut to kMaxReach on each side.
 DiskWindow vertex_disk(const TriangleMesh& mesh, const GridLayout& g, std::int32_t v,
-                       const Vec3& normal, const Vec3& up, double radius) {
+                       const Vec3& normal, const Vec3& up, double radius, bool clip) {
     const auto s = ground_spacing(mesh, g, v, up);
     if (!s.ok) return {};
     const auto pixel = mesh.vertex_pixel[std::size_t(v)];
@@ -136,7 +148,7 @@ DiskWindow vertex_disk(const TriangleMesh& mesh, const GridLayout& g, std::int32
     const double ur = rise(s.row, 0, 1).value_or(-dot(normal, s.row) / nup);
     const double r2 = radius * radius;
     return ellipse_window((dot(s.col, s.col) + uc * uc) / r2, (dot(s.col, s.row) + uc * ur) / r2,
-                          (dot(s.row, s.row) + ur * ur) / r2);
+                          (dot(s.row, s.row) + ur * ur) / r2, clip ? kMaxReach : 0);
 }
 
 // The disk neighbourhood of v on the mesh: the vertices whose pixels are in its window (a
@@ -281,11 +293,11 @@ NormalEquations monge_equations(const double* m) {
 
 // The disk window of v in its tile's frame, gathered on the mesh, and its Monge fit.
 bool disk_mesh_fit(const TriangleMesh& mesh, const GridLayout& g, std::int32_t v,
-                   const Vec3& normal, double radius, Scratch& s, PrincipalCurvatures& k,
+                   const Vec3& normal, double radius, bool clip, Scratch& s, PrincipalCurvatures& k,
                    double& scale) {
     const auto pixel = mesh.vertex_pixel[std::size_t(v)];
     const auto frame = tile_frame(mesh, g, pixel % g.width, pixel / g.width);
-    gather_disk(mesh, g, v, vertex_disk(mesh, g, v, normal, frame.up, radius), s);
+    gather_disk(mesh, g, v, vertex_disk(mesh, g, v, normal, frame.up, radius, clip), s);
     double m[kMonge] = {};
     double mono[kMonge];
     const auto& centre = mesh.positions()[std::size_t(v)];
@@ -296,6 +308,52 @@ bool disk_mesh_fit(const TriangleMesh& mesh, const GridLayout& g, std::int32_t v
     const auto e = monge_equations(m);
     scale = e.scale;
     return solve_curvatures(e, k);
+}
+
+double typical_disk_reach(const TriangleMesh& mesh, double radius) {
+    const int w = mesh.grid_width, h = mesh.grid_height;
+    const std::size_t pixels = std::size_t(std::max(w, 0)) * std::size_t(std::max(h, 0));
+    if (pixels == 0 || mesh.pixel_vertex.size() != pixels) return 0;
+    constexpr std::size_t kSamples = 4096;
+    const std::size_t stride = std::max<std::size_t>(1, pixels / kSamples);
+    std::vector<double> along[2];  // between neighbouring columns, between neighbouring rows
+    for (std::size_t i = 0; i < pixels; i += stride) {
+        const auto v = mesh.pixel_vertex[i];
+        if (v < 0) continue;
+        const int col = int(i % std::size_t(w)), row = int(i / std::size_t(w));
+        const std::int32_t next[2] = {col + 1 < w ? mesh.pixel_vertex[i + 1] : -1,
+                                      row + 1 < h ? mesh.pixel_vertex[i + std::size_t(w)] : -1};
+        for (int axis = 0; axis < 2; ++axis)
+            if (next[axis] >= 0) {
+                const Vec3 d = sub(mesh.positions()[std::size_t(next[axis])],
+                                   mesh.positions()[std::size_t(v)]);
+                along[axis].push_back(std::sqrt(dot(d, d)));
+            }
+    }
+    double finest = 0;
+    for (auto& distances : along) {
+        if (distances.empty()) continue;
+        const auto mid = distances.begin() + std::ptrdiff_t(distances.size() / 2);
+        std::nth_element(distances.begin(), mid, distances.end());
+        if (*mid > 0 && (finest == 0 || *mid < finest)) finest = *mid;
+    }
+    return finest > 0 ? radius / finest : 0.0;
+}
+
+void check_disk_reach(const TriangleMesh& mesh, double radius, const char* name) {
+    const double reach = typical_disk_reach(mesh, radius);
+    if (!(reach > kMaxReach)) return;
+    const auto metres = [](double x) {
+        char text[32];
+        std::snprintf(text, sizeof text, "%.0f", x);
+        return std::string(text);
+    };
+    throw Error("field", std::string(name) + " " + metres(radius) + " m reaches " + metres(reach) +
+                             " pixels of this DEM; the disk window reaches at "
+                             "most " +
+                             std::to_string(kMaxReach) + ": give at most " +
+                             metres(radius * kMaxReach / reach) +
+                             " m, or a DEM averaged to coarser pixels (gdalwarp -tr)");
 }
 
 // The vertices of one tile of output pixels [c0, c0 + t) x [r0, r0 + t), t = g.disk_tile,
@@ -319,8 +377,8 @@ void disk_tile(const TriangleMesh& mesh, const GridLayout& g, const Normals& nor
     };
     int mx = 0, my = 0;
     g.for_each_vertex(r0, r1, c0, c1, [&](std::int32_t v, int col, int row) {
-        const auto& d = disk_of(col, row) =
-            vertex_disk(mesh, g, v, normals[std::size_t(v)], frame.up, options.radius);
+        const auto& d = disk_of(col, row) = vertex_disk(
+            mesh, g, v, normals[std::size_t(v)], frame.up, options.radius, !options.skip_wide);
         if (d.reach_x <= kMaxReach && d.reach_y <= kMaxReach)
             mx = std::max(mx, d.reach_x), my = std::max(my, d.reach_y);
     });

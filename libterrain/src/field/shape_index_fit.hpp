@@ -292,8 +292,6 @@ RegionStatus region_sums(const TriangleMesh& mesh, const GridLayout& g, int r0, 
     const int W = g.width, H = g.height;
     if (mx > kMaxReach || my > kMaxReach) return RegionStatus::mesh_path;
     const int rr0 = std::max(0, r0 - my), rr1 = std::min(H, r1 + my);
-    for (int row : mesh.pole_rows)
-        if (row >= rr0 && row < rr1) return RegionStatus::mesh_path;
     int cc0 = c0 - mx, cc1 = c1 + mx;
     if (g.seam) {
         if (cc1 - cc0 > W) return RegionStatus::mesh_path;
@@ -302,6 +300,18 @@ RegionStatus region_sums(const TriangleMesh& mesh, const GridLayout& g, int r0, 
     }
     const int rows = rr1 - rr0, cols = cc1 - cc0;
     const auto region_col = [&](int col) { return ((col % W) + W) % W; };
+    // A collapsed pole row is one vertex, the pole, at its first pixel (where the mesh path
+    // finds it: TriangleMesh::vertex_pixel); the row's other pixels hold none.
+    const auto region_vertex = [&](int col, int row) -> std::int32_t {
+        for (int k = 0; k < 2; ++k)
+            if (row == mesh.pole_rows[std::size_t(k)]) {
+                const auto pole = mesh.pole_vertices[std::size_t(k)];
+                const auto pixel =
+                    std::int32_t(std::size_t(row) * std::size_t(W) + std::size_t(col));
+                return pole >= 0 && mesh.vertex_pixel[std::size_t(pole)] == pixel ? pole : -1;
+            }
+        return g.vertex_at(col, row);
+    };
     Vec3 ref{0, 0, 0};
     bool any = false;
     for (int row = r0; row < r1 && !any; ++row)
@@ -317,7 +327,7 @@ RegionStatus region_sums(const TriangleMesh& mesh, const GridLayout& g, int r0, 
         double* running = &s.prefix[std::size_t(lr) * std::size_t(cols + 1) * N];
         std::fill_n(running, N, 0.0);
         for (int lc = 0; lc < cols; ++lc) {
-            const auto v = g.vertex_at(region_col(cc0 + lc), rr0 + lr);
+            const auto v = region_vertex(region_col(cc0 + lc), rr0 + lr);
             Vec3 p{std::numeric_limits<double>::quiet_NaN(), 0, 0};
             double* next = running + N;
             if (v < 0) {
@@ -340,8 +350,17 @@ RegionStatus region_sums(const TriangleMesh& mesh, const GridLayout& g, int r0, 
 // The disk window of v in its tile's frame, gathered on the mesh, and its Monge fit
 // (shape_index_disk.cpp).
 bool disk_mesh_fit(const TriangleMesh& mesh, const GridLayout& g, std::int32_t v,
-                   const Vec3& normal, double radius, Scratch& s, PrincipalCurvatures& k,
+                   const Vec3& normal, double radius, bool clip, Scratch& s, PrincipalCurvatures& k,
                    double& scale);
+
+// How many pixels the disk window of `radius` reaches from a typical vertex of a DEM mesh:
+// the radius over the median distance between neighbouring pixels along the grid's finer
+// axis (at most 4096 pixels sampled on a fixed stride); 0 when no two pixels neighbour.
+double typical_disk_reach(const TriangleMesh& mesh, double radius);
+// Throws terrain::Error when the disk window of `radius` (the option `name`) reaches beyond
+// the grid method's tables (kMaxReach) from a typical vertex: every window would be gathered
+// on the mesh, at a cost growing with its area.
+void check_disk_reach(const TriangleMesh& mesh, double radius, const char* name);
 
 // The vertices of one tile of output pixels [c0, c0 + t) x [r0, r0 + t), t = g.disk_tile,
 // with the disk window, through `body` (shape_index_disk.cpp).
