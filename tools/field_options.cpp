@@ -115,7 +115,7 @@ void check_field_limits(const field::FieldOptions& options, const TriangleMesh& 
         return;
     if (std::string(field::shape_index_window(mesh, options.shape_index)) == "disk") {
         // Any radius the tables hold costs the same (the field refuses one reaching further:
-        // field::detail::check_disk_reach); one wider than the grid sees nothing more.
+        // field::detail::check_window_reach); one wider than the grid sees nothing more.
         const double spacing = std::sqrt(mean_vertex_area(mesh));
         const double across = double(std::max(mesh.grid_width, mesh.grid_height)) * spacing;
         if (options.shape_index.radius > across)

@@ -547,11 +547,10 @@ TEST_CASE("shape index with the disk window is the same whatever the thread coun
     CHECK(one == two);
 }
 
-TEST_CASE("a radius the disk window's tables cannot hold is refused before any fit",
-          "[shape_index]") {
+TEST_CASE("a radius the window's tables cannot hold is refused before any fit", "[shape_index]") {
     // 1 m pixels: a radius of 140 m reaches 140 pixels, past the tables' 128. Every window
     // would be gathered on the mesh, at a cost growing with its area (minutes here, hours
-    // on a 1000 x 1000 tile); one line says what the disk window holds instead.
+    // on a 1000 x 1000 tile); one line says what the tables hold instead.
     const auto mesh = mesh::dem_to_mesh(analytic(
         200, 1.0, [](double x, double y) { return std::sin(x * 0.05) * std::cos(y * 0.04) * 5; }));
     field::ShapeIndexOptions options;
@@ -561,6 +560,10 @@ TEST_CASE("a radius the disk window's tables cannot hold is refused before any f
         field::shape_index_field(mesh, options),
         Catch::Contains("--radius 140 m reaches 140 pixels") && Catch::Contains("at most 128"));
     CHECK_THROWS_AS(field::principal_curvatures(mesh, options), Error);
+    // The ball by the grid method has the same tables.
+    options.window = field::ShapeIndexWindow::ball;
+    CHECK_THROWS_WITH(field::shape_index_field(mesh, options),
+                      Catch::Contains("--radius 140 m reaches 140 pixels"));
     // A ladder given with a rung beyond the tables, and one within them.
     field::ShapeIndexOptions ladder;
     ladder.auto_scale = true;

@@ -128,7 +128,7 @@ std::vector<double> checked_ladder(const TriangleMesh& mesh, const ShapeIndexOpt
             throw Error("field", "--radii must be positive metres in increasing order");
     // A rung the disk window's tables cannot hold would be gathered on the mesh at its first
     // rung and skipped at the others (the default ladder stays within them).
-    if (!options.radii.empty()) detail::check_disk_reach(mesh, radii.back(), "--radii");
+    if (!options.radii.empty()) detail::check_window_reach(mesh, radii.back(), "--radii");
     if (!(options.contrast_curvedness >= 0) || !std::isfinite(options.contrast_curvedness))
         throw Error("field", "the contrast curvedness must be a number >= 0");
     if (!(options.peak_dominance >= 1) || !std::isfinite(options.peak_dominance))

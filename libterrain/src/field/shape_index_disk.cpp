@@ -340,7 +340,7 @@ double typical_disk_reach(const TriangleMesh& mesh, double radius) {
     return finest > 0 ? radius / finest : 0.0;
 }
 
-void check_disk_reach(const TriangleMesh& mesh, double radius, const char* name) {
+void check_window_reach(const TriangleMesh& mesh, double radius, const char* name) {
     const double reach = typical_disk_reach(mesh, radius);
     if (!(reach > kMaxReach)) return;
     const auto metres = [](double x) {
@@ -349,7 +349,7 @@ void check_disk_reach(const TriangleMesh& mesh, double radius, const char* name)
         return std::string(text);
     };
     throw Error("field", std::string(name) + " " + metres(radius) + " m reaches " + metres(reach) +
-                             " pixels of this DEM; the disk window reaches at "
+                             " pixels of this DEM; the window's tables reach at "
                              "most " +
                              std::to_string(kMaxReach) + ": give at most " +
                              metres(radius * kMaxReach / reach) +

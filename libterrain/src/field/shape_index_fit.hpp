@@ -357,10 +357,10 @@ bool disk_mesh_fit(const TriangleMesh& mesh, const GridLayout& g, std::int32_t v
 // the radius over the median distance between neighbouring pixels along the grid's finer
 // axis (at most 4096 pixels sampled on a fixed stride); 0 when no two pixels neighbour.
 double typical_disk_reach(const TriangleMesh& mesh, double radius);
-// Throws terrain::Error when the disk window of `radius` (the option `name`) reaches beyond
-// the grid method's tables (kMaxReach) from a typical vertex: every window would be gathered
-// on the mesh, at a cost growing with its area.
-void check_disk_reach(const TriangleMesh& mesh, double radius, const char* name);
+// Throws terrain::Error when a window of `radius` (the option `name`: the disk, or the ball
+// by the grid method) reaches beyond the grid method's tables (kMaxReach) from a typical
+// vertex: every window would be gathered on the mesh, at a cost growing with its area.
+void check_window_reach(const TriangleMesh& mesh, double radius, const char* name);
 
 // The vertices of one tile of output pixels [c0, c0 + t) x [r0, r0 + t), t = g.disk_tile,
 // with the disk window, through `body` (shape_index_disk.cpp).
