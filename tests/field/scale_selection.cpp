@@ -345,11 +345,12 @@ TEST_CASE("near a geographic grid's poles a wide disk window is cut to the table
 }
 
 TEST_CASE("the ladder reaches a crater next to a pole", "[scale_selection]") {
-    // The Moon's sphere at 1 pixel a degree with a bowl of 240 km radius (8 rows) centred at
+    // The Moon's sphere at 1 pixel a degree with a bowl of 150 km radius (5 rows) centred at
     // 80 N: its tiles' tables touch the collapsed pole row, and the ladder must still see the
-    // bowl at its own scale (a rung above the first), concave, as at the equator.
+    // bowl at its own scale (8 pixels or wider, not the first 2), concave, as at the equator.
+    // (Its vertices' windows are held up to 16 pixels there, so the peak is seen to fall.)
     auto dem = moon_sphere(360);
-    const double a = 240e3, depth = 0.1 * a;
+    const double a = 150e3, depth = 0.1 * a;
     const auto bowl_at = [&](double lat0) {
         std::vector<double> z(dem.values.size(), 0.0);
         const double deg = std::numbers::pi / 180;
@@ -380,5 +381,38 @@ TEST_CASE("the ladder reaches a crater next to a pole", "[scale_selection]") {
                         << out.field[std::size_t(v)]);
         CHECK(out.scale[std::size_t(v)] >= 2);  // 8 pixels or wider, not the first 2
         CHECK(out.field[std::size_t(v)] < 25);
+    }
+}
+
+TEST_CASE("a landform wider than a polar vertex's ladder reads nearly planar there",
+          "[scale_selection]") {
+    // A wide cup of 1 000 km radius, 400 km deep (curvedness still rising at every rung), on
+    // the 1-degree Moon. At the equator it rises to the ladder's top (776 km): no peak,
+    // nearly planar. At 80 N the top rungs' windows span more than the tables' 128 columns,
+    // so its vertices' ladder ends at 388 km; a rise into that rung is a rise to their top
+    // as well, not a peak.
+    auto dem = moon_sphere(360);
+    const double a = 1000e3, depth = 400e3;
+    field::ShapeIndexOptions options;
+    options.auto_scale = true;
+    for (double lat0 : {0.0, 80.0}) {
+        const double deg = std::numbers::pi / 180;
+        for (int r = 0; r < dem.height; ++r)
+            for (int c = 0; c < dem.width; ++c) {
+                const double lat = (89.5 - r) * deg, lon = (-179.5 + c) * deg;
+                const double cosd = std::sin(lat) * std::sin(lat0 * deg) +
+                                    std::cos(lat) * std::cos(lat0 * deg) * std::cos(lon);
+                const double d = kMoonRadius * std::acos(std::clamp(cosd, -1.0, 1.0));
+                dem.values[std::size_t(r) * std::size_t(dem.width) + std::size_t(c)] =
+                    d < a ? -depth * (1 - (d / a) * (d / a)) : 0.0;
+            }
+        const auto mesh = mesh::dem_to_mesh(dem);
+        const auto out = field::scale_selected_shape_index(mesh, options);
+        const int row = int(std::lround(89.5 - lat0));
+        const auto v = mesh.pixel_vertex[std::size_t(row) * 360 + 180];
+        REQUIRE(v >= 0);
+        INFO("cup at " << lat0 << " N: rung " << int(out.scale[std::size_t(v)]) << " of "
+                       << out.radii.size() << ", field " << out.field[std::size_t(v)]);
+        CHECK(std::abs(out.field[std::size_t(v)] - 50.0f) < 15.0f);
     }
 }

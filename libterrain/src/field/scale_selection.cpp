@@ -240,11 +240,14 @@ ScaleSelectedField scale_selected_shape_index(const TriangleMesh& mesh,
                 previous_f[v] = f;
             });
     }
-    // The last rung each vertex reached: a peak if the curvedness rose into it (at the
-    // ladder's top only when the ladder is that vertex's whole ladder).
+    // The last rung each vertex reached ends its ladder: the ladder's top, or the last rung
+    // whose window the tables hold (near a pole, or where a geographic grid's pixels are
+    // narrow, the wider ones are skipped). A rise into it is a rise to the top, no peak, for
+    // a vertex that sees the whole ladder and for one that does not (with three rungs or
+    // more).
     for (std::size_t v = 0; v < n; ++v) {
         if (!(state[v] & kSeen) || !(state[v] & kRising)) continue;
-        const bool top = std::size_t(previous_rung(v)) + 1 == rungs && rungs >= 3;
+        const bool top = rungs >= 3;
         peak(v, previous_rung(v), previous_c[v], previous_f[v], top);
     }
     report_progress(progress, 1.0, "shape index");

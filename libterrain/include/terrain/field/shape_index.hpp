@@ -53,8 +53,9 @@ struct ShapeIndexOptions {
     // (curvedness x radius) followed up the ladder. Each local maximum of c over the ladder
     // is a peak; a vertex takes its first significant peak (c >= contrast_curvedness) unless
     // a later one is peak_dominance times as strong, or its strongest peak when none is
-    // significant; a rise to the ladder's top is no peak (the landform is wider than the
-    // ladder: a quarter of that rung's contrast, nearly planar). The field is 50 + 50 SI w, the
+    // significant; a rise to the ladder's top (or to the last rung whose window the tables
+    // hold) is no peak (the landform is wider than the ladder: a quarter of that rung's
+    // contrast, nearly planar). The field is 50 + 50 SI w, the
     // shape index of the chosen radius with its contrast w = c^2 / (c^2 + contrast_curvedness^2):
     // shapes too weak to be seen at any scale read as planar. c is the part the DEM's pixel
     // noise does not explain: sqrt(max(0, c^2 - (3 s)^2)), s the spread of curvedness that
