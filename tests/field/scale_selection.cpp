@@ -273,6 +273,24 @@ Dem moon_sphere(int width) {
 
 constexpr double kMoonRadius = 1737400;
 
+// Heights of a paraboloid cup on moon_sphere's grid: -depth (1 - (d / a)^2) within a great-
+// circle distance d < a of (lat0, 0), 0 elsewhere.
+std::vector<double> cup_on_sphere(const Dem& dem, double lat0, double a, double depth) {
+    const double deg = std::numbers::pi / 180, step = 360.0 / dem.width;
+    std::vector<double> z(std::size_t(dem.width) * std::size_t(dem.height), 0.0);
+    for (int r = 0; r < dem.height; ++r)
+        for (int c = 0; c < dem.width; ++c) {
+            const double lat = (90 - (r + 0.5) * step) * deg, lon = (-180 + (c + 0.5) * step) * deg;
+            const double cosd = std::sin(lat) * std::sin(lat0 * deg) +
+                                std::cos(lat) * std::cos(lat0 * deg) * std::cos(lon);
+            const double d = kMoonRadius * std::acos(std::clamp(cosd, -1.0, 1.0));
+            if (d < a)
+                z[std::size_t(r) * std::size_t(dem.width) + std::size_t(c)] =
+                    -depth * (1 - (d / a) * (d / a));
+        }
+    return z;
+}
+
 }  // namespace
 
 TEST_CASE("the disk fit's bias on a sphere is the one the ladder takes off", "[scale_selection]") {
@@ -351,26 +369,10 @@ TEST_CASE("the ladder reaches a crater next to a pole", "[scale_selection]") {
     // (Its vertices' windows are held up to 16 pixels there, so the peak is seen to fall.)
     auto dem = moon_sphere(360);
     const double a = 150e3, depth = 0.1 * a;
-    const auto bowl_at = [&](double lat0) {
-        std::vector<double> z(dem.values.size(), 0.0);
-        const double deg = std::numbers::pi / 180;
-        for (int r = 0; r < dem.height; ++r)
-            for (int c = 0; c < dem.width; ++c) {
-                const double lat = (89.5 - r) * deg, lon = (-179.5 + c) * deg;
-                // Great-circle distance from (lat0, 0).
-                const double cosd = std::sin(lat) * std::sin(lat0 * deg) +
-                                    std::cos(lat) * std::cos(lat0 * deg) * std::cos(lon);
-                const double d = kMoonRadius * std::acos(std::clamp(cosd, -1.0, 1.0));
-                if (d < a)
-                    z[std::size_t(r) * std::size_t(dem.width) + std::size_t(c)] =
-                        -depth * (1 - (d / a) * (d / a));
-            }
-        return z;
-    };
     field::ShapeIndexOptions options;
     options.auto_scale = true;
     for (double lat0 : {80.0, 0.0}) {
-        dem.values = bowl_at(lat0);
+        dem.values = cup_on_sphere(dem, lat0, a, depth);
         const auto mesh = mesh::dem_to_mesh(dem);
         REQUIRE(mesh.pole_rows[0] == 0);
         const auto out = field::scale_selected_shape_index(mesh, options);
@@ -396,16 +398,7 @@ TEST_CASE("a landform wider than a polar vertex's ladder reads nearly planar the
     field::ShapeIndexOptions options;
     options.auto_scale = true;
     for (double lat0 : {0.0, 80.0}) {
-        const double deg = std::numbers::pi / 180;
-        for (int r = 0; r < dem.height; ++r)
-            for (int c = 0; c < dem.width; ++c) {
-                const double lat = (89.5 - r) * deg, lon = (-179.5 + c) * deg;
-                const double cosd = std::sin(lat) * std::sin(lat0 * deg) +
-                                    std::cos(lat) * std::cos(lat0 * deg) * std::cos(lon);
-                const double d = kMoonRadius * std::acos(std::clamp(cosd, -1.0, 1.0));
-                dem.values[std::size_t(r) * std::size_t(dem.width) + std::size_t(c)] =
-                    d < a ? -depth * (1 - (d / a) * (d / a)) : 0.0;
-            }
+        dem.values = cup_on_sphere(dem, lat0, a, depth);
         const auto mesh = mesh::dem_to_mesh(dem);
         const auto out = field::scale_selected_shape_index(mesh, options);
         const int row = int(std::lround(89.5 - lat0));
