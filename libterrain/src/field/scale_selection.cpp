@@ -126,8 +126,8 @@ std::vector<double> checked_ladder(const TriangleMesh& mesh, const ShapeIndexOpt
     for (std::size_t i = 0; i < radii.size(); ++i)
         if (!(radii[i] > 0) || !std::isfinite(radii[i]) || (i > 0 && !(radii[i] > radii[i - 1])))
             throw Error("field", "--radii must be positive metres in increasing order");
-    // A rung the disk window's tables cannot hold would be gathered on the mesh at its first
-    // rung and skipped at the others (the default ladder stays within them).
+    // A rung the disk window's tables cannot hold would be cut to them at the first rung and
+    // skipped at the others, on most vertices (the default ladder stays within them).
     if (!options.radii.empty()) detail::check_window_reach(mesh, radii.back(), "--radii");
     if (!(options.contrast_curvedness >= 0) || !std::isfinite(options.contrast_curvedness))
         throw Error("field", "the contrast curvedness must be a number >= 0");
@@ -193,7 +193,7 @@ ScaleSelectedField scale_selected_shape_index(const TriangleMesh& mesh,
         chosen_c[v] = c;
         out.scale[v] = rung;
         const float value = float(f / kFieldUnit);
-        out.field[v] = top && rungs >= 3 ? 50.0f + kTopContrast * (value - 50.0f) : value;
+        out.field[v] = top ? 50.0f + kTopContrast * (value - 50.0f) : value;
         state[v] =
             std::uint8_t((state[v] & ~kSignificant) | kChosen | (significant ? kSignificant : 0));
     };
@@ -245,11 +245,10 @@ ScaleSelectedField scale_selected_shape_index(const TriangleMesh& mesh,
     // narrow, the wider ones are skipped). A rise into it is a rise to the top, no peak, for
     // a vertex that sees the whole ladder and for one that does not (with three rungs or
     // more).
-    for (std::size_t v = 0; v < n; ++v) {
-        if (!(state[v] & kSeen) || !(state[v] & kRising)) continue;
-        const bool top = rungs >= 3;
-        peak(v, previous_rung(v), previous_c[v], previous_f[v], top);
-    }
+    const bool top = rungs >= 3;
+    for (std::size_t v = 0; v < n; ++v)
+        if ((state[v] & kSeen) && (state[v] & kRising))
+            peak(v, previous_rung(v), previous_c[v], previous_f[v], top);
     report_progress(progress, 1.0, "shape index");
     return out;
 }

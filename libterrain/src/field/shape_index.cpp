@@ -172,7 +172,8 @@ void for_each_vertex(const TriangleMesh& mesh, const ShapeIndexOptions& options,
     // Normals 0 to 0.05 of the progress (the grid method's, when made by bands, with its
     // tiles), the grid's layout to 0.06, the vertices to 1.
     const bool grid = grid_applies(mesh, options), disk = disk_applies(mesh, options);
-    // A window the tables cannot hold would be gathered on the mesh at a cost of its area.
+    // Most windows reaching past the tables: the disk's would be cut to them, the ball's
+    // gathered on the mesh at a cost of its area.
     if ((disk || grid) && !options.skip_wide) check_window_reach(mesh, options.radius, "--radius");
     if (grid) return grid_method_for_each_vertex(mesh, options, progress, body);
     const auto normals = vertex_normals(mesh, scaled_progress(progress, 0, 0.05));

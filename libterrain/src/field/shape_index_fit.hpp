@@ -359,7 +359,8 @@ bool disk_mesh_fit(const TriangleMesh& mesh, const GridLayout& g, std::int32_t v
 double typical_disk_reach(const TriangleMesh& mesh, double radius);
 // Throws terrain::Error when a window of `radius` (the option `name`: the disk, or the ball
 // by the grid method) reaches beyond the grid method's tables (kMaxReach) from a typical
-// vertex: every window would be gathered on the mesh, at a cost growing with its area.
+// vertex: most disks would be cut to the tables' reach (vertex_disk's clip), and balls
+// gathered on the mesh at a cost growing with their area.
 void check_window_reach(const TriangleMesh& mesh, double radius, const char* name);
 
 // The vertices of one tile of output pixels [c0, c0 + t) x [r0, r0 + t), t = g.disk_tile,
