@@ -10,6 +10,7 @@
 #include <numbers>
 #include <vector>
 
+#include "../../libterrain/src/field/shape_index_fit.hpp"
 #include "terrain/core/error.hpp"
 #include "terrain/field/shape_index.hpp"
 #include "terrain/geo/body.hpp"
@@ -79,6 +80,23 @@ TEST_CASE("the ladder: 2 to 128 pixels, below half the grid", "[scale_selection]
     TriangleMesh file_mesh = mesh;
     file_mesh.grid_width = file_mesh.grid_height = 0;
     CHECK_THROWS_AS(field::default_radii(file_mesh), Error);
+}
+
+TEST_CASE("the default ladder stays within the tables on pixels longer than wide",
+          "[scale_selection]") {
+    // Pixels of 1 m across and 4 m down: the mean spacing is 2 m, the finer axis 1 m, so a
+    // ladder of 2 to 128 mean spacings would reach 256 pixels along the rows.
+    Dem dem = grid(600, [](double, double) { return 0.0; });
+    dem.transform = {0, 1, 0, 0, 0, -4};
+    const auto mesh = mesh::dem_to_mesh(dem);
+    const auto radii = field::default_radii(mesh);
+    REQUIRE(radii.size() >= 2);
+    CHECK(radii.back() <= 128.0 * 1.0001);
+    // The ladder it gives is one the check of a given ladder takes, and runs as listed.
+    field::ShapeIndexOptions options;
+    options.auto_scale = true;
+    options.radii = radii;
+    CHECK(field::scale_selected_shape_index(mesh, options).radii == radii);
 }
 
 TEST_CASE("each crater is seen at its own radius, the plane reads planar", "[scale_selection]") {
@@ -315,6 +333,16 @@ TEST_CASE("the disk fit's bias on a sphere is the one the ladder takes off", "[s
         CHECK(fitted * kMoonRadius - 1 > 0.01 * share * share);  // wider than the sphere's 1/r
         CHECK(std::abs(fitted - seen) * kMoonRadius < 0.15 * (fitted * kMoonRadius - 1));
     }
+}
+
+TEST_CASE("a window's reach is taken at a typical place of a global grid, not pixel",
+          "[scale_selection]") {
+    // Half of a sphere's area lies within 30 degrees of the equator, where a 1-degree grid's
+    // columns are 2 pi R / 360 cos(30) apart; half its pixels lie within 45 (cos 45: the
+    // narrow polar pixels would make a window reaching 128 pixels at 30 degrees reach 157).
+    const auto mesh = mesh::dem_to_mesh(moon_sphere(360));
+    const double column = 2 * std::numbers::pi * kMoonRadius / 360 * std::cos(std::numbers::pi / 6);
+    CHECK(field::detail::typical_disk_reach(mesh, 100 * column) == Approx(100).epsilon(0.02));
 }
 
 TEST_CASE("a body's own sphere reads planar at every rung", "[scale_selection]") {

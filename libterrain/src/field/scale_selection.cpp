@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -108,9 +109,22 @@ std::vector<double> default_radii(const TriangleMesh& mesh) {
     double limit = std::max(4.0, 0.5 * std::min(mesh.grid_width, mesh.grid_height));
     if (mesh.frame == MeshFrame::body && mesh.body.semi_minor_axis() > 0)
         limit = std::min(limit, kLadderBodyShare * mesh.body.semi_minor_axis() / spacing);
+    // A rung whose window would reach beyond the tables at a typical place (pixels longer than
+    // wide, a geographic tile far from the equator) comes down to their reach, the ladder's
+    // last; within a quarter of the rung below, it is left out. Past the reach a rung would
+    // be skipped at most vertices, and is refused if given with --radii.
+    const double per_metre = detail::typical_disk_reach(mesh, 1.0);
+    const double top =
+        per_metre > 0 ? detail::kMaxReach / per_metre : std::numeric_limits<double>::infinity();
     std::vector<double> radii;
-    for (double pixels = 2; pixels <= 128 && (pixels <= limit || radii.size() < 2); pixels *= 2)
-        radii.push_back(pixels * spacing);
+    for (double pixels = 2; pixels <= 128 && (pixels <= limit || radii.size() < 2); pixels *= 2) {
+        const double radius = pixels * spacing;
+        if (radius > top && radii.size() >= 2) {
+            if (top >= 1.25 * radii.back()) radii.push_back(top);
+            break;
+        }
+        radii.push_back(radius);
+    }
     return radii;
 }
 

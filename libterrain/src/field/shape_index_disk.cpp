@@ -8,6 +8,7 @@
 #include <numbers>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "shape_index_fit.hpp"
@@ -314,12 +315,16 @@ double typical_disk_reach(const TriangleMesh& mesh, double radius) {
     const int w = mesh.grid_width, h = mesh.grid_height;
     const std::size_t pixels = std::size_t(std::max(w, 0)) * std::size_t(std::max(h, 0));
     if (pixels == 0 || mesh.pixel_vertex.size() != pixels) return 0;
+    const bool weighted = mesh.vertex_areas.size() == mesh.vertex_count();
     constexpr std::size_t kSamples = 4096;
     const std::size_t stride = std::max<std::size_t>(1, pixels / kSamples);
-    std::vector<double> along[2];  // between neighbouring columns, between neighbouring rows
+    // (distance, area of the vertex it starts at): between neighbouring columns, rows.
+    std::vector<std::pair<double, double>> along[2];
     for (std::size_t i = 0; i < pixels; i += stride) {
         const auto v = mesh.pixel_vertex[i];
         if (v < 0) continue;
+        const double area = weighted ? double(mesh.vertex_areas[std::size_t(v)]) : 1.0;
+        if (!(area > 0)) continue;
         const int col = int(i % std::size_t(w)), row = int(i / std::size_t(w));
         const std::int32_t next[2] = {col + 1 < w ? mesh.pixel_vertex[i + 1] : -1,
                                       row + 1 < h ? mesh.pixel_vertex[i + std::size_t(w)] : -1};
@@ -327,15 +332,24 @@ double typical_disk_reach(const TriangleMesh& mesh, double radius) {
             if (next[axis] >= 0) {
                 const Vec3 d = sub(mesh.positions()[std::size_t(next[axis])],
                                    mesh.positions()[std::size_t(v)]);
-                along[axis].push_back(std::sqrt(dot(d, d)));
+                along[axis].emplace_back(std::sqrt(dot(d, d)), area);
             }
     }
+    // The median by area: the spacing at a typical place of the surface (a geographic grid's
+    // many narrow polar pixels hold little of it).
     double finest = 0;
     for (auto& distances : along) {
         if (distances.empty()) continue;
-        const auto mid = distances.begin() + std::ptrdiff_t(distances.size() / 2);
-        std::nth_element(distances.begin(), mid, distances.end());
-        if (*mid > 0 && (finest == 0 || *mid < finest)) finest = *mid;
+        std::sort(distances.begin(), distances.end());
+        double total = 0;
+        for (const auto& d : distances) total += d.second;
+        double below = 0, mid = distances.back().first;
+        for (const auto& d : distances)
+            if ((below += d.second) >= 0.5 * total) {
+                mid = d.first;
+                break;
+            }
+        if (mid > 0 && (finest == 0 || mid < finest)) finest = mid;
     }
     return finest > 0 ? radius / finest : 0.0;
 }

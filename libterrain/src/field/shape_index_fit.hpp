@@ -353,9 +353,10 @@ bool disk_mesh_fit(const TriangleMesh& mesh, const GridLayout& g, std::int32_t v
                    const Vec3& normal, double radius, bool clip, Scratch& s, PrincipalCurvatures& k,
                    double& scale);
 
-// How many pixels the disk window of `radius` reaches from a typical vertex of a DEM mesh:
+// How many pixels the disk window of `radius` reaches from a typical place of a DEM mesh:
 // the radius over the median distance between neighbouring pixels along the grid's finer
-// axis (at most 4096 pixels sampled on a fixed stride); 0 when no two pixels neighbour.
+// axis, the median taken by the vertices' areas (at most 4096 pixels sampled on a fixed
+// stride); 0 when no two pixels neighbour.
 double typical_disk_reach(const TriangleMesh& mesh, double radius);
 // Throws terrain::Error when a window of `radius` (the option `name`: the disk, or the ball
 // by the grid method) reaches beyond the grid method's tables (kMaxReach) from a typical
