@@ -18,7 +18,8 @@ scored instead, per diameter bin: the regions by the rule above (with why each m
 missed: the bowl's region not concave, spread beyond 1.3 R, or covering under 40 % of the
 bowl), the share of the concave regions of that size whose centroid lies within 0.6 R of a
 catalogued crater, and the crater table (craters.csv) by crater_table_score.py's rule (a
-table crater within 0.5 R of the centre with a diameter within a factor 1.5). No
+table crater within 0.5 R of the centre with a diameter within a factor 1.5): its recall, and
+its precision against the catalogue's craters of the same range and against all of them. No
 catalogue ships with the project: a published one is the user's to give.
 """
 import argparse
@@ -196,17 +197,25 @@ def score_catalogue(a, labels, mean, pixel_km, origin):
         ratio = t_d / d[i]
         hit[i] = np.any((dist < 0.25 * craters["diameter_px"][i]) & (ratio < 1.5) & (ratio > 1 / 1.5))
     in_range = (t_d >= a.min_km) & (t_d <= a.max_km) & (np.abs(t_lat) <= a.max_lat)
-    true = 0
+    # Precision against the craters of the same range, and against the whole catalogue (any
+    # size, any latitude): a listed crater of 60 km may be a catalogued one of 55.
+    a_lon, a_lat, a_d = read_catalogue(a.catalogue, 0, np.inf, 90)
+    a_col, a_row = grid_position(a_lon, a_lat, origin, w, h)
+    every = {"col": a_col, "row": a_row, "diameter_px": a_d / pixel_km,
+             "col_scale": np.cos(np.radians(a_lat))}
+    true = {"range": 0, "any": 0}
     for j in np.nonzero(in_range)[0]:
-        sx = np.cos(np.radians(lat))
-        dist = np.hypot(crater_score._wrap(craters["col"] - table["col"][j], w, True) * sx,
-                        craters["row"] - table["row"][j])
-        ratio = t_d[j] / d
-        true += bool(np.any((dist < 0.25 * craters["diameter_px"]) & (ratio < 1.5) & (ratio > 1 / 1.5)))
+        for key, (c, km) in (("range", (craters, d)), ("any", (every, a_d))):
+            dist = np.hypot(crater_score._wrap(c["col"] - table["col"][j], w, True) * c["col_scale"],
+                            c["row"] - table["row"][j])
+            ratio = t_d[j] / km
+            true[key] += bool(np.any((dist < 0.25 * c["diameter_px"]) & (ratio < 1.5)
+                                     & (ratio > 1 / 1.5)))
+    n = max(int(in_range.sum()), 1)
     print(f"crater table: recall {int(hit.sum())} of {len(d)} = {hit.mean() if len(d) else 0:.3f};"
-          f" precision {true} of {int(in_range.sum())} = {true / max(int(in_range.sum()), 1):.3f}"
-          " (precision counts only catalogued craters in the same diameter range)")
-
+          f" precision {true['range']} of {int(in_range.sum())} = {true['range'] / n:.3f} against"
+          f" the catalogue's {a.min_km:g}-{a.max_km:g} km, {true['any']} = {true['any'] / n:.3f}"
+          " against all of it")
 
 if __name__ == "__main__":
     main()
