@@ -345,6 +345,26 @@ TEST_CASE("a window's reach is taken at a typical place of a global grid, not pi
     CHECK(field::detail::typical_disk_reach(mesh, 100 * column) == Approx(100).epsilon(0.02));
 }
 
+TEST_CASE("a window's reach counts pixels on the ground, whatever the slope", "[scale_selection]") {
+    // A plane rising 1 m a pixel along both axes (1 m pixels): neighbours are 1.41 m apart
+    // in 3-D, 1 m on the ground, where a window counts its pixels.
+    const auto slope = mesh::dem_to_mesh(grid(200, [](double x, double y) { return x + y; }));
+    CHECK(field::detail::typical_disk_reach(slope, 100) == Approx(100).epsilon(0.01));
+    // A tile of the Moon at 30 N, 0.01 degree pixels: its vertices lie far from the body's
+    // centre (the mesh's origin holds that), the columns cos(30) of the rows apart.
+    Dem tile;
+    tile.width = tile.height = 100;
+    tile.crs_wkt = "IAU_2015:30100";
+    tile.transform = {10, 0.01, 0, 30.5, 0, -0.01};
+    tile.has_transform = true;
+    geo::georeference(tile);
+    tile.values.assign(100 * 100, 0.0);
+    const auto mesh = mesh::dem_to_mesh(tile);
+    const double column =
+        kMoonRadius * 0.01 * std::numbers::pi / 180 * std::cos(std::numbers::pi / 6);
+    CHECK(field::detail::typical_disk_reach(mesh, 100 * column) == Approx(100).epsilon(0.01));
+}
+
 TEST_CASE("a body's own sphere reads planar at every rung", "[scale_selection]") {
     const auto mesh = mesh::dem_to_mesh(moon_sphere(256));
     const auto radii = field::default_radii(mesh);

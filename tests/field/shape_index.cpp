@@ -574,6 +574,27 @@ TEST_CASE("a radius the window's tables cannot hold is refused before any fit", 
     CHECK_NOTHROW(field::scale_selected_shape_index(mesh, ladder));
 }
 
+TEST_CASE("above the ladder's first rung a window a little past the tables is cut to them",
+          "[shape_index]") {
+    // A cup z = (x^2 + y^2) / 2000 on 1 m pixels. With skip_wide (the ladder's rungs above
+    // the first) a window reaching 140 pixels, a little past the tables' 128, is cut to them
+    // and fitted: the cup reads as a cup. One reaching 170 (past 160) is skipped: no fit.
+    const auto mesh = mesh::dem_to_mesh(
+        analytic(400, 1.0, [](double x, double y) { return (x * x + y * y) / 2000; }));
+    field::ShapeIndexOptions options;
+    options.skip_wide = true;
+    const auto centre = [&](double radius) {
+        options.radius = radius;
+        const auto f = field::shape_index_field(mesh, options);
+        for (std::size_t v = 0; v < mesh.vertex_count(); ++v)
+            if (mesh.vertex_pixel[v] == 200 * 400 + 200) return f[v];
+        return -1.0f;
+    };
+    CHECK(centre(100) < 10);  // within the tables: a cup (shape index near -1)
+    CHECK(centre(140) < 10);
+    CHECK(centre(170) == Approx(50).margin(1e-3));  // skipped: planar
+}
+
 TEST_CASE("shape index with the disk window on real DEMs", "[shape_index][real_data]") {
     // Each radius with the largest median distance from the ball's values allowed (the
     // medians measured when the disk window came, plus about 30 %: on real terrain the two

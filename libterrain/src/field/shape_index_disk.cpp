@@ -318,7 +318,17 @@ double typical_disk_reach(const TriangleMesh& mesh, double radius) {
     const bool weighted = mesh.vertex_areas.size() == mesh.vertex_count();
     constexpr std::size_t kSamples = 4096;
     const std::size_t stride = std::max<std::size_t>(1, pixels / kSamples);
-    // (distance, area of the vertex it starts at): between neighbouring columns, rows.
+    // The vertical at a vertex: radial on the body, the map's z on a map.
+    const auto up_at = [&](std::int32_t v) -> Vec3 {
+        if (mesh.frame != MeshFrame::body) return {0, 0, 1};
+        const auto& q = mesh.positions()[std::size_t(v)];
+        const Vec3 p{mesh.origin[0] + q[0], mesh.origin[1] + q[1], mesh.origin[2] + q[2]};
+        const double r = std::sqrt(dot(p, p));
+        return r > 0 ? Vec3{p[0] / r, p[1] / r, p[2] / r} : Vec3{0, 0, 1};
+    };
+    // (ground distance, area of the vertex it starts at): between neighbouring columns, rows.
+    // On the ground, as a flat vertex's window counts its pixels: slopes lengthen the
+    // distances between neighbours, not the pixels' spacing across the ground.
     std::vector<std::pair<double, double>> along[2];
     for (std::size_t i = 0; i < pixels; i += stride) {
         const auto v = mesh.pixel_vertex[i];
@@ -332,7 +342,8 @@ double typical_disk_reach(const TriangleMesh& mesh, double radius) {
             if (next[axis] >= 0) {
                 const Vec3 d = sub(mesh.positions()[std::size_t(next[axis])],
                                    mesh.positions()[std::size_t(v)]);
-                along[axis].emplace_back(std::sqrt(dot(d, d)), area);
+                const double rise = dot(d, up_at(v));
+                along[axis].emplace_back(std::sqrt(std::max(0.0, dot(d, d) - rise * rise)), area);
             }
     }
     // The median by area: the spacing at a typical place of the surface (a geographic grid's
@@ -391,8 +402,14 @@ void disk_tile(const TriangleMesh& mesh, const GridLayout& g, const Normals& nor
     };
     int mx = 0, my = 0;
     g.for_each_vertex(r0, r1, c0, c1, [&](std::int32_t v, int col, int row) {
-        const auto& d = disk_of(col, row) = vertex_disk(
-            mesh, g, v, normals[std::size_t(v)], frame.up, options.radius, !options.skip_wide);
+        auto& d = disk_of(col, row) = vertex_disk(mesh, g, v, normals[std::size_t(v)], frame.up,
+                                                  options.radius, !options.skip_wide);
+        // Above the ladder's first rung a window a little past the tables (where a tile's
+        // pixels narrow away from the place its ladder's top was sized at) is cut to them, as
+        // the first rung's windows are; one further past is skipped.
+        if (options.skip_wide && std::max(d.reach_x, d.reach_y) > kMaxReach &&
+            std::max(d.reach_x, d.reach_y) <= kNearReach)
+            d = vertex_disk(mesh, g, v, normals[std::size_t(v)], frame.up, options.radius, true);
         if (d.reach_x <= kMaxReach && d.reach_y <= kMaxReach)
             mx = std::max(mx, d.reach_x), my = std::max(my, d.reach_y);
     });

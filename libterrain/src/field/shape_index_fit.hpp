@@ -113,6 +113,10 @@ constexpr double kMaxDiskTileAngle = 0.05;  // radians
 
 constexpr int kTile = 64;       // output pixels per tile side
 constexpr int kMaxReach = 128;  // a window reaching further (pixels) takes the mesh path
+// The ladder's rungs above the first cut a window reaching up to this far to kMaxReach
+// (a quarter past: a few per cent narrower across the tile's narrower pixels) and skip one
+// reaching further (disk_tile).
+constexpr int kNearReach = kMaxReach + kMaxReach / 4;
 
 // The vertex a pixel owns (-1 where none, and on collapsed pole rows), the grid's seam and
 // the disk window's tile size.
@@ -360,8 +364,8 @@ bool disk_mesh_fit(const TriangleMesh& mesh, const GridLayout& g, std::int32_t v
 double typical_disk_reach(const TriangleMesh& mesh, double radius);
 // Throws terrain::Error when a window of `radius` (the option `name`: the disk, or the ball
 // by the grid method) reaches beyond the grid method's tables (kMaxReach) from a typical
-// vertex: most disks would be cut to the tables' reach (vertex_disk's clip), and balls
-// gathered on the mesh at a cost growing with their area.
+// place (typical_disk_reach): most disks would be cut to the tables' reach (vertex_disk's
+// clip), and balls gathered on the mesh at a cost growing with their area.
 void check_window_reach(const TriangleMesh& mesh, double radius, const char* name);
 
 // The vertices of one tile of output pixels [c0, c0 + t) x [r0, r0 + t), t = g.disk_tile,
