@@ -275,18 +275,23 @@ TEST_CASE("white noise reads planar, a crater under it keeps its scale", "[scale
 
 namespace {
 
-// The whole Moon as a perfect sphere: a geographic grid of width x width / 2 pixels, every
-// height 0.
-Dem moon_sphere(int width) {
+// A geographic grid of the Moon as a perfect sphere: width x height pixels of `step`
+// degrees, its top-left corner at (lon0, lat0), every height 0.
+Dem moon_grid(int width, int height, double lon0, double lat0, double step) {
     Dem dem;
     dem.width = width;
-    dem.height = width / 2;
+    dem.height = height;
     dem.crs_wkt = "IAU_2015:30100";
-    dem.transform = {-180, 360.0 / width, 0, 90, 0, -360.0 / width};
+    dem.transform = {lon0, step, 0, lat0, 0, -step};
     dem.has_transform = true;
     geo::georeference(dem);
     dem.values.assign(std::size_t(dem.width) * std::size_t(dem.height), 0.0);
     return dem;
+}
+
+// The whole Moon: width x width / 2 pixels.
+Dem moon_sphere(int width) {
+    return moon_grid(width, width / 2, -180, 90, 360.0 / width);
 }
 
 constexpr double kMoonRadius = 1737400;
@@ -352,14 +357,7 @@ TEST_CASE("a window's reach counts pixels on the ground, whatever the slope", "[
     CHECK(field::detail::typical_disk_reach(slope, 100) == Approx(100).epsilon(0.01));
     // A tile of the Moon at 30 N, 0.01 degree pixels: its vertices lie far from the body's
     // centre (the mesh's origin holds that), the columns cos(30) of the rows apart.
-    Dem tile;
-    tile.width = tile.height = 100;
-    tile.crs_wkt = "IAU_2015:30100";
-    tile.transform = {10, 0.01, 0, 30.5, 0, -0.01};
-    tile.has_transform = true;
-    geo::georeference(tile);
-    tile.values.assign(100 * 100, 0.0);
-    const auto mesh = mesh::dem_to_mesh(tile);
+    const auto mesh = mesh::dem_to_mesh(moon_grid(100, 100, 10, 30.5, 0.01));
     const double column =
         kMoonRadius * 0.01 * std::numbers::pi / 180 * std::cos(std::numbers::pi / 6);
     CHECK(field::detail::typical_disk_reach(mesh, 100 * column) == Approx(100).epsilon(0.01));

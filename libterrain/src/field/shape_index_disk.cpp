@@ -321,10 +321,8 @@ double typical_disk_reach(const TriangleMesh& mesh, double radius) {
     // The vertical at a vertex: radial on the body, the map's z on a map.
     const auto up_at = [&](std::int32_t v) -> Vec3 {
         if (mesh.frame != MeshFrame::body) return {0, 0, 1};
-        const auto& q = mesh.positions()[std::size_t(v)];
-        const Vec3 p{mesh.origin[0] + q[0], mesh.origin[1] + q[1], mesh.origin[2] + q[2]};
-        const double r = std::sqrt(dot(p, p));
-        return r > 0 ? Vec3{p[0] / r, p[1] / r, p[2] / r} : Vec3{0, 0, 1};
+        const auto& p = mesh.positions()[std::size_t(v)];
+        return normalized({mesh.origin[0] + p[0], mesh.origin[1] + p[1], mesh.origin[2] + p[2]});
     };
     // (ground distance, area of the vertex it starts at): between neighbouring columns, rows.
     // On the ground, as a flat vertex's window counts its pixels: slopes lengthen the
@@ -338,11 +336,12 @@ double typical_disk_reach(const TriangleMesh& mesh, double radius) {
         const int col = int(i % std::size_t(w)), row = int(i / std::size_t(w));
         const std::int32_t next[2] = {col + 1 < w ? mesh.pixel_vertex[i + 1] : -1,
                                       row + 1 < h ? mesh.pixel_vertex[i + std::size_t(w)] : -1};
+        const Vec3 up = up_at(v);
         for (int axis = 0; axis < 2; ++axis)
             if (next[axis] >= 0) {
                 const Vec3 d = sub(mesh.positions()[std::size_t(next[axis])],
                                    mesh.positions()[std::size_t(v)]);
-                const double rise = dot(d, up_at(v));
+                const double rise = dot(d, up);
                 along[axis].emplace_back(std::sqrt(std::max(0.0, dot(d, d) - rise * rise)), area);
             }
     }
