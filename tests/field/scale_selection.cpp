@@ -7,9 +7,12 @@
 #include <cmath>
 #include <cstdint>
 #include <functional>
+#include <limits>
+#include <map>
 #include <numbers>
 #include <vector>
 
+#include "../../libterrain/src/field/sample_lattice.hpp"
 #include "../../libterrain/src/field/shape_index_fit.hpp"
 #include "terrain/core/error.hpp"
 #include "terrain/field/shape_index.hpp"
@@ -161,6 +164,99 @@ TEST_CASE("the scale-selected field is the same on any thread count", "[scale_se
     CHECK(one.scale == many.scale);
     // shape_index_field gives the same values with auto_scale.
     CHECK(field::shape_index_field(mesh, options) == many.field);
+}
+
+TEST_CASE("a wide rung fits the lattice's pixels alone, with every pixel's fits",
+          "[scale_selection]") {
+    // 61 x 45 pixels (the last column and row off the stride of 4), a NoData hole: with a
+    // sample stride only the vertices of every 4th column and row and of the last ones are
+    // fitted, each with the bits of the fit made at every vertex.
+    auto dem = grid(61, [](double x, double y) {
+        return crater(x, y, 20, 22, 9) + 0.3 * std::sin(0.7 * x + y);
+    });
+    dem.height = 45;
+    dem.values.resize(std::size_t(61 * 45));
+    for (int r = 8; r < 14; ++r)
+        for (int c = 33; c < 41; ++c)
+            dem.values[dem.index(c, r)] = std::numeric_limits<double>::quiet_NaN();
+    const auto mesh = mesh::dem_to_mesh(dem);
+    field::ShapeIndexOptions options;
+    options.radius = 9;
+    options.skip_wide = true;
+    options.disk_tile_angle = 0.4;
+    std::map<std::int32_t, field::PrincipalCurvatures> every, sampled;
+    const auto into = [](std::map<std::int32_t, field::PrincipalCurvatures>& out) {
+        return [&out](std::int32_t v, bool ok, const field::PrincipalCurvatures& k, double) {
+            if (ok) out[v] = k;
+        };
+    };
+    field::detail::for_each_curvature(mesh, options, {}, into(every));
+    options.sample_stride = 4;
+    field::detail::for_each_curvature(mesh, options, {}, into(sampled));
+    std::size_t expected = 0;
+    for (const auto& [v, k] : every) {
+        const int pixel = mesh.vertex_pixel[std::size_t(v)], col = pixel % 61, row = pixel / 61;
+        const bool on = (col % 4 == 0 || col == 60) && (row % 4 == 0 || row == 44);
+        expected += on;
+        const auto it = sampled.find(v);
+        CHECK((it != sampled.end()) == on);
+        if (it == sampled.end()) continue;
+        CHECK(it->second.k1 == k.k1);
+        CHECK(it->second.k2 == k.k2);
+        CHECK(it->second.noise == k.noise);
+    }
+    CHECK(sampled.size() == expected);
+    CHECK(expected > 150);  // (16 x 12 lattice points, less the hole's)
+}
+
+TEST_CASE("a wide rung's lattice interpolates between the points that have a value",
+          "[scale_selection]") {
+    // A linear function of the pixel comes back exactly everywhere, the last column and row
+    // (off the stride) included.
+    const int w = 23, h = 14, stride = 4;
+    const auto linear = [](int col, int row) { return float(3 + 0.5 * col + 0.25 * row); };
+    field::detail::SampleLattice lattice(w, h, stride);
+    for (int row = 0; row < h; ++row)
+        for (int col = 0; col < w; ++col)
+            lattice.set(std::int64_t(row) * w + col, linear(col, row), 2 * linear(col, row));
+    for (int row = 0; row < h; ++row)
+        for (int col = 0; col < w; ++col) {
+            float c = 0, f = 0;
+            REQUIRE(lattice.at(std::int64_t(row) * w + col, c, f));
+            CHECK(c == Approx(linear(col, row)).margin(1e-5));
+            CHECK(f == Approx(2 * linear(col, row)).margin(1e-5));
+        }
+    // A smooth field comes back closely: the cubic is within 0.4 of a wave of amplitude 20
+    // over 7 and 9 pixels (0.32 measured; bilinear interpolation is off by up to 1.24 there).
+    const auto wave = [](int col, int row) {
+        return 50 + 20 * std::sin(col / 7.0) * std::cos(row / 9.0);
+    };
+    field::detail::SampleLattice smooth(w, h, stride);
+    for (int row = 0; row < h; ++row)
+        for (int col = 0; col < w; ++col)
+            smooth.set(std::int64_t(row) * w + col, 1.0f, float(wave(col, row)));
+    double worst = 0;
+    for (int row = 0; row < 12; ++row)  // (the last rows' cell is narrower: linear)
+        for (int col = 0; col < 20; ++col) {
+            float c = 0, f = 0;
+            REQUIRE(smooth.at(std::int64_t(row) * w + col, c, f));
+            worst = std::max(worst, std::abs(f - wave(col, row)));
+        }
+    CHECK(worst < 0.4);
+    // A cell with one corner's value: that value; with none, no value.
+    field::detail::SampleLattice sparse(w, h, stride);
+    sparse.set(std::int64_t(8) * w + 8, 7.0f, 70.0f);
+    float c = 0, f = 0;
+    REQUIRE(sparse.at(std::int64_t(6) * w + 6, c, f));
+    CHECK(c == 7.0f);
+    CHECK(f == 70.0f);
+    CHECK(!sparse.at(std::int64_t(1) * w + 1, c, f));
+    // The strides: every pixel below 16 pixels' radius, then an eighth of the radius.
+    CHECK(field::detail::rung_stride(8) == 1);
+    CHECK(field::detail::rung_stride(15.9) == 1);
+    CHECK(field::detail::rung_stride(16) == 2);
+    CHECK(field::detail::rung_stride(128) == 16);
+    CHECK(field::detail::rung_stride(127) == 8);
 }
 
 TEST_CASE("the ladder's field is the same with the normals made by bands of rows",

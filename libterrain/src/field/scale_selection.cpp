@@ -10,6 +10,10 @@
 #include <string>
 #include <vector>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include "sample_lattice.hpp"
 #include "shape_index_fit.hpp"
 #include "terrain/core/error.hpp"
 #include "terrain/field/shape_index.hpp"
@@ -150,6 +154,159 @@ std::vector<double> checked_ladder(const TriangleMesh& mesh, const ShapeIndexOpt
     return radii;
 }
 
+// A vertex's choice along the ladder (docs/field.md, "The choice"). Per vertex, as the rungs
+// go up: the previous rung's curvedness and field value, whether the curvedness rose into it,
+// the previous rung itself, and the peak chosen so far (its curvedness; whether it is a
+// significant one). Curvedness and field values are held in 16 bits (1/4096 and 1/600: far
+// finer than the thresholds and the persistence), so that the ladder adds 8 bytes a vertex to
+// the field's own 5.
+class LadderChoice {
+  public:
+    LadderChoice(const ShapeIndexOptions& options, ScaleSelectedField& out, std::size_t n)
+        : beta_(options.peak_dominance),
+          significant_c_(quantize(options.contrast_curvedness, kCurvednessUnit)),
+          out_(out),
+          previous_c_(n, 0),
+          previous_f_(n, 0),
+          chosen_c_(n, 0),
+          state_(n, kRising) {
+        out.field.assign(n, 50.0f);
+        out.scale.assign(n, 0);
+    }
+
+    // Vertex v's curvedness and field value at `rung`, the rungs in increasing order (a rung
+    // may be missing: the vertex's window was skipped there). Each vertex on one thread.
+    void climb(std::size_t v, std::uint8_t rung, double cd, double f) {
+        const auto c = quantize(cd, kCurvednessUnit);
+        if (state_[v] & kSeen) {
+            const bool rose = state_[v] & kRising;
+            if (rose && c < previous_c_[v])  // the previous rung was a peak
+                peak(v, previous_rung(v), previous_c_[v], previous_f_[v], false);
+            state_[v] =
+                std::uint8_t(c >= previous_c_[v] ? state_[v] | kRising : state_[v] & ~kRising);
+        }
+        state_[v] = std::uint8_t((state_[v] & 0x0f) | kSeen | (rung << 4));
+        previous_c_[v] = c;
+        previous_f_[v] = quantize(f, kFieldUnit);
+    }
+
+    // The last rung each vertex reached ends its ladder: the ladder's top, or the last rung
+    // whose window the tables hold (near a pole, or where a geographic grid's pixels are
+    // narrow, the wider ones are skipped). A rise into it is a rise to the top, no peak (with
+    // `top`: three rungs or more), for a vertex that sees the whole ladder and for one that
+    // does not.
+    void finish(bool top) {
+        for (std::size_t v = 0; v < state_.size(); ++v)
+            if ((state_[v] & kSeen) && (state_[v] & kRising))
+                peak(v, previous_rung(v), previous_c_[v], previous_f_[v], top);
+    }
+
+  private:
+    static constexpr std::uint8_t kRising = 1, kSignificant = 2, kChosen = 4, kSeen = 8;
+    static constexpr double kCurvednessUnit = 4096, kFieldUnit = 600;
+    static std::uint16_t quantize(double x, double unit) {
+        return static_cast<std::uint16_t>(std::clamp(std::lround(x * unit), 0L, 65535L));
+    }
+    std::uint8_t previous_rung(std::size_t v) const { return std::uint8_t(state_[v] >> 4); }
+
+    // A peak over scale at `rung` (curvedness c, field value f): taken when it is the first
+    // significant one (c >= the contrast curvedness), or at least beta times as strong as the
+    // one taken, or when no significant one is taken yet and it is stronger than the one
+    // taken. A rise that ends at the ladder's top is no peak: the landform is larger than the
+    // ladder.
+    void peak(std::size_t v, std::uint8_t rung, std::uint16_t c, std::uint16_t f, bool top) {
+        const bool significant = c >= significant_c_ && !top;
+        const bool chosen = state_[v] & kChosen, chosen_significant = state_[v] & kSignificant;
+        bool take = !chosen;
+        if (significant)
+            take = take || !chosen_significant || c >= beta_ * chosen_c_[v];
+        else
+            take = take || (!chosen_significant && c > chosen_c_[v]);
+        if (!take) return;
+        chosen_c_[v] = c;
+        out_.scale[v] = rung;
+        const float value = float(f / kFieldUnit);
+        out_.field[v] = top ? 50.0f + kTopContrast * (value - 50.0f) : value;
+        state_[v] =
+            std::uint8_t((state_[v] & ~kSignificant) | kChosen | (significant ? kSignificant : 0));
+    }
+
+    double beta_;
+    std::uint16_t significant_c_;
+    ScaleSelectedField& out_;
+    std::vector<std::uint16_t> previous_c_, previous_f_, chosen_c_;
+    std::vector<std::uint8_t> state_;  // flags below, the previous rung above 4 bits
+};
+
+// One rung's scale-normalised curvedness and field value from a fit (docs/field.md, "The
+// measure", "Pixel noise", "The value").
+struct RungMeasure {
+    const TriangleMesh& mesh;
+    double radius, noise_threshold, tau2;
+
+    bool operator()(std::int32_t v, bool ok, const PrincipalCurvatures& k, double scale, double& cd,
+                    double& f) const {
+        if (!ok || !(scale > 0)) return false;
+        // Curvatures in 1/m relative to the body's sphere through the vertex (its own convex
+        // curvature would otherwise grow into every large window), times the radius:
+        // dimensionless, scale-normalised.
+        const double body = body_curvature(v);
+        const double k1 = (k.k1 / scale - body) * radius, k2 = (k.k2 / scale - body) * radius;
+        cd = std::sqrt(0.5 * (k1 * k1 + k2 * k2));
+        // The part of the curvedness the DEM's pixel noise does not explain: less
+        // kNoiseSigmas times what the noise alone gives this fit, in quadrature.
+        const double noisy = noise_threshold * k.noise / (scale * scale) * radius;
+        cd = std::sqrt(std::max(0.0, cd * cd - noisy * noisy));
+        if (!std::isfinite(cd)) return false;
+        const double weight = tau2 > 0 ? cd * cd / (cd * cd + tau2) : 1.0;
+        const double si = cd > 0 ? shape_index(k1, k2) : 0.0;
+        f = 50.0 * (si * weight + 1.0);
+        return true;
+    }
+
+    // The curvature the fit gives the sphere through the vertex (its distance from the
+    // body's centre) on a body-fixed mesh; 0 on a map.
+    double body_curvature(std::int32_t v) const {
+        if (mesh.frame != MeshFrame::body) return 0.0;
+        const auto& p = mesh.positions()[std::size_t(v)];
+        const double x = mesh.origin[0] + p[0], y = mesh.origin[1] + p[1],
+                     z = mesh.origin[2] + p[2];
+        const double r = std::sqrt(x * x + y * y + z * z);
+        return r > 0 ? sphere_curvature_in_fit(r, radius) : 0.0;
+    }
+};
+
+// One rung of the ladder through `choice`: every vertex fitted, or on a wide rung the
+// lattice's vertices fitted and the others interpolated between them.
+void climb_rung(const TriangleMesh& mesh, const ShapeIndexOptions& one, const RungMeasure& measure,
+                std::uint8_t rung, LadderChoice& choice, const ProgressFn& progress) {
+    if (one.sample_stride <= 1) {
+        detail::for_each_curvature(
+            mesh, one, progress,
+            [&](std::int32_t v, bool ok, const PrincipalCurvatures& k, double scale) {
+                double cd = 0, f = 0;
+                if (measure(v, ok, k, scale, cd, f)) choice.climb(std::size_t(v), rung, cd, f);
+            });
+        return;
+    }
+    detail::SampleLattice lattice(mesh.grid_width, mesh.grid_height, one.sample_stride);
+    detail::for_each_curvature(
+        mesh, one, scaled_progress(progress, 0, 0.95),
+        [&](std::int32_t v, bool ok, const PrincipalCurvatures& k, double scale) {
+            double cd = 0, f = 0;
+            if (measure(v, ok, k, scale, cd, f))
+                lattice.set(mesh.vertex_pixel[std::size_t(v)], float(cd), float(f));
+        });
+    const std::size_t n = mesh.vertex_count();
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096), [&](const auto& r) {
+        for (std::size_t v = r.begin(); v < r.end(); ++v) {
+            float cd = 0, f = 0;
+            if (lattice.at(mesh.vertex_pixel[v], cd, f)) choice.climb(v, rung, cd, f);
+        }
+    });
+    report_progress(progress, 1.0, "shape index");
+}
+
 }  // namespace
 
 ScaleSelectedField scale_selected_shape_index(const TriangleMesh& mesh,
@@ -157,61 +314,11 @@ ScaleSelectedField scale_selected_shape_index(const TriangleMesh& mesh,
                                               const ProgressFn& progress) {
     ScaleSelectedField out;
     out.radii = checked_ladder(mesh, options);
-    const std::size_t n = mesh.vertex_count();
-    const double tau2 = options.contrast_curvedness * options.contrast_curvedness;
-    const double beta = options.peak_dominance;
-    const double sig = options.contrast_curvedness;
-    // The curvature the fit of `radius` gives the sphere through the vertex (its distance from
-    // the body's centre) on a body-fixed mesh; 0 on a map.
-    const auto body_curvature = [&](std::int32_t v, double radius) {
-        if (mesh.frame != MeshFrame::body) return 0.0;
-        const auto& p = mesh.positions()[std::size_t(v)];
-        const double x = mesh.origin[0] + p[0], y = mesh.origin[1] + p[1],
-                     z = mesh.origin[2] + p[2];
-        const double r = std::sqrt(x * x + y * y + z * z);
-        return r > 0 ? sphere_curvature_in_fit(r, radius) : 0.0;
-    };
-    // Per vertex, as the rungs go up: the previous rung's curvedness and field value, whether
-    // the curvedness rose into it, the previous rung itself, and the peak chosen so far (its
-    // curvedness; whether it is a significant one). Curvedness and field values are held in
-    // 16 bits (1/4096 and 1/600: far finer than the thresholds and the persistence), so that
-    // the ladder adds 8 bytes a vertex to the field's own 5.
-    constexpr std::uint8_t kRising = 1, kSignificant = 2, kChosen = 4, kSeen = 8;
-    const auto quantize = [](double x, double unit) {
-        return static_cast<std::uint16_t>(std::clamp(std::lround(x * unit), 0L, 65535L));
-    };
-    constexpr double kCurvednessUnit = 4096, kFieldUnit = 600;
-    std::vector<std::uint16_t> previous_c(n, 0), previous_f(n, 0), chosen_c(n, 0);
-    std::vector<std::uint8_t> state(n, kRising);  // flags below, the previous rung above 4 bits
-    const auto previous_rung = [&](std::size_t v) { return std::uint8_t(state[v] >> 4); };
-    out.field.assign(n, 50.0f);
-    out.scale.assign(n, 0);
     out.pixel_noise_m = pixel_noise(mesh);
-    const double noise_threshold = kNoiseSigmas * out.pixel_noise_m;
+    LadderChoice choice(options, out, mesh.vertex_count());
+    const double tau2 = options.contrast_curvedness * options.contrast_curvedness;
+    const double spacing = std::sqrt(mean_vertex_area(mesh));
     const std::size_t rungs = out.radii.size();
-    const std::uint16_t significant_c = quantize(sig, kCurvednessUnit);
-    // A peak over scale at rung `rung` (curvedness c, field value f): taken when it is the
-    // first significant one (c >= sig), or at least beta times as strong as the one taken, or
-    // when no significant one is taken yet and it is stronger than the one taken. A rise
-    // that ends at the ladder's top is no peak: the landform is larger than the ladder.
-    const auto peak = [&](std::size_t v, std::uint8_t rung, std::uint16_t c, std::uint16_t f,
-                          bool top) {
-        const bool significant = c >= significant_c && !top;
-        const bool chosen = state[v] & kChosen, chosen_significant = state[v] & kSignificant;
-        bool take = !chosen;
-        if (significant)
-            take = take || !chosen_significant || c >= beta * chosen_c[v];
-        else
-            take = take || (!chosen_significant && c > chosen_c[v]);
-        if (!take) return;
-        chosen_c[v] = c;
-        out.scale[v] = rung;
-        const float value = float(f / kFieldUnit);
-        out.field[v] = top ? 50.0f + kTopContrast * (value - 50.0f) : value;
-        state[v] =
-            std::uint8_t((state[v] & ~kSignificant) | kChosen | (significant ? kSignificant : 0));
-    };
-    const auto steps = double(rungs);
     for (std::size_t i = 0; i < rungs; ++i) {
         ShapeIndexOptions one = options;
         one.auto_scale = false;
@@ -219,50 +326,13 @@ ScaleSelectedField scale_selected_shape_index(const TriangleMesh& mesh,
         one.window = ShapeIndexWindow::disk;
         one.skip_wide = i > 0;
         one.disk_tile_angle = kLadderTileAngle;
-        const double radius = out.radii[i];
-        const auto rung = static_cast<std::uint8_t>(i);
-        detail::for_each_curvature(
-            mesh, one, scaled_progress(progress, double(i) / steps, double(i + 1) / steps),
-            [&](std::int32_t vi, bool ok, const PrincipalCurvatures& k, double scale) {
-                if (!ok || !(scale > 0)) return;
-                const auto v = std::size_t(vi);
-                // Curvatures in 1/m relative to the body's sphere through the vertex (its own
-                // convex curvature would otherwise grow into every large window), times the
-                // radius: dimensionless, scale-normalised.
-                const double body = body_curvature(vi, radius);
-                const double k1 = (k.k1 / scale - body) * radius,
-                             k2 = (k.k2 / scale - body) * radius;
-                double cd = std::sqrt(0.5 * (k1 * k1 + k2 * k2));
-                // The part of the curvedness the DEM's pixel noise does not explain: less
-                // kNoiseSigmas times what the noise alone gives this fit, in quadrature.
-                const double noisy = noise_threshold * k.noise / (scale * scale) * radius;
-                cd = std::sqrt(std::max(0.0, cd * cd - noisy * noisy));
-                if (!std::isfinite(cd)) return;
-                const auto c = quantize(cd, kCurvednessUnit);
-                const double weight = tau2 > 0 ? cd * cd / (cd * cd + tau2) : 1.0;
-                const double si = cd > 0 ? shape_index(k1, k2) : 0.0;
-                const auto f = quantize(50.0 * (si * weight + 1.0), kFieldUnit);
-                if (state[v] & kSeen) {
-                    const bool rose = state[v] & kRising;
-                    if (rose && c < previous_c[v])  // the previous rung was a peak
-                        peak(v, previous_rung(v), previous_c[v], previous_f[v], false);
-                    state[v] =
-                        std::uint8_t(c >= previous_c[v] ? state[v] | kRising : state[v] & ~kRising);
-                }
-                state[v] = std::uint8_t((state[v] & 0x0f) | kSeen | (rung << 4));
-                previous_c[v] = c;
-                previous_f[v] = f;
-            });
+        one.sample_stride = i + 1 < rungs ? detail::rung_stride(out.radii[i] / spacing) : 1;
+        const RungMeasure measure{mesh, out.radii[i], kNoiseSigmas * out.pixel_noise_m, tau2};
+        climb_rung(
+            mesh, one, measure, std::uint8_t(i), choice,
+            scaled_progress(progress, double(i) / double(rungs), double(i + 1) / double(rungs)));
     }
-    // The last rung each vertex reached ends its ladder: the ladder's top, or the last rung
-    // whose window the tables hold (near a pole, or where a geographic grid's pixels are
-    // narrow, the wider ones are skipped). A rise into it is a rise to the top, no peak, for
-    // a vertex that sees the whole ladder and for one that does not (with three rungs or
-    // more).
-    const bool top = rungs >= 3;
-    for (std::size_t v = 0; v < n; ++v)
-        if ((state[v] & kSeen) && (state[v] & kRising))
-            peak(v, previous_rung(v), previous_c[v], previous_f[v], top);
+    choice.finish(rungs >= 3);
     report_progress(progress, 1.0, "shape index");
     return out;
 }

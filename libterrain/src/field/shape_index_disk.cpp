@@ -399,8 +399,15 @@ void disk_tile(const TriangleMesh& mesh, const GridLayout& g, const Normals& nor
     const auto disk_of = [&](int col, int row) -> DiskWindow& {
         return s.disks[std::size_t(row - r0) * std::size_t(tile) + std::size_t(col - c0)];
     };
+    // With a sample stride, only the sampled pixels' vertices.
+    const int sample_stride = options.sample_stride;
+    const auto for_each_fitted = [&](auto&& f) {
+        g.for_each_vertex(r0, r1, c0, c1, [&](std::int32_t v, int col, int row) {
+            if (sample_stride <= 1 || sampled_pixel(col, row, sample_stride, W, H)) f(v, col, row);
+        });
+    };
     int mx = 0, my = 0;
-    g.for_each_vertex(r0, r1, c0, c1, [&](std::int32_t v, int col, int row) {
+    for_each_fitted([&](std::int32_t v, int col, int row) {
         auto& d = disk_of(col, row) = vertex_disk(mesh, g, v, normals[std::size_t(v)], frame.up,
                                                   options.radius, !options.skip_wide);
         // Above the ladder's first rung a window a little past the tables (where a tile's
@@ -418,7 +425,7 @@ void disk_tile(const TriangleMesh& mesh, const GridLayout& g, const Normals& nor
                             [&](const Vec3& d, double* out) { monge_monomials(frame, d, out); });
     if (status == RegionStatus::empty) return;
     if (status == RegionStatus::mesh_path)
-        return g.for_each_vertex(r0, r1, c0, c1, [&](std::int32_t v, int, int) { fallback(v); });
+        return for_each_fitted([&](std::int32_t v, int, int) { fallback(v); });
     const int rows = region.rows, cols = region.cols;
     const std::size_t stride = std::size_t(cols + 1) * kMonge;
     for (int lr = 1; lr < rows; ++lr) {
@@ -441,7 +448,7 @@ void disk_tile(const TriangleMesh& mesh, const GridLayout& g, const Normals& nor
         const double* a1 = &s.prefix[std::size_t(ra - 1) * stride + std::size_t(cb + 1) * kMonge];
         for (int k = 0; k < kMonge; ++k) moments[k] += (b1[k] - b0[k]) - (a1[k] - a0[k]);
     };
-    g.for_each_vertex(r0, r1, c0, c1, [&](std::int32_t v, int col, int row) {
+    for_each_fitted([&](std::int32_t v, int col, int row) {
         const DiskWindow& d = disk_of(col, row);
         // Beyond the margins (a window wider than kMaxReach): the mesh path.
         if (d.reach_x > mx || d.reach_y > my) return fallback(v);

@@ -122,6 +122,12 @@ constexpr int kNearReach = kMaxReach + kMaxReach / 4;
 // the disk window's tile size.
 GridLayout grid_layout(const TriangleMesh& mesh, double tile_angle = kMaxDiskTileAngle);
 
+// Whether pixel (col, row) of a width x height grid is fitted at a sample stride: every
+// stride-th column and row, and the last ones.
+inline bool sampled_pixel(int col, int row, int stride, int width, int height) {
+    return (col % stride == 0 || col == width - 1) && (row % stride == 0 || row == height - 1);
+}
+
 // The disk window: the pixels whose ground offset from the vertex, lifted onto the vertex's
 // tangent plane, is within the radius (the ball's footprint where the terrain is its tangent
 // plane: an ellipse of the grid, a disk on flat ground). It is drawn as three bands of rows

@@ -309,7 +309,13 @@ std::size_t grid_for_each_vertex(const TriangleMesh& mesh, const GridLayout& g,
     tbb::enumerable_thread_specific<std::size_t> fallbacks(0);
     const int tile = disk ? g.disk_tile : kTile;
     const int tile_rows = (g.height + tile - 1) / tile, tile_cols = (g.width + tile - 1) / tile;
-    const auto unowned = unowned_vertices(mesh, g);
+    // With a sample stride, of the vertices no pixel owns only the poles (pinched copies share
+    // their pixel's sample with its owner).
+    auto unowned = unowned_vertices(mesh, g);
+    if (options.sample_stride > 1)
+        std::erase_if(unowned, [&](std::int32_t v) {
+            return v != mesh.pole_vertices[0] && v != mesh.pole_vertices[1];
+        });
     std::vector<Vec3> unowned_normals(unowned.size());
     std::size_t next_unowned = 0;
     for (int tr = 0; tr < tile_rows; ++tr) {

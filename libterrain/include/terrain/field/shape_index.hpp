@@ -73,6 +73,11 @@ struct ShapeIndexOptions {
     // tile's fits are made in the frame of its first vertex. scale_selected_shape_index widens
     // it, so that its large radii do not pay for margins many times a small tile's area.
     double disk_tile_angle = 0.05;
+    // With the disk window on a DEM's grid, only the vertices of every sample_stride-th pixel
+    // column and row (and of the grid's last column and row) are fitted; the others get no
+    // call. scale_selected_shape_index sets it on its wide rungs, whose field varies over
+    // their radius, and interpolates between the fitted vertices.
+    int sample_stride = 1;
 };
 
 // The method shape_index_field takes for this mesh and these options: "grid" or "mesh".
