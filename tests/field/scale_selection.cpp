@@ -8,8 +8,8 @@
 #include <cstdint>
 #include <functional>
 #include <limits>
-#include <map>
 #include <numbers>
+#include <utility>
 #include <vector>
 
 #include "../../libterrain/src/field/sample_lattice.hpp"
@@ -166,11 +166,42 @@ TEST_CASE("the scale-selected field is the same on any thread count", "[scale_se
     CHECK(field::shape_index_field(mesh, options) == many.field);
 }
 
+namespace {
+
+// The curvatures for_each_curvature gives each vertex (from any thread: one slot each).
+struct Fits {
+    std::vector<field::PrincipalCurvatures> k;
+    std::vector<std::uint8_t> fitted;
+    explicit Fits(std::size_t n) : k(n), fitted(n, 0) {}
+    field::detail::CurvatureBody body() {
+        return [this](std::int32_t v, bool ok, const field::PrincipalCurvatures& c, double) {
+            if (ok) k[std::size_t(v)] = c, fitted[std::size_t(v)] = 1;
+        };
+    }
+    std::size_t count() const { return std::size_t(std::count(fitted.begin(), fitted.end(), 1)); }
+};
+
+// A wide rung of `radius` (the ladder's options) fitted at every vertex, and on a lattice.
+std::pair<Fits, Fits> fit_all_and_lattice(const TriangleMesh& mesh, double radius, int stride) {
+    field::ShapeIndexOptions options;
+    options.radius = radius;
+    options.skip_wide = true;
+    options.disk_tile_angle = 0.4;
+    std::pair<Fits, Fits> out{Fits(mesh.vertex_count()), Fits(mesh.vertex_count())};
+    field::detail::for_each_curvature(mesh, options, {}, out.first.body());
+    options.sample_stride = stride;
+    field::detail::for_each_curvature(mesh, options, {}, out.second.body());
+    return out;
+}
+
+}  // namespace
+
 TEST_CASE("a wide rung fits the lattice's pixels alone, with every pixel's fits",
           "[scale_selection]") {
     // 61 x 45 pixels (the last column and row off the stride of 4), a NoData hole: with a
     // sample stride only the vertices of every 4th column and row and of the last ones are
-    // fitted, each with the bits of the fit made at every vertex.
+    // fitted, each with the fit made at every vertex (within rounding: a tile's tables are
+    // sized for the windows it fits, and their sums start where the tables do).
     auto dem = grid(61, [](double x, double y) {
         return crater(x, y, 20, 22, 9) + 0.3 * std::sin(0.7 * x + y);
     });
@@ -180,32 +211,20 @@ TEST_CASE("a wide rung fits the lattice's pixels alone, with every pixel's fits"
         for (int c = 33; c < 41; ++c)
             dem.values[dem.index(c, r)] = std::numeric_limits<double>::quiet_NaN();
     const auto mesh = mesh::dem_to_mesh(dem);
-    field::ShapeIndexOptions options;
-    options.radius = 9;
-    options.skip_wide = true;
-    options.disk_tile_angle = 0.4;
-    std::map<std::int32_t, field::PrincipalCurvatures> every, sampled;
-    const auto into = [](std::map<std::int32_t, field::PrincipalCurvatures>& out) {
-        return [&out](std::int32_t v, bool ok, const field::PrincipalCurvatures& k, double) {
-            if (ok) out[v] = k;
-        };
-    };
-    field::detail::for_each_curvature(mesh, options, {}, into(every));
-    options.sample_stride = 4;
-    field::detail::for_each_curvature(mesh, options, {}, into(sampled));
+    const auto [every, sampled] = fit_all_and_lattice(mesh, 9, 4);
     std::size_t expected = 0;
-    for (const auto& [v, k] : every) {
-        const int pixel = mesh.vertex_pixel[std::size_t(v)], col = pixel % 61, row = pixel / 61;
+    for (std::size_t v = 0; v < mesh.vertex_count(); ++v) {
+        if (!every.fitted[v]) continue;
+        const int pixel = mesh.vertex_pixel[v], col = pixel % 61, row = pixel / 61;
         const bool on = (col % 4 == 0 || col == 60) && (row % 4 == 0 || row == 44);
         expected += on;
-        const auto it = sampled.find(v);
-        CHECK((it != sampled.end()) == on);
-        if (it == sampled.end()) continue;
-        CHECK(it->second.k1 == k.k1);
-        CHECK(it->second.k2 == k.k2);
-        CHECK(it->second.noise == k.noise);
+        CHECK(bool(sampled.fitted[v]) == on);
+        if (!sampled.fitted[v]) continue;
+        CHECK(sampled.k[v].k1 == Approx(every.k[v].k1).epsilon(1e-9));
+        CHECK(sampled.k[v].k2 == Approx(every.k[v].k2).epsilon(1e-9));
+        CHECK(sampled.k[v].noise == Approx(every.k[v].noise).epsilon(1e-9));
     }
-    CHECK(sampled.size() == expected);
+    CHECK(sampled.count() == expected);
     CHECK(expected > 150);  // (16 x 12 lattice points, less the hole's)
 }
 
@@ -550,4 +569,44 @@ TEST_CASE("a landform wider than a polar vertex's ladder reads nearly planar the
                        << out.radii.size() << ", field " << out.field[std::size_t(v)]);
         CHECK(std::abs(out.field[std::size_t(v)] - 50.0f) < 15.0f);
     }
+}
+
+TEST_CASE("a wide rung's lattice holds the seam's columns and the poles", "[scale_selection]") {
+    // The 1-degree Moon with a bowl across the seam: the last column (359, off the stride of
+    // 4) and both poles are fitted on the lattice, with the full fits' values; the
+    // scale-selected field of a half-degree Moon, whose 16-pixel rung is on a lattice, is
+    // finite and within [0, 100] at every vertex.
+    auto dem = moon_sphere(360);
+    dem.values = cup_on_sphere(dem, 10, 400e3, 40e3);
+    // (cup_on_sphere centres the bowl at longitude 0: move it to the seam.)
+    for (int r = 0; r < dem.height; ++r) {
+        auto row = dem.values.begin() + std::ptrdiff_t(r) * dem.width;
+        std::rotate(row, row + 180, row + dem.width);
+    }
+    const auto mesh = mesh::dem_to_mesh(dem);
+    const auto [every, sampled] =
+        fit_all_and_lattice(mesh, 8 * kMoonRadius * std::numbers::pi / 180, 4);
+    REQUIRE(sampled.count() > 80 * 45);
+    std::size_t differ = 0;
+    for (std::size_t v = 0; v < mesh.vertex_count(); ++v)
+        if (sampled.fitted[v])
+            differ += !every.fitted[v] ||
+                      std::abs(sampled.k[v].k1 - every.k[v].k1) > 1e-9 * std::abs(every.k[v].k1) ||
+                      std::abs(sampled.k[v].k2 - every.k[v].k2) > 1e-9 * std::abs(every.k[v].k2);
+    CHECK(differ == 0);
+    for (const auto pole : mesh.pole_vertices) CHECK(sampled.fitted[std::size_t(pole)]);
+    CHECK(sampled.fitted[std::size_t(mesh.pixel_vertex[std::size_t(100) * 360 + 359])]);
+
+    auto half = moon_sphere(720);
+    half.values = cup_on_sphere(half, 10, 400e3, 40e3);
+    const auto fine = mesh::dem_to_mesh(half);
+    field::ShapeIndexOptions ladder;
+    ladder.auto_scale = true;
+    const auto out = field::scale_selected_shape_index(fine, ladder);
+    REQUIRE(out.radii.size() >= 5);  // 2 to 32 pixels: the 16-pixel rung on a lattice
+    std::size_t bad = 0;
+    for (std::size_t v = 0; v < fine.vertex_count(); ++v)
+        bad += !(std::isfinite(out.field[v]) && out.field[v] >= 0.0f && out.field[v] <= 100.0f &&
+                 out.scale[v] < out.radii.size());
+    CHECK(bad == 0);
 }
