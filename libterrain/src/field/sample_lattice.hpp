@@ -22,11 +22,11 @@ inline int rung_stride(double radius_pixels) {
 
 // A wide rung's curvedness and field value on the lattice of sampled pixels (every stride-th
 // column and row, and the grid's last ones: sampled_pixel), interpolated at any pixel by
-// Catmull-Rom cubics through the 4 x 4 lattice points around it. Bilinear interpolation is
-// only continuous in value: its kinks along the lattice's lines put the interpolated field's
-// ridges and troughs there, and the regions of a quiet plain (top rungs, nearly planar)
-// followed the lattice in straight steps. The cubic is continuous in slope and passes
-// through the lattice's values. Where one of the 16 points has no value (NoData, a window
+// Catmull-Rom cubics through the 4 x 4 lattice points around it: continuous in slope, where
+// bilinear interpolation has kinks along the lattice's lines that put the field's ridges and
+// troughs there. (Either way a weak field's extrema sit on lattice points, so the ladder's
+// top rung, where the quiet plains end, is not fitted on a lattice: scale_selection.cpp.)
+// Where one of the 16 points has no value (NoData, a window
 // the tables cannot hold), or in the last, narrower cell of a grid whose size is off the
 // stride, the cell's corners that have one are weighed bilinearly.
 class SampleLattice {

@@ -326,6 +326,8 @@ ScaleSelectedField scale_selected_shape_index(const TriangleMesh& mesh,
         one.window = ShapeIndexWindow::disk;
         one.skip_wide = i > 0;
         one.disk_tile_angle = kLadderTileAngle;
+        // Wide rungs on a lattice (sample_lattice.hpp), but the top: the quiet plains end
+        // there, and on a lattice their regions' boundaries ran along its lines in steps.
         one.sample_stride = i + 1 < rungs ? detail::rung_stride(out.radii[i] / spacing) : 1;
         const RungMeasure measure{mesh, out.radii[i], kNoiseSigmas * out.pixel_noise_m, tau2};
         climb_rung(
