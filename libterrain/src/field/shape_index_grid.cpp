@@ -309,10 +309,10 @@ std::size_t grid_for_each_vertex(const TriangleMesh& mesh, const GridLayout& g,
     tbb::enumerable_thread_specific<std::size_t> fallbacks(0);
     const int tile = disk ? g.disk_tile : kTile;
     const int tile_rows = (g.height + tile - 1) / tile, tile_cols = (g.width + tile - 1) / tile;
-    // With a sample stride, of the vertices no pixel owns only the poles (pinched copies share
-    // their pixel's sample with its owner).
+    // With the disk's sample stride (disk_tile fits only the lattice's pixels), of the vertices
+    // no pixel owns only the poles (pinched copies share their pixel's sample with its owner).
     auto unowned = unowned_vertices(mesh, g);
-    if (options.sample_stride > 1)
+    if (disk && options.sample_stride > 1)
         std::erase_if(unowned, [&](std::int32_t v) {
             return v != mesh.pole_vertices[0] && v != mesh.pole_vertices[1];
         });
