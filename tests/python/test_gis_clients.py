@@ -132,6 +132,13 @@ def test_labels_tif_has_internal_overviews(cli, tmp_path):
     assert (overview.XSize, overview.YSize) == (256, 256)
     # Nearest: every overview pixel is a region id of the full grid.
     assert set(overview.ReadAsArray().ravel().tolist()) <= full
+    # The colour table (65 536 entries, 384 KB in a UInt16 TIFF) is in the full grid's
+    # directory only: the overviews are plain grey ids, the file a quarter of what four
+    # copies made it.
+    assert band.GetColorTable() is not None and band.GetColorTable().GetCount() == 65536
+    for k in range(band.GetOverviewCount()):
+        assert band.GetOverview(k).GetColorTable() is None
+    assert (out / "labels.tif").stat().st_size < 600_000
 
 
 @pytest.fixture(scope="module")

@@ -176,6 +176,14 @@ std::unique_ptr<GDALDataset> write_cloud_optimized(const Dem& dem, GDALDataset& 
         options.SetNameValue("OVERVIEW_COUNT", std::to_string(factors.size()).c_str());
     GDALDriver* cog = GetGDALDriverManager()->GetDriverByName("COG");
     if (!cog) throw Error("write", "GDAL has no COG driver (GDAL 3.1 or later is needed)");
+    // A paletted band's colour table stays in the full grid's directory: a UInt16 TIFF colour
+    // table is 65 536 entries (384 KB), which the overviews' directories would repeat, while
+    // their pixels are ids whose colours the full grid's table (and labels.qml) give. (Set for
+    // this thread only: the other outputs are written beside it.)
+    const bool paletted =
+        source.GetRasterCount() > 0 && source.GetRasterBand(1)->GetColorTable() != nullptr;
+    const CPLConfigOptionSetter plain_overviews("PHOTOMETRIC_OVERVIEW",
+                                                paletted ? "MINISBLACK" : nullptr, false);
     GdalProgress reported{progress};
     std::unique_ptr<GDALDataset> ds(cog->CreateCopy(temp_path.c_str(), &source, FALSE,
                                                     options.List(), GdalProgress::call, &reported));
