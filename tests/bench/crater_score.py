@@ -1,5 +1,5 @@
 """How well a label map holds known craters: the rule of the crater benchmarks
-(docs/segment.md, "Scoring against known craters"), shared by bench_craters.py and the tests.
+(docs/landforms.md, "Scoring against known craters"), shared by bench_craters.py and the tests.
 
 A crater is *found* when the region holding most of its inner bowl (the pixels within 0.6 R
 of its centre) is concave (its mean shape index in a concave class: below 43.75 on the
