@@ -85,8 +85,18 @@ std::vector<std::string> write_segment_outputs(const std::string& dir, const Tri
         within(fraction);
         return true;
     };
+    // The adjacency graph's three files (they read the region graph only).
+    const auto adjacency = [&] {
+        write_adjacency_json(graph, paths[2], overwrite);
+        step();
+        write_adjacency_graphml(graph, paths[3], overwrite);
+        step();
+        write_adjacency_geojson(graph, paths[4], overwrite);
+        step();
+    };
     if (dem) {
-        // The three raster-based files are independent: written side by side.
+        // The raster-based files and the adjacency files are independent: written side by
+        // side.
         const auto pixels = segment::label_pixels(mesh, *dem, labels);
         tbb::parallel_invoke(
             [&] {
@@ -108,19 +118,16 @@ std::vector<std::string> write_segment_outputs(const std::string& dir, const Tri
                     *options.deferred_preview = std::move(image);
                 else
                     write_preview_image(image, paths[5], overwrite);
-            });
+                step();
+            },
+            adjacency);
     } else {
         write_labels_ply(mesh, field, labels, paths[0], overwrite, options.field_name);
         step();
         write_faces_seg(mesh, labels, paths[1], overwrite);
+        step();
+        adjacency();
     }
-    step();
-    write_adjacency_json(graph, paths[2], overwrite);
-    step();
-    write_adjacency_graphml(graph, paths[3], overwrite);
-    step();
-    write_adjacency_geojson(graph, paths[4], overwrite);
-    step();
     return paths;
 }
 
