@@ -53,8 +53,7 @@ def render(tif, png, tmp_path, shrink=1):
     env = dict(os.environ, QT_QPA_PLATFORM="offscreen", XDG_RUNTIME_DIR=str(runtime),
                QGIS_CUSTOM_CONFIG_PATH=str(tmp_path / "config"), GDAL_PAM_ENABLED="YES")
     done = subprocess.run(["/usr/bin/python3", "-c", RENDER, str(tif), str(png), str(shrink)],
-                          env=env,
-                          capture_output=True, text=True, timeout=120)
+                          env=env, capture_output=True, text=True, timeout=120)
     assert done.returncode == 0, done.stderr
     return done.stdout.split()[-1]
 
