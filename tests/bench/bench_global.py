@@ -5,7 +5,10 @@ several sizes. Prints, per size, the wall time and the peak memory (bytes per pi
 seconds per million pixels for each stage, so that the growth of the cost with size shows;
 `x_first` is a size's seconds per Mpx over the first size's (the run's linearity: 1.3 at most
 is asked of the 265 M grid against the 1 M one). The first size runs three times, and its
-median is the reference.
+median is the reference. A second line per run gives the CPU seconds per wall second, of the
+whole run (`cpu/wall`) and of each stage: the process's CPU time sampled every 0.1 s, each
+stage's share read between its start and end as run.json's timings place them (from the
+process's start; a stage under a second is too short to read and shows `-`).
 
   bench_global.py [BUILD_DIR] [WIDTH ...]      (height = width / 2)
 
@@ -16,20 +19,57 @@ import statistics
 import subprocess
 import sys
 import tempfile
+import time
 
 STAGES = ["read", "mesh", "field", "reeb", "simplify", "grow", "write"]
 FIRST_RUNS = 3
 
 
+def cpu_seconds(pid):
+    """The CPU seconds (user + system) process pid has used so far; None once it is gone."""
+    try:
+        with open(f"/proc/{pid}/stat") as f:
+            fields = f.read().rsplit(")", 1)[1].split()
+    except OSError:
+        return None
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+
 def run(terrain, dem, work):
-    """`terrain segment` with every output: wall seconds, peak resident bytes, stage seconds."""
+    """`terrain segment` with every output: wall seconds, peak resident bytes, stage seconds,
+    the CPU seconds per wall second of the run and of each stage (None: too short to read)."""
     out, timing = os.path.join(work, "out"), os.path.join(work, "time")
     subprocess.run(["rm", "-rf", out], check=True)
-    subprocess.run(["/usr/bin/time", "-f", "%e %M", "-o", timing, terrain, "segment", "-q", dem,
-                    "-o", out, "--timings"], check=True, stdout=subprocess.DEVNULL)
-    wall, rss_kb = open(timing).read().split()[-2:]
+    start = time.monotonic()
+    process = subprocess.Popen(["/usr/bin/time", "-f", "%e %M %U %S", "-o", timing, terrain,
+                                "segment", "-q", dem, "-o", out, "--timings"],
+                               stdout=subprocess.DEVNULL)
+    samples = []  # (seconds since start, CPU seconds) of terrain, /usr/bin/time's child
+    child = None
+    while process.poll() is None:
+        if child is None:
+            try:
+                with open(f"/proc/{process.pid}/task/{process.pid}/children") as f:
+                    child = int(f.read().split()[0])
+            except (OSError, IndexError, ValueError):
+                pass
+        used = cpu_seconds(child) if child else None
+        if used is not None:
+            samples.append((time.monotonic() - start, used))
+        time.sleep(0.1)
+    if process.returncode != 0:
+        raise subprocess.CalledProcessError(process.returncode, terrain)
+    wall, rss_kb, user, system = open(timing).read().split()[-4:]
     t = json.load(open(os.path.join(out, "run.json")))["timings_seconds"]
-    return float(wall), int(rss_kb) * 1024, t
+    usage = {"cpu/wall": (float(user) + float(system)) / max(float(wall), 1e-9)}
+    at = 0.0
+    for stage in STAGES:
+        end = at + t.get(stage, 0)
+        inside = [s for s in samples if at <= s[0] <= end]
+        usage[stage] = ((inside[-1][1] - inside[0][1]) / (inside[-1][0] - inside[0][0])
+                        if len(inside) >= 10 else None)
+        at = end
+    return float(wall), int(rss_kb) * 1024, t, usage
 
 
 def main():
@@ -52,11 +92,15 @@ def main():
             mpx = px / 1e6
             rates = []
             for _ in range(FIRST_RUNS if i == 0 else 1):
-                wall, rss, t = run(terrain, dem, work)
+                wall, rss, t, usage = run(terrain, dem, work)
                 rates.append(wall / mpx)
                 ratio = f"{wall / mpx / first:7.2f}" if first else f"{'':7}"
                 print(f"{w}x{h:<7} {wall:8.1f} {rss / 2**20:9.0f} {rss / px:8.0f} {wall / mpx:7.2f} "
                       f"{ratio} " + " ".join(f"{t.get(s, 0) / mpx:8.2f}" for s in STAGES), flush=True)
+                share = " ".join(f"{usage[s]:8.2f}" if usage[s] is not None else f"{'-':>8}"
+                                 for s in STAGES)
+                print(f"{'':12} {'cpu/wall':>26} {usage['cpu/wall']:7.2f} {'':7} {share}",
+                      flush=True)
             if first is None:
                 first = statistics.median(rates)
                 print(f"{'':12} (the first size's median: {first:.2f} s/Mpx)", flush=True)
