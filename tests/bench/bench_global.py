@@ -19,14 +19,16 @@ import statistics
 import subprocess
 import sys
 import tempfile
-import time
+
+from stage_samples import run_sampled, stage_spans
 
 STAGES = ["read", "mesh", "field", "reeb", "simplify", "grow", "write"]
 FIRST_RUNS = 3
 
 
 def cpu_seconds(pid):
-    """The CPU seconds (user + system) process pid has used so far; None once it is gone."""
+    """The CPU seconds (user + system) process pid has used so far; None when it cannot be
+    read."""
     try:
         with open(f"/proc/{pid}/stat") as f:
             fields = f.read().rsplit(")", 1)[1].split()
@@ -38,38 +40,20 @@ def cpu_seconds(pid):
 def run(terrain, dem, work):
     """`terrain segment` with every output: wall seconds, peak resident bytes, stage seconds,
     the CPU seconds per wall second of the run and of each stage (None: too short to read)."""
-    out, timing = os.path.join(work, "out"), os.path.join(work, "time")
+    out = os.path.join(work, "out")
     subprocess.run(["rm", "-rf", out], check=True)
-    start = time.monotonic()
-    process = subprocess.Popen(["/usr/bin/time", "-f", "%e %M %U %S", "-o", timing, terrain,
-                                "segment", "-q", dem, "-o", out, "--timings"],
-                               stdout=subprocess.DEVNULL)
-    samples = []  # (seconds since start, CPU seconds) of terrain, /usr/bin/time's child
-    child = None
-    while process.poll() is None:
-        if child is None:
-            try:
-                with open(f"/proc/{process.pid}/task/{process.pid}/children") as f:
-                    child = int(f.read().split()[0])
-            except (OSError, IndexError, ValueError):
-                pass
-        used = cpu_seconds(child) if child else None
-        if used is not None:
-            samples.append((time.monotonic() - start, used))
-        time.sleep(0.1)
+    process, wall, usage, samples = run_sampled(
+        [terrain, "segment", "-q", dem, "-o", out, "--timings"], cpu_seconds, 0.1,
+        stdout=subprocess.DEVNULL)
     if process.returncode != 0:
         raise subprocess.CalledProcessError(process.returncode, terrain)
-    wall, rss_kb, user, system = open(timing).read().split()[-4:]
     t = json.load(open(os.path.join(out, "run.json")))["timings_seconds"]
-    usage = {"cpu/wall": (float(user) + float(system)) / max(float(wall), 1e-9)}
-    at = 0.0
-    for stage in STAGES:
-        end = at + t.get(stage, 0)
-        inside = [s for s in samples if at <= s[0] <= end]
-        usage[stage] = ((inside[-1][1] - inside[0][1]) / (inside[-1][0] - inside[0][0])
+    cores = {"cpu/wall": (usage.ru_utime + usage.ru_stime) / max(wall, 1e-9)}
+    for stage, begin, end in stage_spans(t, 0.0):
+        inside = [s for s in samples if begin <= s[0] <= end]
+        cores[stage] = ((inside[-1][1] - inside[0][1]) / (inside[-1][0] - inside[0][0])
                         if len(inside) >= 10 else None)
-        at = end
-    return float(wall), int(rss_kb) * 1024, t, usage
+    return wall, usage.ru_maxrss * 1024, t, cores
 
 
 def main():
@@ -92,14 +76,14 @@ def main():
             mpx = px / 1e6
             rates = []
             for _ in range(FIRST_RUNS if i == 0 else 1):
-                wall, rss, t, usage = run(terrain, dem, work)
+                wall, rss, t, cores = run(terrain, dem, work)
                 rates.append(wall / mpx)
                 ratio = f"{wall / mpx / first:7.2f}" if first else f"{'':7}"
                 print(f"{w}x{h:<7} {wall:8.1f} {rss / 2**20:9.0f} {rss / px:8.0f} {wall / mpx:7.2f} "
                       f"{ratio} " + " ".join(f"{t.get(s, 0) / mpx:8.2f}" for s in STAGES), flush=True)
-                share = " ".join(f"{usage[s]:8.2f}" if usage[s] is not None else f"{'-':>8}"
+                share = " ".join(f"{cores[s]:8.2f}" if cores.get(s) is not None else f"{'-':>8}"
                                  for s in STAGES)
-                print(f"{'':12} {'cpu/wall':>26} {usage['cpu/wall']:7.2f} {'':7} {share}",
+                print(f"{'':12} {'cpu/wall':>26} {cores['cpu/wall']:7.2f} {'':7} {share}",
                       flush=True)
             if first is None:
                 first = statistics.median(rates)
