@@ -1,6 +1,6 @@
 // Benchmark: the growing stage of `terrain segment`: the regions grown on the simplified Reeb
-// graph, the absorbed vertices divided among them by the flooding (its batches on every
-// thread), and the region graph. On a DEM given (a global grid of tests/bench/
+// graph, the absorbed vertices divided among them by the flooding (in parts of the vertices
+// on every thread), and the region graph. On a DEM given (a global grid of tests/bench/
 // make_global_dem.py) or a synthetic Vesta tile of the size given; the stages before it run
 // once, each step of the growing three times (best wall time, and the calling thread's CPU
 // time). It holds every stage's arrays, unlike `terrain segment`, which frees and parks them:

@@ -152,14 +152,13 @@ TEST_CASE("Dividing absorbed vertices on the Vesta tile: connected, deterministi
     CHECK(one.counts.detached == run.counts.detached);
 }
 
-TEST_CASE("Dividing absorbed vertices in batches of offers on the threads: the same division",
+TEST_CASE("Dividing absorbed vertices in parts on the threads: the same division",
           "[segment][divide]") {
-    // Offers taken one at a time in order (the plain flooding) against batches of them taken
-    // on every thread, even batches of one offer; on the Vesta tile (a grid) and on a sphere
-    // (a mesh whose vertex numbers are not rows: bumps with a little noise, and deep pits that
-    // set the range, so that its steps are mostly the constant per edge length). Batches
-    // bounded by five times the least step (a flooding that takes offers too early) give
-    // other labels on the tile.
+    // The flooding in order (one offer at a time) against the flooding in parts of the
+    // vertices, each taking what no other part can undercut, at one and two threads; on the
+    // Vesta tile (a grid, parts of rows) and on a sphere (a mesh whose vertex numbers are not
+    // rows, so that each part touches many others: bumps with a little noise, and deep pits
+    // that set the range, so that its steps are mostly the constant per edge length).
     const auto dem = io::read_dem(test::sample("vesta_hamo_tile.lbl"));
     const auto tile = mesh::dem_to_mesh(dem);
     const auto sphere = icosphere(40);
@@ -177,18 +176,20 @@ TEST_CASE("Dividing absorbed vertices in batches of offers on the threads: the s
         o.area_ratio = mesh == &tile ? 0.5 : 0.0;  // (the sphere's bumps and pits stay)
         const auto simplified = reeb::simplify(*mesh, reeb::build_reeb_graph(*mesh, field), o);
         const auto grown = segment::grow_regions(*mesh, simplified.graph);
-        const auto divide = [&](std::size_t batch) {
+        const auto divide = [&](std::size_t parts) {
             auto s = grown;
             const auto counts = segment::internal::divide_absorbed(
-                *mesh, simplified.graph, field, simplified.absorbed, s, nullptr, {}, batch);
+                *mesh, simplified.graph, field, simplified.absorbed, s, nullptr, {}, parts);
             return std::make_pair(s.labels, counts.relabelled);
         };
-        const auto in_order = test::with_threads(1, [&] { return divide(SIZE_MAX); });
+        const auto in_order = test::with_threads(1, [&] { return divide(1); });
         REQUIRE(in_order.second > 0);
-        CHECK(test::with_threads(2, [&] { return divide(1); }) == in_order);
-        CHECK(test::with_threads(2, [&] { return divide(64); }) == in_order);
-        CHECK(test::with_threads(1, [&] { return divide(1); }) == in_order);
-        CHECK(divide(segment::internal::kParallelBatch) == in_order);
+        for (const std::size_t parts : {2, 3, 16, 64, 1000}) {
+            CAPTURE(parts);
+            CHECK(test::with_threads(2, [&] { return divide(parts); }) == in_order);
+            CHECK(test::with_threads(1, [&] { return divide(parts); }) == in_order);
+        }
+        CHECK(divide(0) == in_order);
     }
 }
 

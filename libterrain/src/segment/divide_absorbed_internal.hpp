@@ -1,7 +1,7 @@
 #pragma once
-// Private: segment::divide_absorbed with the size of the batches of offers its flooding takes
-// on every thread (divide_absorbed.cpp), for tests: SIZE_MAX takes every offer in order on
-// one thread, as a flooding one offer at a time does; 1 takes every batch on the threads.
+// Private: segment::divide_absorbed with the number of parts of the vertices its flooding
+// takes on the threads (flooding.hpp), for tests: 1 floods in order on one thread, k in k
+// parts, 0 as divide_absorbed chooses.
 
 #include <cstddef>
 
@@ -9,14 +9,17 @@
 
 namespace terrain::segment::internal {
 
-// Below this many offers a batch is taken in order on the caller's thread: a batch on the
-// threads costs a few microseconds to start.
-inline constexpr std::size_t kParallelBatch = 64;
+// With this many vertices or more, the flooding goes in parts: kPartsPerThread a thread (so
+// that a thread that finishes its parts first takes another's), at most kMostParts. Below,
+// the rounds' starts on the threads cost more than they save.
+inline constexpr std::size_t kPartsFrom = std::size_t{1} << 18;
+inline constexpr std::size_t kPartsPerThread = 8;
+inline constexpr std::size_t kMostParts = 64;
 
 DivideCounts divide_absorbed(const TriangleMesh& mesh, const reeb::ReebGraph& graph,
                              const std::vector<float>& field,
                              const std::vector<std::uint8_t>& absorbed, Segmentation& segmentation,
                              const std::vector<std::uint32_t>* finer, const ProgressFn& progress,
-                             std::size_t parallel_batch, Residency& memory = all_resident());
+                             std::size_t parts, Residency& memory = all_resident());
 
 }  // namespace terrain::segment::internal
