@@ -20,6 +20,13 @@ namespace terrain::segment::internal {
 using detail::i32;
 using detail::idx;
 
+double edge_length(const TriangleMesh& mesh, std::size_t a, std::size_t b) {
+    const auto& p = mesh.positions()[a];
+    const auto& q = mesh.positions()[b];
+    return std::sqrt(double(p[0] - q[0]) * (p[0] - q[0]) + double(p[1] - q[1]) * (p[1] - q[1]) +
+                     double(p[2] - q[2]) * (p[2] - q[2]));
+}
+
 double mean_edge_length(const TriangleMesh& mesh, const ProgressFn& progress, double from,
                         double to) {
     const detail::PassProgress pass(progress, from, to, "divide");
@@ -28,12 +35,6 @@ double mean_edge_length(const TriangleMesh& mesh, const ProgressFn& progress, do
     const std::size_t blocks = (n >> kBlockShift) + 1;
     constexpr std::size_t kWaveBlocks = 64;  // (a wave's lengths: 2^18 vertices, about 12 MB)
     std::array<std::vector<double>, kWaveBlocks> lengths;
-    const auto length = [&](std::size_t a, std::size_t b) {
-        const auto& p = mesh.positions()[a];
-        const auto& q = mesh.positions()[b];
-        return std::sqrt(double(p[0] - q[0]) * (p[0] - q[0]) + double(p[1] - q[1]) * (p[1] - q[1]) +
-                         double(p[2] - q[2]) * (p[2] - q[2]));
-    };
     double sum = 0;
     std::size_t count = 0;
     for (std::size_t b0 = 0; b0 < blocks; b0 += kWaveBlocks) {
@@ -47,7 +48,7 @@ double mean_edge_length(const TriangleMesh& mesh, const ProgressFn& progress, do
                                   const std::size_t last = std::min(n, (b + 1) << kBlockShift);
                                   for (std::size_t v = b << kBlockShift; v < last; ++v)
                                       for (const i32 w : mesh.neighbors_of(v))
-                                          mine.push_back(length(v, idx(w)));
+                                          mine.push_back(edge_length(mesh, v, idx(w)));
                               }
                           });
         for (std::size_t b = b0; b < b1; ++b) {
@@ -56,13 +57,6 @@ double mean_edge_length(const TriangleMesh& mesh, const ProgressFn& progress, do
         }
     }
     return count == 0 || sum <= 0 ? 1.0 : sum / double(count);
-}
-
-double Flooding::edge_length(std::size_t a, std::size_t b) const {
-    const auto& p = mesh_.positions()[a];
-    const auto& q = mesh_.positions()[b];
-    return std::sqrt(double(p[0] - q[0]) * (p[0] - q[0]) + double(p[1] - q[1]) * (p[1] - q[1]) +
-                     double(p[2] - q[2]) * (p[2] - q[2]));
 }
 
 void Flooding::prefetch(std::size_t vertex) const {

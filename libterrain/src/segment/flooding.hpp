@@ -56,6 +56,9 @@ inline bool is_final(Site s) {
     return (s & kFinal) != 0;
 }
 
+// The length of the edge from a to b, in the mesh's units.
+double edge_length(const TriangleMesh& mesh, std::size_t a, std::size_t b);
+
 // The edges' mean length. The costs, hence the labels, depend on the sum's last bits: it is
 // taken in vertex order, on one thread, over the lengths that a wave of blocks of vertices has
 // made on every thread. Progress `from` to `to` of "divide".
@@ -85,14 +88,12 @@ class Flooding {
     // The constant part of a step from w to u: at least this is added to any offer's cost
     // (in floats, not less: a sum of floats does not fall when a term grows).
     float step(std::size_t u, std::size_t w) const {
-        return step_ * static_cast<float>(edge_length(u, w) / mean_edge_);
+        return step_ * static_cast<float>(edge_length(mesh_, u, w) / mean_edge_);
     }
 
     void prefetch(std::size_t vertex) const;
 
   private:
-    double edge_length(std::size_t a, std::size_t b) const;
-
     const TriangleMesh& mesh_;
     const std::vector<float>& field_;
     std::vector<Site>& sites_;
