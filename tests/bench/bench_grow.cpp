@@ -1,6 +1,7 @@
 // Benchmark: the growing stage of `terrain segment`: the regions grown on the simplified Reeb
 // graph, the absorbed vertices divided among them by the flooding (in parts of the vertices
-// on every thread), and the region graph. On a DEM given (a global grid of tests/bench/
+// on every thread; then again in order, one offer at a time, for comparison), and the region
+// graph. On a DEM given (a global grid of tests/bench/
 // make_global_dem.py) or a synthetic Vesta tile of the size given; the stages before it run
 // once, each step of the growing three times (best wall time, and the calling thread's CPU
 // time). It holds every stage's arrays, unlike `terrain segment`, which frees and parks them:
@@ -11,6 +12,7 @@
 #include <cstdlib>
 #include <string>
 
+#include "../../libterrain/src/segment/divide_absorbed_internal.hpp"
 #include "bench_main.hpp"
 #include "bench_measure.hpp"
 #include "terrain/field/shape_index.hpp"
@@ -67,6 +69,20 @@ static int run_bench(int argc, char** argv) {
         &cpu);
     std::printf("divide absorbed  %7.3f s (CPU %7.3f)  %6.2f M vertices/s  %zu absorbed\n", t, cpu,
                 nv / t / 1e6, counts.absorbed);
+    // The same division with its flooding in order, one offer at a time (the parts' reference:
+    // the same labels, checked).
+    segment::Segmentation in_order;
+    t = best_of(
+        3,
+        [&] {
+            in_order = grown;
+            segment::internal::divide_absorbed(mesh, simplified.graph, field, simplified.absorbed,
+                                               in_order, nullptr, {}, 1);
+        },
+        &cpu);
+    std::printf("  in order       %7.3f s (CPU %7.3f)  %6.2f M vertices/s  %s labels\n", t, cpu,
+                nv / t / 1e6, in_order.labels == divided.labels ? "the same" : "OTHER");
+    if (in_order.labels != divided.labels) return 1;
     segment::RegionGraph regions;
     t = best_of(
         3,
