@@ -610,3 +610,49 @@ TEST_CASE("a wide rung's lattice holds the seam's columns and the poles", "[scal
                  out.scale[v] < out.radii.size());
     CHECK(bad == 0);
 }
+
+TEST_CASE("the scale-selected field made by bands of rows is the whole field's on them",
+          "[scale_selection]") {
+    // A field split over processes or tiles: each band of rows made alone (the rows of tiles
+    // around it fitted, the lattice's points around it for the wide rungs) gives its rows'
+    // values and scales bit for bit. On a tile with two craters and on the half-degree Moon
+    // (poles, seam, a rung on a lattice), bands cut at rows off the tiles and the lattice.
+    const auto tile = mesh::dem_to_mesh(grid(128, [](double x, double y) {
+        return crater(x, y, 40, 60, 7) + crater(x, y, 90, 70, 15) + 0.3 * std::sin(0.7 * x + y);
+    }));
+    auto moon = moon_sphere(720);
+    moon.values = cup_on_sphere(moon, 10, 400e3, 40e3);
+    const auto globe = mesh::dem_to_mesh(moon);
+    for (const auto* mesh : {&tile, &globe}) {
+        field::ShapeIndexOptions options;
+        options.auto_scale = true;
+        const auto whole = field::scale_selected_shape_index(*mesh, options);
+        const int h = mesh->grid_height;
+        const std::vector<int> cuts{0, 1, h / 3 + 1, h / 2 + 5, h - 1, h};
+        std::size_t compared = 0, differ = 0;
+        for (std::size_t b = 0; b + 1 < cuts.size(); ++b) {
+            options.first_row = cuts[b];
+            options.end_row = cuts[b + 1];
+            const auto band = field::scale_selected_shape_index(*mesh, options);
+            for (std::size_t v = 0; v < mesh->vertex_count(); ++v) {
+                const int row = mesh->vertex_pixel[v] / mesh->grid_width;
+                if (row < cuts[b] || row >= cuts[b + 1]) continue;
+                ++compared;
+                differ += band.field[v] != whole.field[v] || band.scale[v] != whole.scale[v];
+            }
+        }
+        CHECK(compared == mesh->vertex_count());
+        CHECK(differ == 0);
+    }
+    // A band's rung fits the rows of tiles around it only.
+    std::size_t fitted = 0;
+    field::ShapeIndexOptions one;
+    one.radius = 4 * std::sqrt(mean_vertex_area(globe));
+    one.first_row = 100;
+    one.end_row = 101;
+    field::detail::for_each_curvature(
+        globe, one, {},
+        [&](std::int32_t, bool, const field::PrincipalCurvatures&, double) { ++fitted; });
+    CHECK(fitted > 0);
+    CHECK(fitted < globe.vertex_count() / 4);
+}

@@ -290,16 +290,25 @@ void climb_rung(const TriangleMesh& mesh, const ShapeIndexOptions& one, const Ru
         return;
     }
     detail::SampleLattice lattice(mesh.grid_width, mesh.grid_height, one.sample_stride);
+    // The lattice's points around the rows asked for: a vertex takes the points of its cell,
+    // or past the lattice's ends the last two along a line.
+    ShapeIndexOptions around = one;
+    const int margin = 2 * one.sample_stride + 1;
+    around.first_row = one.first_row > margin ? one.first_row - margin : 0;
+    around.end_row = one.end_row < INT32_MAX - margin ? one.end_row + margin : INT32_MAX;
     detail::for_each_curvature(
-        mesh, one, scaled_progress(progress, 0, 0.95),
+        mesh, around, scaled_progress(progress, 0, 0.95),
         [&](std::int32_t v, bool ok, const PrincipalCurvatures& k, double scale) {
             double cd = 0, f = 0;
             if (measure(v, ok, k, scale, cd, f))
                 lattice.set(mesh.vertex_pixel[std::size_t(v)], float(cd), float(f));
         });
     const std::size_t n = mesh.vertex_count();
+    const auto width = std::int64_t(mesh.grid_width);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096), [&](const auto& r) {
         for (std::size_t v = r.begin(); v < r.end(); ++v) {
+            const std::int64_t row = mesh.vertex_pixel[v] / width;
+            if (row < one.first_row || row >= one.end_row) continue;
             float cd = 0, f = 0;
             if (lattice.at(mesh.vertex_pixel[v], cd, f)) choice.climb(v, rung, cd, f);
         }

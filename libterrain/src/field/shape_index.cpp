@@ -162,6 +162,14 @@ void fit_in_batches(const TriangleMesh& mesh, const std::vector<Vec3>& normals,
     }
 }
 
+// Whether vertex v's row is among options' rows (a vertex of a mesh not made from a DEM:
+// always).
+bool row_asked(const TriangleMesh& mesh, const ShapeIndexOptions& options, std::int32_t v) {
+    if (mesh.grid_width <= 0 || mesh.vertex_pixel.size() != mesh.vertex_count()) return true;
+    const auto row = std::int64_t(mesh.vertex_pixel[std::size_t(v)]) / mesh.grid_width;
+    return row >= options.first_row && row < options.end_row;
+}
+
 template <class Body>
 void for_each_vertex(const TriangleMesh& mesh, const ShapeIndexOptions& options,
                      const ProgressFn& progress, Body body) {
@@ -197,6 +205,7 @@ void for_each_vertex(const TriangleMesh& mesh, const ShapeIndexOptions& options,
             }
             Scratch& s = scratch.local();
             for (std::int32_t v = r.begin(); v < r.end(); ++v) {
+                if (!row_asked(mesh, options, v)) continue;
                 PrincipalCurvatures k;
                 double scale = 0;
                 const bool ok = mesh_fit(mesh, v, normals[v], options, disk_grid, s, k, scale);

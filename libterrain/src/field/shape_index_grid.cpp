@@ -316,10 +316,20 @@ std::size_t grid_for_each_vertex(const TriangleMesh& mesh, const GridLayout& g,
         std::erase_if(unowned, [&](std::int32_t v) {
             return v != mesh.pole_vertices[0] && v != mesh.pole_vertices[1];
         });
+    // (Rows of tiles with no row asked for are skipped, and vertices no pixel owns outside
+    // them.)
+    const auto asked = [&](int r0, int r1) {
+        return r1 > options.first_row && r0 < options.end_row;
+    };
+    std::erase_if(unowned, [&](std::int32_t v) {
+        const int row = int(std::size_t(mesh.vertex_pixel[std::size_t(v)]) / std::size_t(g.width));
+        return !asked(row, row + 1);
+    });
     std::vector<Vec3> unowned_normals(unowned.size());
     std::size_t next_unowned = 0;
     for (int tr = 0; tr < tile_rows; ++tr) {
         const int r0 = tr * tile, r1 = std::min(g.height, r0 + tile);
+        if (!asked(r0, r1)) continue;
         const Normals& band = normals.rows(r0, r1);
         tbb::parallel_for(tbb::blocked_range<int>(0, tile_cols, 1), [&](const auto& r) {
             for (int tc = r.begin(); tc < r.end(); ++tc)

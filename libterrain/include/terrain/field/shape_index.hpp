@@ -78,6 +78,13 @@ struct ShapeIndexOptions {
     // call. scale_selected_shape_index sets it on its wide rungs, whose field varies over
     // their radius, and interpolates between the fitted vertices.
     int sample_stride = 1;
+    // On a DEM's grid (the grid method and the disk window), the pixel rows [first_row,
+    // end_row) whose vertices must get their value; the others may be left with any value
+    // (the rows of tiles that hold none of them are not fitted). A part of a grid's field made
+    // so is the whole field's, bit for bit, on those rows: the field split over processes
+    // or tiles. Meshes not made from a DEM take every vertex.
+    int first_row = 0;
+    int end_row = INT32_MAX;
 };
 
 // The method shape_index_field takes for this mesh and these options: "grid" or "mesh".
