@@ -31,6 +31,8 @@ packages=(
   libfreetype-dev
   libboost-program-options-dev
   libeigen3-dev libtbb-dev
+  # `mpirun -np N terrain segment` (docs/scale.md, "Ranks").
+  libopenmpi-dev openmpi-bin
   catch2
   time
   fonts-dejavu-core

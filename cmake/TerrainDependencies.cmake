@@ -19,6 +19,8 @@ terrain_require(Boost libboost-program-options-dev 1.71 COMPONENTS program_optio
 terrain_require(Eigen3 libeigen3-dev 3.3 NO_MODULE)
 terrain_require(TBB libtbb-dev CONFIG)
 terrain_require(Freetype libfreetype-dev)
+set(MPI_CXX_SKIP_MPICXX ON)  # (the C API from C++: no deprecated C++ bindings)
+terrain_require(MPI libopenmpi-dev COMPONENTS CXX)
 find_package(Threads REQUIRED)
 
 include(TerrainFindLibraries)

@@ -1,4 +1,5 @@
 #include "cli.hpp"
+#include "ranks.hpp"
 
 #include <cmath>
 #include <iostream>
@@ -59,10 +60,19 @@ ProgressFn terminal_progress(bool quiet) {
 }
 
 int guarded(const std::string& command, const std::function<int()>& body) {
+    // With several ranks, the line names the rank, and every rank stops.
+    const bool several = ranks().size > 1;
     auto report = [&](const std::string& message) {
         if (progress_line_open) std::cerr << "\n";
         progress_line_open = false;
-        std::cerr << "terrain " << command << ": " << message << "\n";
+        std::cerr << "terrain " << command << ": "
+                  << (several ? "rank " + std::to_string(ranks().rank) + ": " : "") << message
+                  << "\n";
+        std::cerr.flush();
+    };
+    const auto stop = [&](int status) {
+        if (several) stop_all_ranks(status);
+        return status;
     };
     // Interrupted: the work stopped at a progress callback and the temporaries went with the
     // unwinding; the status says which signal.
@@ -72,22 +82,22 @@ int guarded(const std::string& command, const std::function<int()>& body) {
     };
     try {
         const int status = body();
-        return pending_signal() != 0 ? interrupted() : status;
+        return pending_signal() != 0 ? stop(interrupted()) : status;
     } catch (const UsageError& e) {
-        if (pending_signal() != 0) return interrupted();
+        if (pending_signal() != 0) return stop(interrupted());
         report(e.what());
-        return kUsageError;
+        return stop(kUsageError);
     } catch (const terrain::Error& e) {
-        if (pending_signal() != 0) return interrupted();
+        if (pending_signal() != 0) return stop(interrupted());
         report(e.what());
-        return kUserError;
+        return stop(kUserError);
     } catch (const std::bad_alloc&) {
         report("out of memory; try a smaller input");
-        return kUserError;
+        return stop(kUserError);
     } catch (const std::exception& e) {
-        if (pending_signal() != 0) return interrupted();
+        if (pending_signal() != 0) return stop(interrupted());
         report(e.what());
-        return kUserError;
+        return stop(kUserError);
     }
 }
 

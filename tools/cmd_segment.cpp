@@ -5,9 +5,12 @@
 // The main job: field, Reeb graph, simplification, region growing, and every output file
 // (terrain/pipeline/segment.hpp does the work). The outputs are written into a temporary
 // sibling directory that replaces OUTDIR at the end, so OUTDIR appears complete or not at all.
+#include <optional>
 #include "cli.hpp"
 #include "field_options.hpp"
+
 #include "input.hpp"
+#include "ranks.hpp"
 #include "segment_job.hpp"
 
 namespace terrain::cli {
@@ -39,21 +42,35 @@ int run_segment(int argc, char** argv) {
         field_values.options = to_field_options(field_values, vm);
         check_one_area_threshold(vm, "min-area");
         segment_values.landform_defaults = no_scale_option(vm);
-        const auto segment_options = to_pipeline_options(field_values, segment_values);
-        pipeline::OutputDirectory dir(common.output, common.overwrite);
+        auto segment_options = to_pipeline_options(field_values, segment_values);
+        // Under mpirun the ranks make the field's bands together, and rank 0 alone goes on,
+        // checks, reports and writes (docs/scale.md, "Ranks").
+        const Ranks& mpi = ranks();
+        const bool writer = mpi.rank == 0;
+        std::optional<pipeline::OutputDirectory> dir;
+        if (writer) dir.emplace(common.output, common.overwrite);
 
-        const auto progress = terminal_progress(common.quiet);
+        const auto progress = terminal_progress(common.quiet || !writer);
+        if (!writer) meet_ranks();
         auto input = load_input(common.input, input_values, field_values.options.kind,
                                 scaled_progress(progress, 0, 0.15), true);
         check_field_limits(field_values.options, input.mesh);  // --radius against the mesh
-        print_input_warnings("segment", input);
+        if (writer) {
+            print_input_warnings("segment", input);
+            meet_ranks();
+        }
+        if (mpi.size > 1 && pipeline::field_splits(segment_options, input))
+            segment_options.field_share = field_share();
+        else if (!writer)
+            return 0;  // (a field that does not split is made whole on rank 0)
         auto result = pipeline::segment(std::move(input), segment_options,
                                         scaled_progress(progress, 0.15, 0.7));
+        if (!writer) return 0;
         pipeline::WriteOptions write;
         write.release_memory = true;
-        pipeline::write_segment_directory(result, segment_options, common.input, dir.temp_path(),
+        pipeline::write_segment_directory(result, segment_options, common.input, dir->temp_path(),
                                           write, scaled_progress(progress, 0.7, 0.95));
-        dir.commit();
+        dir->commit();
         report_progress(progress, 1.0);
         print_summary(result, common.output, segment_values.timings);
         return 0;

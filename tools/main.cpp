@@ -9,6 +9,7 @@
 #include <string>
 
 #include "cli.hpp"
+#include "ranks.hpp"
 #include "signals.hpp"
 #include "terrain/core/huge_pages.hpp"
 #include "terrain/core/version.hpp"
@@ -114,8 +115,16 @@ int main(int argc, char** argv) {
             std::cout << "  " << name << " " << version << "\n";
         return 0;
     }
-    for (const auto& c : kCommands)
-        if (first == c.name) return c.run(argc - 1, argv + 1);
+    for (const auto& c : kCommands) {
+        if (first != c.name) continue;
+        // Under mpirun: `segment` splits its field over the ranks; any other command runs on
+        // rank 0 alone, the other ranks waiting for it to end.
+        terrain::cli::start_ranks(argc, argv);
+        const auto& ranks = terrain::cli::ranks();
+        if (ranks.size > 1 && ranks.rank != 0 && first != "segment")
+            return terrain::cli::finish_ranks(0);
+        return terrain::cli::finish_ranks(c.run(argc - 1, argv + 1));
+    }
     std::cerr << "terrain: unknown command '" << first << "' (see terrain --help)\n";
     return terrain::cli::kUsageError;
 }

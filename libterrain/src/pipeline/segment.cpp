@@ -79,13 +79,50 @@ std::vector<std::uint32_t> SegmentResult::label_pixels() const {
     return segment::label_pixels(input.mesh, *input.dem, segmentation.labels);
 }
 
+bool field_splits(const SegmentOptions& options, const Input& input) {
+    const auto resolved = resolve_options(options, input.dem.has_value());
+    return input.dem && resolved.field == field::FieldKind::shape_index &&
+           resolved.shape_index.auto_scale && input.mesh.grid_width > 0 &&
+           input.mesh.vertex_pixel.size() == input.mesh.vertex_count();
+}
+
+namespace {
+
+// Each part's first vertex, and the vertex count last: part p holds the rows [H p / parts,
+// H (p + 1) / parts) of the grid, whose vertices are numbered by rows.
+std::vector<std::size_t> part_bounds(const TriangleMesh& mesh, int parts) {
+    std::vector<std::size_t> bounds;
+    const std::int64_t width = mesh.grid_width, height = mesh.grid_height;
+    for (int p = 0; p < parts; ++p) {
+        const std::int64_t row = height * p / parts;
+        const auto first = std::partition_point(
+            mesh.vertex_pixel.begin(), mesh.vertex_pixel.end(),
+            [&](std::int32_t pixel) { return std::int64_t(pixel) / width < row; });
+        bounds.push_back(std::size_t(first - mesh.vertex_pixel.begin()));
+    }
+    bounds.push_back(mesh.vertex_count());
+    return bounds;
+}
+
+}  // namespace
+
 void compute_field(SegmentResult& result, const SegmentOptions& options,
                    const ProgressFn& progress) {
     const auto t0 = clock::now();
-    const auto fo = field_options(options);
+    auto fo = field_options(options);
+    const FieldShare& share = options.field_share;
+    const bool split = share.parts > 1 && field_splits(options, result.input);
+    if (split) {
+        const std::int64_t height = result.input.mesh.grid_height;
+        fo.shape_index.first_row = int(height * share.part / share.parts);
+        fo.shape_index.end_row = int(height * (share.part + 1) / share.parts);
+    }
     if (fo.kind == field::FieldKind::shape_index && fo.shape_index.auto_scale) {
         auto selected =
             field::scale_selected_shape_index(result.input.mesh, fo.shape_index, progress);
+        if (split)
+            share.gather(selected.field, selected.scale,
+                         part_bounds(result.input.mesh, share.parts));
         result.field = std::move(selected.field);
         result.field_scale = std::move(selected.scale);
         result.field_radii = std::move(selected.radii);
@@ -359,6 +396,7 @@ SegmentResult segment(Input input, const SegmentOptions& requested, const Progre
     result.parked_field = plan.parked_in(field);
     result.add_time("field", since(t0));
     compute_field(result, options, slice_of(progress, kFieldSlice, 0.05, 1));
+    if (options.field_share.stop_after_field) return result;
 
     t0 = clock::now();
     plan.enter(Stage::reeb_events, slice_of(progress, kReebSlice, 0, 0.05));

@@ -67,6 +67,23 @@ Input input_from_dem(Dem dem, std::optional<MeshFrame> frame = std::nullopt,
 
 // The options of `terrain segment` (docs/cli.md), with its defaults. The command line and the
 // Python module read them from text with the parsers of terrain/pipeline/options.hpp.
+// The ladder's field made in parts by several processes (MPI ranks; docs/scale.md, "Ranks"):
+// this process makes the DEM's rows [rows x part / parts, rows x (part + 1) / parts) (the
+// field by bands of rows, docs/field.md), then `gather` fills in the other parts' values and
+// scales from theirs. `bounds` holds each part's first vertex and, last, the vertex count: a
+// DEM's vertices are numbered by rows, so part p holds [bounds[p], bounds[p + 1]). The field
+// is the whole field's bit for bit, so the outputs do not depend on the number of parts.
+// Only the ladder's field on a DEM splits (field_splits); other fields are made whole.
+struct FieldShare {
+    int part = 0, parts = 1;
+    std::function<void(std::vector<float>& field, std::vector<std::uint8_t>& scale,
+                       const std::vector<std::size_t>& bounds)>
+        gather;
+    // segment() returns once the field is gathered: a process that takes part in the field
+    // only (its result holds the input and the field).
+    bool stop_after_field = false;
+};
+
 struct SegmentOptions {
     // The shape index, the SDF or the height.
     field::FieldKind field = field::FieldKind::shape_index;
@@ -109,7 +126,13 @@ struct SegmentOptions {
     // the same either way (docs/performance.md, "Arrays parked on disk").
     std::string park_directory;
     std::size_t park_min_bytes = std::size_t{64} << 20;
+    FieldShare field_share;
 };
+
+// Whether segment() with these options splits the field of this input over
+// options.field_share's parts: the ladder's field (shape_index.auto_scale, or the landform
+// defaults) on a DEM.
+bool field_splits(const SegmentOptions& options, const Input& input);
 
 // The smallest landform of min_area "auto", in mean vertex areas (pixels of a DEM): a floor
 // of about 5 pixels across, that of a crater of about 10.
