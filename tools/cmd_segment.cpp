@@ -6,9 +6,9 @@
 // (terrain/pipeline/segment.hpp does the work). The outputs are written into a temporary
 // sibling directory that replaces OUTDIR at the end, so OUTDIR appears complete or not at all.
 #include <optional>
+
 #include "cli.hpp"
 #include "field_options.hpp"
-
 #include "input.hpp"
 #include "ranks.hpp"
 #include "segment_job.hpp"
