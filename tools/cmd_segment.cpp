@@ -45,27 +45,21 @@ int run_segment(int argc, char** argv) {
         auto segment_options = to_pipeline_options(field_values, segment_values);
         // Under mpirun the ranks make the field's bands together, and rank 0 alone goes on,
         // checks, reports and writes (docs/scale.md, "Ranks").
-        const Ranks& mpi = ranks();
-        const bool writer = mpi.rank == 0;
+        const RankedCommand ranked;
         std::optional<pipeline::OutputDirectory> dir;
-        if (writer) dir.emplace(common.output, common.overwrite);
+        if (ranked.writer()) dir.emplace(common.output, common.overwrite);
 
-        const auto progress = terminal_progress(common.quiet || !writer);
-        if (!writer) meet_ranks();
+        const auto progress = terminal_progress(common.quiet || !ranked.writer());
+        ranked.reading();
         auto input = load_input(common.input, input_values, field_values.options.kind,
                                 scaled_progress(progress, 0, 0.15), true);
         check_field_limits(field_values.options, input.mesh);  // --radius against the mesh
-        if (writer) {
-            print_input_warnings("segment", input);
-            meet_ranks();
-        }
-        if (mpi.size > 1 && pipeline::field_splits(segment_options, input))
-            segment_options.field_share = field_share();
-        else if (!writer)
-            return 0;  // (a field that does not split is made whole on rank 0)
+        if (ranked.writer()) print_input_warnings("segment", input);
+        ranked.read();
+        if (!ranked.take_part(segment_options, input)) return 0;
         auto result = pipeline::segment(std::move(input), segment_options,
                                         scaled_progress(progress, 0.15, 0.7));
-        if (!writer) return 0;
+        if (!ranked.writer()) return 0;
         pipeline::WriteOptions write;
         write.release_memory = true;
         pipeline::write_segment_directory(result, segment_options, common.input, dir->temp_path(),

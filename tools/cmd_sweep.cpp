@@ -7,9 +7,12 @@
 // regions of the next scale), sweep.csv, sweep.png and run.json. See docs/sweep.md.
 #include <cstdio>
 
+#include <optional>
+
 #include "cli.hpp"
 #include "field_options.hpp"
 #include "input.hpp"
+#include "ranks.hpp"
 #include "segment_job.hpp"
 #include "terrain/pipeline/sweep.hpp"
 
@@ -49,27 +52,34 @@ int run_sweep(int argc, char** argv) {
         const bool by_area = vm.count("min-areas") > 0;
         // (refuses contradictions: exit status 2)
         field_values.options = to_field_options(field_values, vm);
-        const auto segment_options = to_pipeline_options(field_values, segment_values);
+        auto segment_options = to_pipeline_options(field_values, segment_values);
         std::vector<double> ratios;
         std::vector<pipeline::AreaThreshold> areas;
         if (by_area)
             areas = pipeline::parse_min_areas(areas_text);
         else
             ratios = pipeline::parse_area_ratios(ratios_text);
-        pipeline::OutputDirectory dir(common.output, common.overwrite);
+        // Under mpirun the ranks make the field's bands together (docs/scale.md, "Ranks").
+        const RankedCommand ranked;
+        std::optional<pipeline::OutputDirectory> dir;
+        if (ranked.writer()) dir.emplace(common.output, common.overwrite);
 
-        const auto progress = terminal_progress(common.quiet);
+        const auto progress = terminal_progress(common.quiet || !ranked.writer());
+        ranked.reading();
         auto input = load_input(common.input, input_values, field_values.options.kind,
                                 scaled_progress(progress, 0, 0.15));
         check_field_limits(field_values.options, input.mesh);  // --radius against the mesh
-        print_input_warnings("sweep", input);
+        if (ranked.writer()) print_input_warnings("sweep", input);
+        ranked.read();
+        if (!ranked.take_part(segment_options, input)) return 0;
         auto result = by_area ? pipeline::sweep(std::move(input), areas, segment_options,
                                                 scaled_progress(progress, 0.15, 0.75))
                               : pipeline::sweep(std::move(input), ratios, segment_options,
                                                 scaled_progress(progress, 0.15, 0.75));
-        pipeline::write_sweep_directory(result, segment_options, common.input, dir.temp_path(),
+        if (!ranked.writer()) return 0;
+        pipeline::write_sweep_directory(result, segment_options, common.input, dir->temp_path(),
                                         scaled_progress(progress, 0.75, 0.99));
-        dir.commit();
+        dir->commit();
         report_progress(progress, 1.0);
         std::printf("%s: %zu scales;", common.output.c_str(), result.scales.size());
         for (const auto& s : result.scales)

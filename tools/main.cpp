@@ -117,11 +117,11 @@ int main(int argc, char** argv) {
     }
     for (const auto& c : kCommands) {
         if (first != c.name) continue;
-        // Under mpirun: `segment` splits its field over the ranks; any other command runs on
-        // rank 0 alone, the other ranks waiting for it to end.
+        // Under mpirun: `segment` and `sweep` split their field over the ranks; any other
+        // command runs on rank 0 alone, the other ranks waiting for it to end.
         terrain::cli::start_ranks(argc, argv);
         const auto& ranks = terrain::cli::ranks();
-        if (ranks.size > 1 && ranks.rank != 0 && first != "segment")
+        if (ranks.size > 1 && ranks.rank != 0 && first != "segment" && first != "sweep")
             return terrain::cli::finish_ranks(0);
         return terrain::cli::finish_ranks(c.run(argc - 1, argv + 1));
     }

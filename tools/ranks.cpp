@@ -70,8 +70,29 @@ void stop_all_ranks(int status) {
     if (started && the_ranks.size > 1) MPI_Abort(MPI_COMM_WORLD, status);
 }
 
+namespace {
+
 void meet_ranks() {
     if (started && the_ranks.size > 1) MPI_Barrier(MPI_COMM_WORLD);
+}
+
+}  // namespace
+
+void RankedCommand::reading() const {
+    if (!writer()) meet_ranks();
+}
+
+void RankedCommand::read() const {
+    if (writer()) meet_ranks();
+}
+
+bool RankedCommand::take_part(pipeline::SegmentOptions& options,
+                              const pipeline::Input& input) const {
+    if (the_ranks.size > 1 && pipeline::field_splits(options, input)) {
+        options.field_share = field_share();
+        return true;
+    }
+    return writer();
 }
 
 pipeline::FieldShare field_share() {

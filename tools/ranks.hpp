@@ -25,9 +25,20 @@ void stop_all_ranks(int status);
 // gathered with every other rank's.
 pipeline::FieldShare field_share();
 
-// With several ranks, a meeting of all: rank 0 comes once it has checked the output and read
-// the input, the others before reading it, so that an error every rank would meet (a bad
-// input or output) is reported once, by rank 0, which then stops them all.
-void meet_ranks();
+// A command whose field splits over the ranks (segment, sweep): rank 0 checks the output,
+// reads the input and meets the others, which read the input only then (so that an error
+// every rank would meet, a bad input or output, is one line from rank 0, which then stops
+// them all); each rank makes its band of the field, and rank 0 alone goes on and writes.
+class RankedCommand {
+  public:
+    // Whether this rank checks, reports and writes (rank 0, or the only process).
+    bool writer() const { return ranks().rank == 0; }
+    // Before reading the input (after rank 0 checked the output), and after it.
+    void reading() const;
+    void read() const;
+    // options.field_share set when the field of `input` splits over the ranks; false when
+    // this rank has no part in the run (the field does not split: rank 0 makes it whole).
+    bool take_part(pipeline::SegmentOptions& options, const pipeline::Input& input) const;
+};
 
 }  // namespace terrain::cli

@@ -1,5 +1,5 @@
-"""`mpirun -np N terrain segment` (docs/scale.md, "Ranks"): the ranks make the field's bands of
-rows together and rank 0 writes; the outputs are those of one process, byte for byte, at 1, 2
+"""`mpirun -np N terrain segment` and `terrain sweep` (docs/scale.md, "Ranks"): the ranks make
+the field's bands of rows together and rank 0 writes; the outputs are those of one process, byte for byte, at 1, 2
 and 4 ranks; an error on any rank stops every rank with one line naming it."""
 
 import os
@@ -48,6 +48,24 @@ def test_ranks_write_the_outputs_of_one_process(cli, tmp_path, sample):
         # One summary line: rank 0 alone reports.
         assert run.stdout.count("regions on") == 1, run.stdout
         assert files(out) == expected, f"{ranks} ranks"
+
+
+def test_ranks_sweep_as_one_process(cli, tmp_path):
+    # terrain sweep splits its field the same way (the ladder's, with --radius auto).
+    dem = SAMPLE_FILES["vesta"]
+    args = ["--radius", "auto", "--area-ratios", "0.1,0.5,2"]
+    one = cli("sweep", "-q", dem, "-o", tmp_path / "one", *args)
+    assert one.returncode == 0, one.stderr
+    run = mpirun(3, "sweep", "-q", dem, "-o", tmp_path / "three", *args)
+    assert run.returncode == 0, run.stderr
+    assert run.stdout.count("scales;") == 1, run.stdout
+    expected = {p.relative_to(tmp_path / "one"): p.read_bytes()
+                for p in sorted((tmp_path / "one").rglob("*"))
+                if p.is_file() and p.name != "run.json"}
+    got = {p.relative_to(tmp_path / "three"): p.read_bytes()
+           for p in sorted((tmp_path / "three").rglob("*"))
+           if p.is_file() and p.name != "run.json"}
+    assert len(expected) > 10 and got == expected
 
 
 def test_a_field_that_does_not_split_is_made_on_rank_zero(cli, tmp_path):

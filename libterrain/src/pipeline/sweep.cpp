@@ -100,6 +100,7 @@ SweepResult run_sweep(Input input, const std::vector<ScaleSpec>& specs,
     if (base.input.dem) base.add_time("mesh", base.input.mesh_seconds);
     // The slices of the command line's bar (field 0.15-0.4, reeb -0.5, scales -0.75).
     compute_field(base, options, scaled_progress(progress, 0, 0.25 / 0.6));
+    if (options.field_share.stop_after_field) return out;  // (a rank of the field only)
     const auto graph = compute_reeb(base, scaled_progress(progress, 0.25 / 0.6, 0.35 / 0.6));
 
     // Scale by scale, finest first, each simplification continuing from the previous scale's
