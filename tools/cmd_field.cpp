@@ -10,6 +10,7 @@
 #include "cli.hpp"
 #include "field_options.hpp"
 #include "input.hpp"
+#include "ranks.hpp"
 #include "terrain/core/error.hpp"
 #include "terrain/field/vertex_field.hpp"
 #include "terrain/io/mesh_files.hpp"
@@ -66,9 +67,13 @@ int run_field(int argc, char** argv) {
             throw UsageError("the output must end in .tif or .ply");
         if (!to_ply && io::is_mesh_file(input_path))
             throw UsageError("a mesh input gives a .ply output, not a raster");
-        io::check_output_path(output, overwrite);
+        // Under mpirun the ranks make the ladder's field by bands of rows together, rank 0
+        // writes (docs/scale.md, "Ranks"); any other field is made by rank 0 alone.
+        const RankedCommand ranked;
+        if (ranked.writer()) io::check_output_path(output, overwrite);
 
-        const auto progress = terminal_progress(quiet);
+        const auto progress = terminal_progress(quiet || !ranked.writer());
+        ranked.reading();
         const Input input = load_input(input_path, input_values, field_options.kind,
                                        scaled_progress(progress, 0, 0.4));
         const auto field_progress = scaled_progress(progress, 0.4, 1);
@@ -81,7 +86,10 @@ int run_field(int argc, char** argv) {
             (std::filesystem::path(output).parent_path() /
              (std::filesystem::path(output).stem().string() + "_radius.tif"))
                 .string();
-        if (scales) io::check_output_path(radius_path, overwrite);
+        if (scales && ranked.writer()) io::check_output_path(radius_path, overwrite);
+        ranked.read();
+        pipeline::FieldShare share;
+        if (!ranked.take_part(share, scales && input.dem.has_value())) return 0;
         std::vector<float> radius;
         if (field_options.kind == field::FieldKind::sdf) {
             const std::size_t open = input.dem && !field_options.sdf.allow_open
@@ -97,8 +105,9 @@ int run_field(int argc, char** argv) {
         } else {
             check_field_limits(field_options, input.mesh);
             if (scales) {
-                auto selected = field::scale_selected_shape_index(
-                    input.mesh, field_options.shape_index, field_progress);
+                auto selected = pipeline::shared_scale_selected_field(
+                    input.mesh, field_options.shape_index, share, field_progress);
+                if (!ranked.writer()) return 0;
                 values = std::move(selected.field);
                 radius.reserve(selected.scale.size());
                 for (const auto k : selected.scale) radius.push_back(float(selected.radii[k]));

@@ -32,6 +32,8 @@ struct Command {
     const char* summary;
     int (*run)(int, char**);
     bool large_arrays = false;  // works on the whole grid: started again with huge pages
+    // Under mpirun its ranks share the field (ranks.hpp); other commands run on rank 0 alone.
+    bool ranked = false;
 };
 
 constexpr Command kCommands[] = {
@@ -40,13 +42,13 @@ constexpr Command kCommands[] = {
     {"mesh", "triangulate a DEM on its body (or check a mesh file) into a binary PLY",
      terrain::cli::run_mesh, true},
     {"field", "the scalar field (shape index, SDF, height) on a DEM's grid or a mesh's vertices",
-     terrain::cli::run_field, true},
+     terrain::cli::run_field, true, true},
     {"reeb", "the Reeb graph of the field, simplified by persistence and area ratio",
      terrain::cli::run_reeb, true},
     {"segment", "the main job: regions from the Reeb graph, as rasters, polygons and graphs",
-     terrain::cli::run_segment, true},
+     terrain::cli::run_segment, true, true},
     {"sweep", "segmentations at several area ratios from one Reeb graph, with their lineage",
-     terrain::cli::run_sweep, true},
+     terrain::cli::run_sweep, true, true},
     {"synth", "generate a synthetic cratered DEM tile (the Vesta sample)", terrain::cli::run_synth},
 };
 
@@ -117,12 +119,11 @@ int main(int argc, char** argv) {
     }
     for (const auto& c : kCommands) {
         if (first != c.name) continue;
-        // Under mpirun: `segment` and `sweep` split their field over the ranks; any other
-        // command runs on rank 0 alone, the other ranks waiting for it to end.
+        // Under mpirun: the ranked commands split their field over the ranks; any other runs
+        // on rank 0 alone, the other ranks waiting for it to end.
         terrain::cli::start_ranks(argc, argv);
         const auto& ranks = terrain::cli::ranks();
-        if (ranks.size > 1 && ranks.rank != 0 && first != "segment" && first != "sweep")
-            return terrain::cli::finish_ranks(0);
+        if (ranks.size > 1 && ranks.rank != 0 && !c.ranked) return terrain::cli::finish_ranks(0);
         return terrain::cli::finish_ranks(c.run(argc - 1, argv + 1));
     }
     std::cerr << "terrain: unknown command '" << first << "' (see terrain --help)\n";

@@ -88,8 +88,12 @@ void RankedCommand::read() const {
 
 bool RankedCommand::take_part(pipeline::SegmentOptions& options,
                               const pipeline::Input& input) const {
-    if (the_ranks.size > 1 && pipeline::field_splits(options, input)) {
-        options.field_share = field_share();
+    return take_part(options.field_share, pipeline::field_splits(options, input));
+}
+
+bool RankedCommand::take_part(pipeline::FieldShare& share, bool splits) const {
+    if (the_ranks.size > 1 && splits) {
+        share = field_share();
         return true;
     }
     return writer();

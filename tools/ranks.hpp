@@ -39,6 +39,8 @@ class RankedCommand {
     // options.field_share set when the field of `input` splits over the ranks; false when
     // this rank has no part in the run (the field does not split: rank 0 makes it whole).
     bool take_part(pipeline::SegmentOptions& options, const pipeline::Input& input) const;
+    // The same for a field that splits when `splits`, into `share`.
+    bool take_part(pipeline::FieldShare& share, bool splits) const;
 };
 
 }  // namespace terrain::cli

@@ -1,4 +1,4 @@
-"""`mpirun -np N terrain segment` and `terrain sweep` (docs/scale.md, "Ranks"): the ranks make
+"""`mpirun -np N terrain segment`, `sweep` and `field` (docs/scale.md, "Ranks"): the ranks make
 the field's bands of rows together and rank 0 writes; the outputs are those of one process, byte for byte, at 1, 2
 and 4 ranks; an error on any rank stops every rank with one line naming it."""
 
@@ -22,7 +22,7 @@ def mpirun(ranks, *args, env=None):
     for name in (env or {}):
         command += ["-x", name]
     return subprocess.run(command + [os.environ["TERRAIN_CLI"], *map(str, args)],
-                          capture_output=True, text=True, timeout=300,
+                          capture_output=True, text=True, timeout=120,
                           env=dict(ENV, **(env or {})))
 
 
@@ -66,6 +66,18 @@ def test_ranks_sweep_as_one_process(cli, tmp_path):
            for p in sorted((tmp_path / "three").rglob("*"))
            if p.is_file() and p.name != "run.json"}
     assert len(expected) > 10 and got == expected
+
+
+def test_ranks_make_terrain_fields_raster_as_one_process(cli, tmp_path):
+    # terrain field --radius auto: the field and the radius each pixel took, both rasters.
+    dem = SAMPLE_FILES["moon1g"]
+    one = cli("field", "-q", dem, "--radius", "auto", "-o", tmp_path / "one.tif")
+    assert one.returncode == 0, one.stderr
+    run = mpirun(2, "field", "-q", dem, "--radius", "auto", "-o", tmp_path / "two.tif")
+    assert run.returncode == 0, run.stderr
+    assert run.stdout.count("shape_index on") == 1, run.stdout
+    for one_file, two_file in (("one.tif", "two.tif"), ("one_radius.tif", "two_radius.tif")):
+        assert (tmp_path / two_file).read_bytes() == (tmp_path / one_file).read_bytes()
 
 
 def test_a_field_that_does_not_split_is_made_on_rank_zero(cli, tmp_path):

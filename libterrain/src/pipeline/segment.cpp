@@ -106,23 +106,28 @@ std::vector<std::size_t> part_bounds(const TriangleMesh& mesh, int parts) {
 
 }  // namespace
 
+field::ScaleSelectedField shared_scale_selected_field(const TriangleMesh& mesh,
+                                                      field::ShapeIndexOptions options,
+                                                      const FieldShare& share,
+                                                      const ProgressFn& progress) {
+    if (share.parts <= 1) return field::scale_selected_shape_index(mesh, options, progress);
+    const std::int64_t height = mesh.grid_height;
+    options.first_row = int(height * share.part / share.parts);
+    options.end_row = int(height * (share.part + 1) / share.parts);
+    auto selected = field::scale_selected_shape_index(mesh, options, progress);
+    share.gather(selected.field, selected.scale, part_bounds(mesh, share.parts));
+    return selected;
+}
+
 void compute_field(SegmentResult& result, const SegmentOptions& options,
                    const ProgressFn& progress) {
     const auto t0 = clock::now();
-    auto fo = field_options(options);
-    const FieldShare& share = options.field_share;
-    const bool split = share.parts > 1 && field_splits(options, result.input);
-    if (split) {
-        const std::int64_t height = result.input.mesh.grid_height;
-        fo.shape_index.first_row = int(height * share.part / share.parts);
-        fo.shape_index.end_row = int(height * (share.part + 1) / share.parts);
-    }
+    const auto fo = field_options(options);
+    const bool split = options.field_share.parts > 1 && field_splits(options, result.input);
     if (fo.kind == field::FieldKind::shape_index && fo.shape_index.auto_scale) {
         auto selected =
-            field::scale_selected_shape_index(result.input.mesh, fo.shape_index, progress);
-        if (split)
-            share.gather(selected.field, selected.scale,
-                         part_bounds(result.input.mesh, share.parts));
+            shared_scale_selected_field(result.input.mesh, fo.shape_index,
+                                        split ? options.field_share : FieldShare{}, progress);
         result.field = std::move(selected.field);
         result.field_scale = std::move(selected.scale);
         result.field_radii = std::move(selected.radii);

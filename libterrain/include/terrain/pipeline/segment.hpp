@@ -134,6 +134,13 @@ struct SegmentOptions {
 // defaults) on a DEM.
 bool field_splits(const SegmentOptions& options, const Input& input);
 
+// The ladder's field of a DEM mesh (field::scale_selected_shape_index) made by `share`'s parts:
+// this process's band of rows, then the others' gathered (share.parts 1: made whole).
+field::ScaleSelectedField shared_scale_selected_field(const TriangleMesh& mesh,
+                                                      field::ShapeIndexOptions options,
+                                                      const FieldShare& share,
+                                                      const ProgressFn& progress = {});
+
 // The smallest landform of min_area "auto", in mean vertex areas (pixels of a DEM): a floor
 // of about 5 pixels across, that of a crater of about 10.
 inline constexpr double kAutoMinAreaPixels = 20;
