@@ -1,3 +1,5 @@
+// The ranks of an MPI run (ranks.hpp): the only code of the project that calls MPI.
+
 #include "ranks.hpp"
 
 #include <mpi.h>
@@ -32,6 +34,10 @@ void part_counts(const std::vector<std::size_t>& bounds, std::vector<int>& count
         offsets.push_back(int(bounds[p]));
         counts.push_back(int(bounds[p + 1] - bounds[p]));
     }
+}
+
+void meet_ranks() {
+    if (started && the_ranks.size > 1) MPI_Barrier(MPI_COMM_WORLD);
 }
 
 }  // namespace
@@ -69,14 +75,6 @@ const Ranks& ranks() {
 void stop_all_ranks(int status) {
     if (started && the_ranks.size > 1) MPI_Abort(MPI_COMM_WORLD, status);
 }
-
-namespace {
-
-void meet_ranks() {
-    if (started && the_ranks.size > 1) MPI_Barrier(MPI_COMM_WORLD);
-}
-
-}  // namespace
 
 void RankedCommand::reading() const {
     if (!writer()) meet_ranks();
