@@ -40,6 +40,29 @@ void meet_ranks() {
     if (started && the_ranks.size > 1) MPI_Barrier(MPI_COMM_WORLD);
 }
 
+// The field split over the ranks: this rank's part, its values gathered with every other
+// rank's.
+pipeline::FieldShare field_share() {
+    pipeline::FieldShare share;
+    share.part = the_ranks.rank;
+    share.parts = the_ranks.size;
+    share.stop_after_field = the_ranks.rank != 0;
+    share.gather = [](std::vector<float>& field, std::vector<std::uint8_t>& scale,
+                      const std::vector<std::size_t>& bounds) {
+        // (For the tests: a rank's error, after the others started their parts.)
+        if (const char* fail = std::getenv("TERRAIN_FAIL_RANK");
+            fail && std::string(fail) == std::to_string(the_ranks.rank))
+            throw Error("segment", "stopped on purpose by TERRAIN_FAIL_RANK");
+        std::vector<int> counts, offsets;
+        part_counts(bounds, counts, offsets);
+        MPI_Allgatherv(MPI_IN_PLACE, 0, MPI_DATATYPE_NULL, field.data(), counts.data(),
+                       offsets.data(), MPI_FLOAT, MPI_COMM_WORLD);
+        MPI_Allgatherv(MPI_IN_PLACE, 0, MPI_DATATYPE_NULL, scale.data(), counts.data(),
+                       offsets.data(), MPI_UNSIGNED_CHAR, MPI_COMM_WORLD);
+    };
+    return share;
+}
+
 }  // namespace
 
 void start_ranks(int& argc, char**& argv) {
@@ -95,27 +118,6 @@ bool RankedCommand::take_part(pipeline::FieldShare& share, bool splits) const {
         return true;
     }
     return writer();
-}
-
-pipeline::FieldShare field_share() {
-    pipeline::FieldShare share;
-    share.part = the_ranks.rank;
-    share.parts = the_ranks.size;
-    share.stop_after_field = the_ranks.rank != 0;
-    share.gather = [](std::vector<float>& field, std::vector<std::uint8_t>& scale,
-                      const std::vector<std::size_t>& bounds) {
-        // (For the tests: a rank's error, after the others started their parts.)
-        if (const char* fail = std::getenv("TERRAIN_FAIL_RANK");
-            fail && std::string(fail) == std::to_string(the_ranks.rank))
-            throw Error("segment", "stopped on purpose by TERRAIN_FAIL_RANK");
-        std::vector<int> counts, offsets;
-        part_counts(bounds, counts, offsets);
-        MPI_Allgatherv(MPI_IN_PLACE, 0, MPI_DATATYPE_NULL, field.data(), counts.data(),
-                       offsets.data(), MPI_FLOAT, MPI_COMM_WORLD);
-        MPI_Allgatherv(MPI_IN_PLACE, 0, MPI_DATATYPE_NULL, scale.data(), counts.data(),
-                       offsets.data(), MPI_UNSIGNED_CHAR, MPI_COMM_WORLD);
-    };
-    return share;
 }
 
 }  // namespace terrain::cli

@@ -21,10 +21,6 @@ const Ranks& ranks();
 // With several ranks: stops every rank with `status` (after a rank's error line).
 void stop_all_ranks(int status);
 
-// The field split over the ranks (pipeline::FieldShare): this rank's part, its values
-// gathered with every other rank's.
-pipeline::FieldShare field_share();
-
 // A command whose field splits over the ranks (segment, sweep): rank 0 checks the output,
 // reads the input and meets the others, which read the input only then (so that an error
 // every rank would meet, a bad input or output, is one line from rank 0, which then stops

@@ -27,8 +27,10 @@ def mpirun(ranks, *args, env=None):
 
 
 def files(directory):
-    """Every output file's bytes but run.json's (its timings and versions)."""
-    return {p.name: p.read_bytes() for p in sorted(directory.iterdir()) if p.name != "run.json"}
+    """Every output file's bytes (in subdirectories too) but run.json's (its timings and
+    versions), by path within the directory."""
+    return {str(p.relative_to(directory)): p.read_bytes() for p in sorted(directory.rglob("*"))
+            if p.is_file() and p.name != "run.json"}
 
 
 @pytest.mark.parametrize("sample", ["vesta", "moon1g"])
@@ -59,13 +61,8 @@ def test_ranks_sweep_as_one_process(cli, tmp_path):
     run = mpirun(3, "sweep", "-q", dem, "-o", tmp_path / "three", *args)
     assert run.returncode == 0, run.stderr
     assert run.stdout.count("scales;") == 1, run.stdout
-    expected = {p.relative_to(tmp_path / "one"): p.read_bytes()
-                for p in sorted((tmp_path / "one").rglob("*"))
-                if p.is_file() and p.name != "run.json"}
-    got = {p.relative_to(tmp_path / "three"): p.read_bytes()
-           for p in sorted((tmp_path / "three").rglob("*"))
-           if p.is_file() and p.name != "run.json"}
-    assert len(expected) > 10 and got == expected
+    expected = files(tmp_path / "one")
+    assert len(expected) > 10 and files(tmp_path / "three") == expected
 
 
 def test_ranks_make_terrain_fields_raster_as_one_process(cli, tmp_path):

@@ -304,11 +304,9 @@ void climb_rung(const TriangleMesh& mesh, const ShapeIndexOptions& one, const Ru
                 lattice.set(mesh.vertex_pixel[std::size_t(v)], float(cd), float(f));
         });
     const std::size_t n = mesh.vertex_count();
-    const auto width = std::int64_t(mesh.grid_width);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096), [&](const auto& r) {
         for (std::size_t v = r.begin(); v < r.end(); ++v) {
-            const std::int64_t row = mesh.vertex_pixel[v] / width;
-            if (row < one.first_row || row >= one.end_row) continue;
+            if (!detail::row_asked(mesh, one, std::int32_t(v))) continue;
             float cd = 0, f = 0;
             if (lattice.at(mesh.vertex_pixel[v], cd, f)) choice.climb(v, rung, cd, f);
         }

@@ -162,14 +162,6 @@ void fit_in_batches(const TriangleMesh& mesh, const std::vector<Vec3>& normals,
     }
 }
 
-// Whether vertex v's row is among options' rows (a vertex of a mesh not made from a DEM:
-// always).
-bool row_asked(const TriangleMesh& mesh, const ShapeIndexOptions& options, std::int32_t v) {
-    if (mesh.grid_width <= 0 || mesh.vertex_pixel.size() != mesh.vertex_count()) return true;
-    const auto row = std::int64_t(mesh.vertex_pixel[std::size_t(v)]) / mesh.grid_width;
-    return row >= options.first_row && row < options.end_row;
-}
-
 template <class Body>
 void for_each_vertex(const TriangleMesh& mesh, const ShapeIndexOptions& options,
                      const ProgressFn& progress, Body body) {
@@ -217,6 +209,12 @@ void for_each_vertex(const TriangleMesh& mesh, const ShapeIndexOptions& options,
 }
 
 }  // namespace
+
+bool row_asked(const TriangleMesh& mesh, const ShapeIndexOptions& options, std::int32_t v) {
+    if (mesh.grid_width <= 0 || mesh.vertex_pixel.size() != mesh.vertex_count()) return true;
+    const auto row = std::int64_t(mesh.vertex_pixel[std::size_t(v)]) / mesh.grid_width;
+    return row >= options.first_row && row < options.end_row;
+}
 
 void for_each_curvature(const TriangleMesh& mesh, const ShapeIndexOptions& options,
                         const ProgressFn& progress, const CurvatureBody& body) {

@@ -385,6 +385,9 @@ void disk_tile(const TriangleMesh& mesh, const GridLayout& g, const Normals& nor
 using CurvatureBody = std::function<void(std::int32_t, bool, const PrincipalCurvatures&, double)>;
 void for_each_curvature(const TriangleMesh& mesh, const ShapeIndexOptions& options,
                         const ProgressFn& progress, const CurvatureBody& body);
+// Whether vertex v's pixel row is among options' rows [first_row, end_row) (a vertex of a
+// mesh not made from a DEM: always).
+bool row_asked(const TriangleMesh& mesh, const ShapeIndexOptions& options, std::int32_t v);
 // Whether the disk window applies (a radius, the disk window, a mesh made from a DEM) and
 // whether the grid method does (shape_index_grid.cpp); the grid method refuses a mesh not made
 // from a DEM when asked for.

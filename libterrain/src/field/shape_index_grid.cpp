@@ -321,10 +321,7 @@ std::size_t grid_for_each_vertex(const TriangleMesh& mesh, const GridLayout& g,
     const auto asked = [&](int r0, int r1) {
         return r1 > options.first_row && r0 < options.end_row;
     };
-    std::erase_if(unowned, [&](std::int32_t v) {
-        const int row = int(std::size_t(mesh.vertex_pixel[std::size_t(v)]) / std::size_t(g.width));
-        return !asked(row, row + 1);
-    });
+    std::erase_if(unowned, [&](std::int32_t v) { return !row_asked(mesh, options, v); });
     std::vector<Vec3> unowned_normals(unowned.size());
     std::size_t next_unowned = 0;
     for (int tr = 0; tr < tile_rows; ++tr) {

@@ -266,8 +266,8 @@ void flood_in_parts(const Flooding& flooding, std::size_t part_count, std::size_
                     const ProgressFn& progress) {
     const std::size_t n = flooding.sites().size();
     Parts parts;
-    parts.size = std::max<std::size_t>(
-        1, (n + std::max<std::size_t>(1, part_count) - 1) / std::max<std::size_t>(1, part_count));
+    const std::size_t asked = std::max<std::size_t>(1, part_count);
+    parts.size = std::max<std::size_t>(1, (n + asked - 1) / asked);
     const std::size_t k = parts.count = std::max<std::size_t>(1, (n + parts.size - 1) / parts.size);
     parts.heaps.resize(k);
     parts.inbox.resize(k * k);
